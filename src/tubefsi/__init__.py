@@ -1,0 +1,24 @@
+"""tubefsi: steady fluid–structure interaction of generalized Newtonian flow in soft tubes.
+
+Quick start::
+
+    import tubefsi
+    tube = tubefsi.Tube(radius=1e-4, thickness=3e-5, length=1e-2)
+    fluid = tubefsi.registry.rheologies["power-law"](consistency=0.017, index=0.7)
+    wall = tubefsi.registry.walls["thick-neo-hookean"](shear_modulus=2e3)
+    sol = tubefsi.solve(fluid, wall, tube, flow_rate=1e-9)
+    sol.pressure_drop, sol.inlet_displacement
+"""
+
+from . import registry
+from .errors import ConvergenceError, InvalidParameterError, NoSteadyStateError, TubefsiError
+from .geometry import Tube
+from .solution import Solution
+from .solve import max_flow_rate, select_coupler, solve
+
+__all__ = [
+    "Tube", "solve", "max_flow_rate", "select_coupler", "Solution", "registry",
+    "TubefsiError", "InvalidParameterError", "NoSteadyStateError", "ConvergenceError",
+]
+
+__version__ = "0.1.0"

@@ -1,0 +1,233 @@
+r"""The coupler contract, and the separated-variables machinery couplers share.
+
+Lubrication theory gives :math:`dp/dz = -G(q, R(p))` with :math:`p(L) = p_{out}`.
+Writing the tube law :math:`p = P(\lambda)` and the log-stretch
+:math:`u = \ln(\lambda/\lambda_{out})` separates the variables:
+
+.. math::
+
+    L - z = \int_0^{v(z)} \frac{s\,P'(s)}{G(q, a s)}\,du, \qquad s = \lambda_{out} e^u,
+
+so the inlet log-stretch :math:`v` solves :math:`H(v; q) = L` and the pressure drop is
+:math:`\int_0^v s P'(s)\,du`. For a separable rheology, :math:`G = \phi(q)\psi(R)`, this is
+:math:`J(v) = L\,\phi(q)` with :math:`J` independent of :math:`q`, so one function serves a
+whole flow curve. Couplers differ only in how they evaluate :math:`J` (closed form or
+Gauss–Legendre quadrature) or in integrating the ODE instead.
+"""
+
+from __future__ import annotations
+
+import abc
+import math
+from typing import ClassVar
+
+import attrs
+import numpy as np
+from scipy.optimize import elementwise
+
+from .._numerics import integrate_panels, solve_increasing
+from ..errors import NoSteadyStateError
+
+__all__ = ["Coupler", "Scene", "State"]
+
+#: Largest inlet stretch (relative to the outlet) a solve may reach: ln(1e15).
+MAX_LOG_STRETCH = math.log(1e15)
+_PROBE_LOG_STRETCH = math.log(1e8)
+
+
+@attrs.frozen
+class State:
+    """What a coupler returns: arrays of one shape."""
+
+    flow_rate: np.ndarray
+    pressure_drop: np.ndarray
+    inlet_strain: np.ndarray
+    log_stretch: np.ndarray          # v = ln(lambda_in / lambda_out)
+
+
+@attrs.frozen(kw_only=True)
+class Scene:
+    """A rheology, a wall, a tube and an outlet pressure: everything but the load."""
+
+    rheology: object
+    wall: object
+    tube: object
+    outlet_pressure: float = 0.0
+
+    @property
+    def tb(self) -> float:
+        return self.tube.reduced_thickness
+
+    @property
+    def outlet_strain(self) -> float:
+        return float(self.wall._strain(np.asarray(self.outlet_pressure), self.tb))
+
+    @property
+    def outlet_stretch(self) -> float:
+        return 1.0 + self.outlet_strain
+
+    # -- tube law along u
+    def stretch_at(self, u):
+        return self.outlet_stretch * np.exp(u)
+
+    def strain_at(self, u):
+        """Hoop strain at log-stretch ``u``, without cancellation."""
+        return self.outlet_strain + self.outlet_stretch * np.expm1(u)
+
+    def pressure_rise(self, v):
+        r""":math:`P(\lambda_{out}e^v) - p_{out}`, computed without cancellation."""
+        v = np.asarray(v, dtype=float)
+        if self.outlet_pressure == 0.0:
+            return self.wall._pressure_at_strain(np.expm1(v), self.tb)
+        return integrate_panels(lambda u: self._slope(u), v)
+
+    def _slope(self, u):
+        s = self.stretch_at(u)
+        return s * self.wall._stiffness(s, self.tb)
+
+    # -- the separated integrand
+    def integrand(self, u, q=None):
+        r""":math:`s P'(s)/\psi(a s)` (separable) or :math:`s P'(s)/G(q, a s)`."""
+        s = self.stretch_at(u)
+        a = self.tube.radius
+        slope = s * self.wall._stiffness(s, self.tb)
+        if self.rheology.separable:
+            return slope / self.rheology._radius_factor(a * s)
+        qq = np.broadcast_to(q, np.shape(u))
+        return slope / self.rheology._pressure_gradient(qq, a * s)
+
+    def target(self, q):
+        """Right-hand side of the separated identity for flow rate ``q``."""
+        if self.rheology.separable:
+            return self.tube.length * self.rheology._flow_factor(q)
+        return np.full(np.shape(q), self.tube.length)
+
+
+class Coupler(abc.ABC):
+    """Abstract solution strategy. Subclasses are attrs frozen classes of options."""
+
+    __slots__ = ()
+
+    #: Lower is cheaper; ``coupler="auto"`` takes the cheapest that supports the pair.
+    cost_rank: ClassVar[int] = 100
+    #: Whether ``auto`` may pick it (it meets the 1e-12 accuracy contract).
+    meets_accuracy_contract: ClassVar[bool] = True
+    #: Whether ``_J`` (the separated integral) is available for profiles.
+    separates_variables: ClassVar[bool] = True
+
+    @abc.abstractmethod
+    def supports(self, rheology, wall) -> bool:
+        """Whether this coupler can solve ``rheology`` flowing in ``wall``."""
+
+    # --------------------------------------------------------------- J hooks
+    @abc.abstractmethod
+    def _J(self, scene: Scene, v, q):
+        r""":math:`\int_0^v` of the separated integrand (``q`` only if non-separable)."""
+
+    def _J_infinity(self, scene: Scene, q=None) -> float:
+        r""":math:`J(\infty)`: finite only for a wall with a limit pressure and a fast
+        enough decay of :math:`s P'(s)/\psi(as)`; used for the maximum flow rate."""
+        tb = scene.tb
+        if not math.isfinite(scene.wall._limit_pressure(tb)):
+            return math.inf
+        rheo = scene.rheology
+        mu = getattr(rheo, "radius_exponent", None)
+        if mu is None:
+            r = scene.tube.radius * np.array([1e6, 1e7])
+            qq = 1.0 if q is None else q
+            g = rheo._pressure_gradient(np.full(2, qq), r) if not rheo.separable else rheo._radius_factor(r)
+            mu = float(-np.log(g[1] / g[0]) / np.log(10.0))
+        alpha = scene.wall._stiffness_decay_exponent(tb) - 1.0 - mu
+        if not alpha > 1e-12:
+            return math.inf
+        v1 = np.asarray(_PROBE_LOG_STRETCH)
+        head = self._J(scene, v1, q)
+        tail = scene.integrand(v1, q) / alpha
+        return float(head + tail)
+
+    # --------------------------------------------------------------- problems
+    def flow_controlled(self, scene: Scene, flow_rate) -> State:
+        """Solve for the pressure drop at each flow rate (array)."""
+        q = np.asarray(flow_rate, dtype=float)
+        if scene.wall.is_rigid:
+            dp = scene.tube.length * scene.rheology._pressure_gradient(q, scene.tube.radius)
+            dp = np.where(q == 0, 0.0, dp)
+            zero = np.zeros_like(q)
+            return State(q, dp, zero + scene.outlet_strain, zero)
+        target = scene.target(q)
+        sep = scene.rheology.separable
+        qflat = q.ravel()
+
+        def F(v, i):
+            return self._J(scene, v, None if sep else qflat[i])
+
+        def dF(v, i):
+            return scene.integrand(v, None if sep else qflat[i])
+
+        slope0 = scene.integrand(np.zeros_like(q), None if sep else q)
+        guess = np.minimum(target / slope0, 1.0)
+        v, ok = solve_increasing(F, dF, np.where(q == 0, 0.0, target), guess=guess,
+                                 xmax=MAX_LOG_STRETCH, max_step=2.0)
+        if not np.all(ok):
+            self._raise_runaway(scene, q, ok)
+        dp = scene.pressure_rise(v)
+        return State(q, dp, scene.strain_at(v), v)
+
+    def pressure_controlled(self, scene: Scene, pressure_drop) -> State:
+        """Solve for the flow rate at each pressure drop (array)."""
+        dp = np.asarray(pressure_drop, dtype=float)
+        tb, wall, a, L = scene.tb, scene.wall, scene.tube.radius, scene.tube.length
+        rheo = scene.rheology
+        if wall.is_rigid:
+            q = np.where(dp == 0, 0.0, rheo._flow_rate(np.full_like(dp, a), np.where(dp == 0, 1.0, dp) / L))
+            zero = np.zeros_like(dp)
+            return State(q, dp, zero + scene.outlet_strain, zero)
+        wall._check_pressure(scene.outlet_pressure + dp, tb)
+        e_in = wall._strain(scene.outlet_pressure + dp, tb)
+        v = np.log1p((e_in - scene.outlet_strain) / scene.outlet_stretch)
+        if rheo.separable:
+            q = rheo._flow_factor_inverse(self._J(scene, v, None) / L)
+        else:
+            q = self._solve_flow_rate(scene, v, dp)
+        q = np.where(dp == 0, 0.0, q)
+        return State(q, dp, e_in, v)
+
+    def _solve_flow_rate(self, scene, v, dp):
+        """Non-separable rheology: find q with H(v; q) = L, bracketed by rigid tubes."""
+        a, L, rheo = scene.tube.radius, scene.tube.length, scene.rheology
+        g = np.where(dp == 0, 1.0, dp) / L
+        q_lo = rheo._flow_rate(np.full_like(g, a * scene.outlet_stretch), g)
+        q_hi = rheo._flow_rate(a * scene.stretch_at(v), g)
+
+        def f(log_q, v):
+            return np.log(self._J(scene, v, np.exp(log_q))) - np.log(L)
+
+        lo, hi = np.log(q_lo), np.log(q_hi) * (1 + 1e-15) + 1e-15
+        res = elementwise.find_root(f, (lo - 1e-12 * np.abs(lo), hi), args=(v,),
+                                    tolerances=dict(xrtol=4 * np.finfo(float).eps, xatol=1e-300))
+        return np.exp(res.x)
+
+    def max_flow_rate(self, scene: Scene) -> float:
+        """Largest flow rate with a steady state (``inf`` if none)."""
+        if scene.wall.is_rigid:
+            return math.inf
+        j_inf = self._J_infinity(scene)
+        if not math.isfinite(j_inf):
+            return math.inf
+        if scene.rheology.separable:
+            return float(scene.rheology._flow_factor_inverse(j_inf / scene.tube.length))
+        raise NotImplementedError("maximum flow rate of a non-separable rheology")
+
+    def _raise_runaway(self, scene, q, ok):
+        q_max = self.max_flow_rate(scene)
+        bad = q[~ok].flat[0]
+        if math.isfinite(q_max) and bad >= q_max:
+            raise NoSteadyStateError("flow_rate", q_max, bad, "the tube inflates without bound")
+        v = np.asarray(MAX_LOG_STRETCH)
+        sep = scene.rheology.separable
+        if sep:
+            reach = float(scene.rheology._flow_factor_inverse(self._J(scene, v, None) / scene.tube.length))
+        else:
+            reach = float("nan")
+        raise NoSteadyStateError("flow_rate", reach, bad,
+                                 "the inlet stretch would exceed 1e15 (the tube inflates without practical bound)")

@@ -1,0 +1,49 @@
+r"""``closed-form``: power-law fluids in walls whose separated integral is elementary.
+
+For :math:`G = \phi(q)(as)^{-k}`, :math:`k = 3n+1`,
+:math:`J(v) = a^k\int_0^v s^{k+1}P'(s)\,du`, which the wall gives in closed form
+(``WallModel._power_law_integral``) for linear walls and both thin Mooney–Rivlin /
+neo-Hookean conventions, e.g. thin reference thickness with :math:`\lambda_{out} = 1`:
+
+.. math::
+
+    J/(a^k\mu\bar t) = \frac{\lambda^{3n+2} - 1}{3n+2} + 3\,\frac{\lambda^{3n-2} - 1}{3n-2},
+
+evaluated as ``expm1(c v)/c``, exact through the removable singularities at
+:math:`n = 2/3` and (thin current thickness) :math:`n = 1`.
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import attrs
+import numpy as np
+
+from .base import Coupler
+
+__all__ = ["ClosedForm"]
+
+
+@attrs.frozen(kw_only=True)
+class ClosedForm(Coupler):
+    """Closed-form separated integral (power-law fluid; rigid, linear or thin hyperelastic wall)."""
+
+    cost_rank: ClassVar[int] = 0
+
+    def supports(self, rheology, wall) -> bool:
+        if getattr(rheology, "radius_exponent", None) is None or not rheology.separable:
+            return False
+        if wall.is_rigid:
+            return True
+        probe = wall._power_law_integral(np.asarray(0.5), 1.0, 4.0, 0.1)
+        return probe is not None
+
+    def _J(self, scene, v, q):
+        k = scene.rheology.radius_exponent
+        a = scene.tube.radius
+        return a**k * scene.wall._power_law_integral(np.asarray(v, dtype=float), scene.outlet_stretch, k,
+                                                     scene.tb)
+
+    def _J_infinity(self, scene, q=None):
+        return float(self._J(scene, np.asarray(np.inf), None))

@@ -1,0 +1,129 @@
+r"""``ode``: integrate the lubrication ODE along the tube, as the chapter does.
+
+The state is :math:`y = (\lambda, p - p_{out})`, integrated from :math:`z = L`
+(:math:`\lambda = \lambda_{out}`, :math:`p = p_{out}`) to :math:`z = 0`:
+
+.. math::
+
+    \frac{d\lambda}{dz} = -\frac{G(q, a\lambda)}{P'(\lambda)}, \qquad
+    \frac{dp}{dz} = -G(q, a\lambda).
+
+``method`` is any :func:`scipy.integrate.solve_ivp` method, or ``"odeint"`` for
+:func:`scipy.integrate.odeint` (LSODA) with its default tolerances — the chapter's
+method, kept as the speed baseline. Pressure-controlled problems are solved by
+shooting on the flow rate (Brent's method inside the rigid-tube bracket). One ODE
+runs per point; this coupler is a reference, not a default.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import ClassVar
+
+import attrs
+import numpy as np
+from scipy import integrate, optimize
+
+from ..errors import ConvergenceError, NoSteadyStateError
+from .base import Coupler, State
+
+__all__ = ["ODE"]
+
+_METHODS = ("odeint", "RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
+
+
+def _check_method(instance, attribute, value):
+    if value not in _METHODS:
+        from ..errors import InvalidParameterError
+
+        raise InvalidParameterError("method", "{" + ", ".join(_METHODS) + "}", value)
+
+
+@attrs.frozen(kw_only=True)
+class ODE(Coupler):
+    """Integrate dp/dz = -G(q, R(p)) with SciPy (reference path, one ODE per point)."""
+
+    method: str = attrs.field(default="LSODA", validator=_check_method)
+    rtol: float | None = attrs.field(default=None)
+    atol: float | None = attrs.field(default=None)
+
+    cost_rank: ClassVar[int] = 1000
+    meets_accuracy_contract: ClassVar[bool] = False
+    separates_variables: ClassVar[bool] = False
+
+    def supports(self, rheology, wall) -> bool:
+        return True
+
+    def _J(self, scene, v, q):  # pragma: no cover - the ODE path does not separate variables
+        raise NotImplementedError
+
+    def max_flow_rate(self, scene):
+        from .quadrature import Quadrature
+
+        return Quadrature().max_flow_rate(scene)
+
+    def _integrate(self, scene, q):
+        """Return (inlet stretch, pressure rise) for one flow rate."""
+        tb, a, L = scene.tb, scene.tube.radius, scene.tube.length
+        wall, rheo = scene.wall, scene.rheology
+        lam_max = wall._max_stretch(tb)
+
+        def rhs(z, y):
+            lam = min(max(y[0], 1.0), lam_max * (1 - 1e-15)) if math.isfinite(lam_max) else max(y[0], 1.0)
+            g = float(rheo._pressure_gradient(np.asarray([q]), np.asarray([a * lam]))[0])
+            stiff = float(wall._stiffness(np.asarray(lam), tb))
+            return [-g / stiff, -g]
+
+        y0 = [scene.outlet_stretch, 0.0]
+        if self.method == "odeint":
+            kw = {k: v for k, v in (("rtol", self.rtol), ("atol", self.atol)) if v is not None}
+            y, info = integrate.odeint(rhs, y0, [L, 0.0], tfirst=True, full_output=True, **kw)
+            if info["message"] != "Integration successful.":
+                raise ConvergenceError(f"odeint failed at q = {q!r}: {info['message']}")
+            lam_in, rise = y[-1]
+        else:
+            kw = {k: v for k, v in (("rtol", self.rtol), ("atol", self.atol)) if v is not None}
+            sol = integrate.solve_ivp(rhs, (L, 0.0), y0, method=self.method, **kw)
+            if not sol.success:
+                raise ConvergenceError(f"solve_ivp({self.method}) failed at q = {q!r}: {sol.message}")
+            lam_in, rise = sol.y[:, -1]
+        if not (np.isfinite(lam_in) and np.isfinite(rise)):
+            raise ConvergenceError(f"the ODE solution is not finite at q = {q!r}")
+        return lam_in, rise
+
+    def flow_controlled(self, scene, flow_rate) -> State:
+        q = np.asarray(flow_rate, dtype=float)
+        if scene.wall.is_rigid:
+            return super().flow_controlled(scene, q)
+        q_max = self.max_flow_rate(scene)
+        if np.any(q >= q_max):
+            raise NoSteadyStateError("flow_rate", q_max, q[q >= q_max].flat[0])
+        lam = np.empty(q.size)
+        rise = np.empty(q.size)
+        for i, qi in enumerate(q.ravel()):
+            lam[i], rise[i] = (scene.outlet_stretch, 0.0) if qi == 0 else self._integrate(scene, qi)
+        lam, rise = lam.reshape(q.shape), rise.reshape(q.shape)
+        v = np.log(lam / scene.outlet_stretch)
+        return State(q, rise, lam - 1.0, v)
+
+    def pressure_controlled(self, scene, pressure_drop) -> State:
+        dp = np.asarray(pressure_drop, dtype=float)
+        if scene.wall.is_rigid:
+            return super().pressure_controlled(scene, dp)
+        tb, a, L, rheo = scene.tb, scene.tube.radius, scene.tube.length, scene.rheology
+        scene.wall._check_pressure(scene.outlet_pressure + dp, tb)
+        e_in = scene.wall._strain(scene.outlet_pressure + dp, tb)
+        q = np.zeros(dp.size)
+        for i, (d, e) in enumerate(zip(dp.ravel(), np.ravel(e_in))):
+            if d == 0:
+                continue
+            lo = float(rheo._flow_rate(np.asarray([a * scene.outlet_stretch]), np.asarray([d / L]))[0])
+            hi = float(rheo._flow_rate(np.asarray([a * (1.0 + e)]), np.asarray([d / L]))[0])
+            if hi <= lo * (1 + 1e-14):
+                q[i] = lo
+                continue
+            q[i] = optimize.brentq(lambda qq: self._integrate(scene, qq)[1] - d, lo, hi,
+                                   xtol=1e-300, rtol=8 * np.finfo(float).eps)
+        q = q.reshape(dp.shape)
+        v = np.log1p((e_in - scene.outlet_strain) / scene.outlet_stretch)
+        return State(q, dp, e_in, v)

@@ -1,0 +1,73 @@
+"""Exception types raised by tubefsi.
+
+Every failure the library can foresee is one of these, never a NaN or an
+exception from deep inside SciPy.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "TubefsiError",
+    "InvalidParameterError",
+    "NoSteadyStateError",
+    "ConvergenceError",
+]
+
+
+class TubefsiError(Exception):
+    """Base class of every tubefsi exception."""
+
+
+class InvalidParameterError(TubefsiError, ValueError):
+    """A parameter lies outside its admissible range.
+
+    Attributes
+    ----------
+    parameter : str
+        The name of the offending parameter, as the caller spelled it.
+    admissible : str
+        The admissible range, e.g. ``"(0, inf)"``.
+    """
+
+    def __init__(self, parameter: str, admissible: str, value=None, detail: str = ""):
+        self.parameter = parameter
+        self.admissible = admissible
+        self.value = value
+        got = "" if value is None else f" (got {_short(value)})"
+        extra = f"; {detail}" if detail else ""
+        super().__init__(f"{parameter} must be in {admissible}{got}{extra}")
+
+
+class NoSteadyStateError(TubefsiError, ValueError):
+    """The requested load has no steady solution: the tube inflates without bound.
+
+    Attributes
+    ----------
+    quantity : str
+        Which load exceeds its limit: ``"pressure"`` or ``"flow_rate"``.
+    limit : float
+        The limit (Pa or m^3/s) that the load must stay below.
+    """
+
+    def __init__(self, quantity: str, limit: float, value=None, detail: str = ""):
+        self.quantity = quantity
+        self.limit = float(limit)
+        got = "" if value is None else f" (got {_short(value)})"
+        unit = "Pa" if quantity == "pressure" else "m^3/s"
+        extra = f"; {detail}" if detail else ""
+        super().__init__(
+            f"no steady state: {quantity} must stay below its limit {self.limit:.10g} {unit}{got}{extra}"
+        )
+
+
+class ConvergenceError(TubefsiError, ArithmeticError):
+    """An iterative method did not reach its tolerance (a non-default method's failure)."""
+
+
+def _short(value) -> str:
+    import numpy as np
+
+    a = np.asarray(value)
+    if a.ndim == 0:
+        return f"{a.item()!r}"
+    return f"array of shape {a.shape}"

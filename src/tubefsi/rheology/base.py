@@ -1,0 +1,166 @@
+r"""The rheology contract: a generalized Newtonian fluid in simple shear.
+
+A subclass implements ``_stress(shear_rate)`` *or* ``_shear_rate(stress)`` (for
+positive arguments). The base class derives the inverse, the apparent viscosity
+and, from the Rabinowitsch–Mooney integral with :math:`\tau = G r/2`,
+
+.. math::
+
+    q(R, G) = \frac{\pi R^3}{\tau_w^3}\int_0^{\tau_w} \tau^2\,\dot\gamma(\tau)\,d\tau,
+    \qquad \tau_w = \frac{G R}{2},
+
+the tube flow function, its inverse ``pressure_gradient(q, R)`` and the velocity
+profile :math:`v(r) = \int_r^R \dot\gamma(G\rho/2)\,d\rho`.
+
+A *separable* rheology (Newtonian, power law) has
+:math:`G(q, R) = \phi(q)\,\psi(R)`; it sets ``separable = True`` and implements
+``_flow_factor`` (:math:`\phi`), ``_flow_factor_inverse`` and ``_radius_factor``
+(:math:`\psi`). Couplers then reuse one integral for a whole flow curve.
+"""
+
+from __future__ import annotations
+
+import abc
+import math
+
+import numpy as np
+from scipy import integrate
+from scipy.optimize import elementwise
+
+from .._numerics import as_output
+from .._validation import as_array
+
+__all__ = ["Rheology"]
+
+_TOL = dict(xrtol=4 * np.finfo(float).eps, xatol=1e-300)
+
+
+def _overrides(obj, name) -> bool:
+    return getattr(type(obj), name) is not getattr(Rheology, name)
+
+
+class Rheology(abc.ABC):
+    """Abstract base of every rheology (see the module docstring for the contract)."""
+
+    __slots__ = ()
+
+    #: True when ``pressure_gradient(q, R) = phi(q) * psi(R)``.
+    separable = False
+
+    # ------------------------------------------------------------------ public API
+    def stress(self, shear_rate):
+        """Shear stress (Pa) at shear rate ``shear_rate`` (1/s, >= 0)."""
+        g = as_array("shear_rate", shear_rate, "[0, inf)", lambda a: a >= 0)
+        return as_output(np.where(g == 0, 0.0, self._stress(np.where(g == 0, 1.0, g))), np.ndim(shear_rate) == 0)
+
+    def shear_rate(self, stress):
+        """Shear rate (1/s) at shear stress ``stress`` (Pa, >= 0)."""
+        t = as_array("stress", stress, "[0, inf)", lambda a: a >= 0)
+        return as_output(np.where(t == 0, 0.0, self._shear_rate(np.where(t == 0, 1.0, t))), np.ndim(stress) == 0)
+
+    def apparent_viscosity(self, shear_rate):
+        r"""Apparent viscosity :math:`\eta = \tau/\dot\gamma` (Pa s), shear rate > 0."""
+        g = as_array("shear_rate", shear_rate, "(0, inf)", lambda a: a > 0)
+        return as_output(self._stress(g) / g, np.ndim(shear_rate) == 0)
+
+    def flow_rate(self, radius, pressure_gradient):
+        r"""Flow rate :math:`q(R, G)` (m^3/s) in a rigid tube of radius ``radius`` (m)
+        under pressure gradient :math:`G = -dp/dz` (Pa/m)."""
+        r = as_array("radius", radius, "(0, inf)", lambda a: a > 0)
+        g = as_array("pressure_gradient", pressure_gradient, "[0, inf)", lambda a: a >= 0)
+        r, g = np.broadcast_arrays(r, g)
+        out = np.zeros(r.shape)
+        pos = g > 0
+        out[pos] = self._flow_rate(r[pos], g[pos])
+        return as_output(out, np.ndim(radius) == 0 and np.ndim(pressure_gradient) == 0)
+
+    def pressure_gradient(self, flow_rate, radius):
+        r"""Pressure gradient :math:`G(q, R) = -dp/dz` (Pa/m) that drives ``flow_rate`` (m^3/s)."""
+        q = as_array("flow_rate", flow_rate, "[0, inf)", lambda a: a >= 0)
+        r = as_array("radius", radius, "(0, inf)", lambda a: a > 0)
+        q, r = np.broadcast_arrays(q, r)
+        out = np.zeros(q.shape)
+        pos = q > 0
+        out[pos] = self._pressure_gradient(q[pos], r[pos])
+        return as_output(out, np.ndim(flow_rate) == 0 and np.ndim(radius) == 0)
+
+    def velocity(self, r, radius, pressure_gradient):
+        r"""Axial velocity (m/s) at radial position ``r`` (0 <= r <= radius)."""
+        rr = as_array("r", r, "[0, radius]", lambda a: a >= 0)
+        big_r = as_array("radius", radius, "(0, inf)", lambda a: a > 0)
+        g = as_array("pressure_gradient", pressure_gradient, "[0, inf)", lambda a: a >= 0)
+        rr, big_r, g = np.broadcast_arrays(rr, big_r, g)
+        if np.any(rr > big_r * (1 + 1e-12)):
+            raise _invalid("r", "[0, radius]", rr[rr > big_r].flat[0])
+        out = np.zeros(rr.shape)
+        pos = g > 0
+        out[pos] = self._velocity(np.minimum(rr[pos], big_r[pos]), big_r[pos], g[pos])
+        return as_output(out, all(np.ndim(v) == 0 for v in (r, radius, pressure_gradient)))
+
+    # ------------------------------------------------------------------ hooks
+    def _stress(self, shear_rate):
+        if not _overrides(self, "_shear_rate"):
+            raise TypeError(f"{type(self).__name__} must implement _stress or _shear_rate")
+        g = np.asarray(shear_rate, dtype=float)
+
+        def f(t, g):
+            return self._shear_rate(t) - g
+
+        lo = np.full_like(g, 1e-300)
+        b = elementwise.bracket_root(f, lo, np.maximum(g, 1.0), xmin=0.0, args=(g,))
+        return elementwise.find_root(f, b.bracket, args=(g,), tolerances=_TOL).x
+
+    def _shear_rate(self, stress):
+        if not _overrides(self, "_stress"):
+            raise TypeError(f"{type(self).__name__} must implement _stress or _shear_rate")
+        t = np.asarray(stress, dtype=float)
+
+        def f(g, t):
+            return self._stress(g) - t
+
+        b = elementwise.bracket_root(f, np.full_like(t, 1e-300), np.maximum(t, 1.0), xmin=0.0, args=(t,))
+        return elementwise.find_root(f, b.bracket, args=(t,), tolerances=_TOL).x
+
+    def _flow_rate(self, radius, pressure_gradient):
+        if self.separable:
+            return self._flow_factor_inverse(pressure_gradient / self._radius_factor(radius))
+        tau_w = 0.5 * pressure_gradient * radius
+
+        def integrand(x, tau_w):
+            return x * x * self._shear_rate(x * tau_w)
+
+        res = integrate.tanhsinh(integrand, 0.0, 1.0, args=(tau_w,), rtol=1e-14)
+        return math.pi * radius**3 * res.integral
+
+    def _pressure_gradient(self, flow_rate, radius):
+        if self.separable:
+            return self._flow_factor(flow_rate) * self._radius_factor(radius)
+
+        def f(log_g, q, r):
+            return np.log(self._flow_rate(r, np.exp(log_g))) - np.log(q)
+
+        b = elementwise.bracket_root(f, np.zeros_like(flow_rate), 1.0, args=(flow_rate, radius))
+        return np.exp(elementwise.find_root(f, b.bracket, args=(flow_rate, radius), tolerances=_TOL).x)
+
+    def _velocity(self, r, radius, pressure_gradient):
+        def integrand(rho, g):
+            return self._shear_rate(0.5 * g * rho)
+
+        res = integrate.tanhsinh(integrand, r, radius, args=(pressure_gradient,), rtol=1e-14)
+        return res.integral
+
+    # separable rheologies implement these three
+    def _flow_factor(self, flow_rate):
+        raise NotImplementedError
+
+    def _flow_factor_inverse(self, factor):
+        raise NotImplementedError
+
+    def _radius_factor(self, radius):
+        raise NotImplementedError
+
+
+def _invalid(name, admissible, value):
+    from ..errors import InvalidParameterError
+
+    return InvalidParameterError(name, admissible, value)

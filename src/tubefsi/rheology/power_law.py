@@ -1,0 +1,61 @@
+r"""Power-law (Ostwald–de Waele) fluid: :math:`\tau = m\,|\dot\gamma|^{n-1}\dot\gamma`.
+
+Tube flow: :math:`q = \frac{\pi n}{3n+1}\left(\frac{G}{2m}\right)^{1/n} R^{3+1/n}`, hence
+:math:`G(q, R) = 2m\left[\frac{(3n+1)q}{\pi n}\right]^n R^{-(3n+1)}` (separable).
+Velocity: :math:`v(r) = \frac{n}{n+1}\left(\frac{G}{2m}\right)^{1/n}(R^{1+1/n} - r^{1+1/n})`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import attrs
+import numpy as np
+
+from .._validation import positive
+from .base import Rheology
+
+__all__ = ["PowerLaw"]
+
+
+class _PowerLawForms(Rheology):
+    """Closed forms in terms of ``self.consistency`` and ``self.index``."""
+
+    __slots__ = ()
+    separable = True
+
+    def _stress(self, shear_rate):
+        return self.consistency * shear_rate**self.index
+
+    def _shear_rate(self, stress):
+        return (stress / self.consistency) ** (1.0 / self.index)
+
+    def _flow_factor(self, flow_rate):
+        n = self.index
+        return 2.0 * self.consistency * ((3.0 * n + 1.0) * flow_rate / (math.pi * n)) ** n
+
+    def _flow_factor_inverse(self, factor):
+        n = self.index
+        return math.pi * n / (3.0 * n + 1.0) * (factor / (2.0 * self.consistency)) ** (1.0 / n)
+
+    def _radius_factor(self, radius):
+        return radius ** -(3.0 * self.index + 1.0)
+
+    @property
+    def radius_exponent(self) -> float:
+        """:math:`3n+1`: :math:`G \\propto R^{-(3n+1)}` at fixed flow rate."""
+        return 3.0 * self.index + 1.0
+
+    def _velocity(self, r, radius, pressure_gradient):
+        n = self.index
+        k = 1.0 + 1.0 / n
+        return n / (n + 1.0) * (pressure_gradient / (2.0 * self.consistency)) ** (1.0 / n) * (
+            radius**k - r**k)
+
+
+@attrs.frozen(kw_only=True)
+class PowerLaw(_PowerLawForms):
+    r"""Power-law fluid, :math:`\tau = m\dot\gamma^n`: shear-thinning for :math:`n<1`."""
+
+    consistency: float = positive(unit="Pa s^n", doc="consistency m")
+    index: float = positive(doc="power-law index n")

@@ -1,0 +1,150 @@
+"""The entry points: :func:`solve` and :func:`max_flow_rate`."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ._validation import as_load
+from .couplers.base import Coupler, Scene
+from .errors import InvalidParameterError, NoSteadyStateError
+from .geometry import Tube
+from .rheology.base import Rheology
+from .solution import Solution
+from .walls.base import WallModel
+
+__all__ = ["solve", "max_flow_rate", "select_coupler"]
+
+
+def _resolve(kind, value, base, registry):
+    if isinstance(value, str):
+        try:
+            value = registry[value]
+        except KeyError as exc:
+            raise InvalidParameterError(kind, "{" + ", ".join(registry) + "}", value) from exc
+    if isinstance(value, type) and issubclass(value, base):
+        try:
+            value = value()
+        except TypeError as exc:
+            raise InvalidParameterError(kind, f"an instance of {base.__name__}", value,
+                                        f"{value.__name__} needs parameters: {exc}") from None
+    if not isinstance(value, base):
+        raise InvalidParameterError(kind, f"an instance of {base.__name__} or a registered name", value)
+    return value
+
+
+def select_coupler(rheology, wall, coupler="auto") -> Coupler:
+    """The coupler ``solve`` would use: a name, an instance, or ``"auto"`` (cheapest accurate)."""
+    from . import registry
+
+    if isinstance(coupler, str) and coupler == "auto":
+        candidates = []
+        for name in registry.couplers:
+            cls = registry.couplers[name]
+            if cls.meets_accuracy_contract:
+                inst = cls()
+                if inst.supports(rheology, wall):
+                    candidates.append((cls.cost_rank, name, inst))
+        if not candidates:
+            raise InvalidParameterError("coupler", "a coupler that supports this pair",
+                                        "auto", "no registered coupler supports it")
+        return min(candidates, key=lambda c: (c[0], c[1]))[2]
+    inst = _resolve("coupler", coupler, Coupler, registry.couplers)
+    if not inst.supports(rheology, wall):
+        raise InvalidParameterError("coupler", "a coupler that supports this pair", coupler,
+                                    f"{type(inst).__name__} does not support {type(rheology).__name__} "
+                                    f"with {type(wall).__name__}")
+    return inst
+
+
+def _scene(rheology, wall, tube, outlet_pressure):
+    from . import registry
+
+    rheology = _resolve("rheology", rheology, Rheology, registry.rheologies)
+    wall = _resolve("wall", wall, WallModel, registry.walls)
+    if not isinstance(tube, Tube):
+        raise InvalidParameterError("tube", "a tubefsi.Tube", tube)
+    try:
+        p_out = float(outlet_pressure)
+    except (TypeError, ValueError):
+        raise InvalidParameterError("outlet_pressure", "[0, inf)", outlet_pressure) from None
+    if not (math.isfinite(p_out) and p_out >= 0):
+        raise InvalidParameterError("outlet_pressure", "[0, inf)", p_out)
+    lim = wall.limit_pressure(tube.reduced_thickness)
+    if not wall.is_rigid and p_out >= lim:
+        raise NoSteadyStateError("pressure", lim, p_out, "the outlet pressure already exceeds it")
+    return Scene(rheology=rheology, wall=wall, tube=tube, outlet_pressure=p_out)
+
+
+def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="auto",
+          outlet_pressure=0.0) -> Solution:
+    r"""Solve steady flow of ``rheology`` through ``tube`` with wall ``wall``.
+
+    Exactly one of ``flow_rate`` (flow-controlled) and ``pressure_drop``
+    (pressure-controlled) is given, as a float or an array (every entry >= 0).
+
+    Parameters
+    ----------
+    rheology, wall : model instance, class, or registered name
+    tube : Tube
+    flow_rate : float or array_like, optional
+        Volumetric flow rate q (m^3/s).
+    pressure_drop : float or array_like, optional
+        Pressure drop p(0) - p(L) (Pa).
+    coupler : "auto", registered name, or Coupler instance
+        ``"auto"`` takes the cheapest coupler that supports the pair and meets the
+        accuracy contract (``closed-form`` where it exists, else ``quadrature``).
+    outlet_pressure : float
+        Transmural pressure at the outlet, p(L) >= 0 (Pa).
+
+    Returns
+    -------
+    Solution
+
+    Raises
+    ------
+    InvalidParameterError
+        For any input outside its admissible range.
+    NoSteadyStateError
+        Beyond the wall's limit pressure or the maximum flow rate.
+    """
+    scene = _scene(rheology, wall, tube, outlet_pressure)
+    if (flow_rate is None) == (pressure_drop is None):
+        raise InvalidParameterError("flow_rate / pressure_drop", "exactly one of the two",
+                                    None, "give flow_rate= or pressure_drop=, not both or neither")
+    chosen = select_coupler(scene.rheology, scene.wall, coupler)
+    if flow_rate is not None:
+        q = as_load("flow_rate", flow_rate)
+        q_max = _finite_max_flow(chosen, scene, q)
+        if q_max is not None and np.any(q >= q_max):
+            raise NoSteadyStateError("flow_rate", q_max, q[q >= q_max].flat[0],
+                                     "the tube inflates without bound")
+        state = chosen.flow_controlled(scene, q)
+        scalar = np.ndim(flow_rate) == 0
+    else:
+        dp = as_load("pressure_drop", pressure_drop)
+        state = chosen.pressure_controlled(scene, dp)
+        scalar = np.ndim(pressure_drop) == 0
+    return Solution(scene=scene, coupler=chosen, state=state, scalar=scalar)
+
+
+def _finite_max_flow(coupler, scene, q):
+    if scene.wall.is_rigid or not math.isfinite(scene.wall.limit_pressure(scene.tb)):
+        return None
+    if not scene.rheology.separable:
+        return None
+    q_max = coupler.max_flow_rate(scene)
+    return q_max if math.isfinite(q_max) else None
+
+
+def max_flow_rate(rheology, wall, tube, *, outlet_pressure=0.0, coupler="auto") -> float:
+    r"""The largest flow rate with a steady state (m^3/s); ``inf`` where every flow rate has one.
+
+    Finite only for a wall with a limit pressure (thick or thin-current
+    Mooney–Rivlin/neo-Hookean) and a fluid whose :math:`G(q,R)` falls off slowly
+    enough in :math:`R`: for a power law, exactly when :math:`n < 1`. Then
+    :math:`L\,\phi(q_{max}) = \int_0^\infty s P'(s)/\psi(as)\,du`.
+    """
+    scene = _scene(rheology, wall, tube, outlet_pressure)
+    return float(select_coupler(scene.rheology, scene.wall, coupler).max_flow_rate(scene))

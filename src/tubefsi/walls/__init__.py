@@ -1,0 +1,15 @@
+"""Wall laws (tube laws) and their base classes."""
+
+from .base import WallModel
+from .hyperelastic import HyperelasticWall, ThickWall, ThinWall
+from .linear import ThickLinear, ThinLinear
+from .mooney_rivlin import MooneyRivlin, ThickMooneyRivlin, ThinMooneyRivlin
+from .neo_hookean import NeoHookean, ThickNeoHookean, ThinNeoHookean
+from .rigid import Rigid
+
+__all__ = [
+    "WallModel", "HyperelasticWall", "ThinWall", "ThickWall",
+    "Rigid", "ThinLinear", "ThickLinear",
+    "MooneyRivlin", "ThinMooneyRivlin", "ThickMooneyRivlin",
+    "NeoHookean", "ThinNeoHookean", "ThickNeoHookean",
+]

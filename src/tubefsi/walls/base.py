@@ -1,0 +1,224 @@
+r"""The wall contract: a tube law between transmural pressure and hoop stretch.
+
+A wall law maps the hoop stretch :math:`\lambda = R/a` of the inner surface and the
+reduced thickness :math:`\bar t = t/a` to the transmural pressure
+:math:`p = P(\lambda; \bar t)`. Like :class:`scipy.stats.rv_continuous`, a subclass
+implements the one natural method, ``_pressure(stretch, reduced_thickness)`` *or*
+``_stretch(pressure, reduced_thickness)``, and the base class derives the rest:
+the inverse by vectorized bracketed root finding, the stiffness
+:math:`dP/d\lambda` by numerical differentiation. A subclass may override any
+derived hook (``_strain``, ``_pressure_at_strain``, ``_stiffness``,
+``_limit_pressure``, ``_max_stretch``) with a closed form for speed or accuracy;
+the contract suite :mod:`tubefsi.testing` checks that every path agrees.
+
+tubefsi models inflation: stretches :math:`\lambda \ge 1`, pressures :math:`p \ge 0`.
+"""
+
+from __future__ import annotations
+
+import abc
+import math
+
+import numpy as np
+from scipy import differentiate
+from scipy.optimize import elementwise
+
+from .._numerics import as_output
+from .._validation import as_array
+from ..errors import InvalidParameterError, NoSteadyStateError
+
+__all__ = ["WallModel"]
+
+
+def _overrides(obj, name) -> bool:
+    return getattr(type(obj), name) is not getattr(WallModel, name)
+
+
+class WallModel(abc.ABC):
+    """Abstract base of every wall law (see the module docstring for the contract)."""
+
+    __slots__ = ()
+
+    #: True only for the rigid wall, whose tube law is the vertical line ``stretch = 1``.
+    is_rigid = False
+
+    # ------------------------------------------------------------------ public API
+    def pressure(self, stretch, reduced_thickness):
+        r"""Transmural pressure :math:`P(\lambda; \bar t)` (Pa) at hoop stretch ``stretch``."""
+        tb = self._check_thickness(reduced_thickness)
+        lam = self._check_stretch(stretch, tb)
+        return as_output(self._pressure_at_strain(lam - 1.0, tb), _is_scalar(stretch, reduced_thickness))
+
+    def stretch(self, pressure, reduced_thickness):
+        r"""Hoop stretch :math:`\lambda = R/a` under transmural pressure ``pressure`` (Pa)."""
+        return as_output(1.0 + np.asarray(self.strain(pressure, reduced_thickness)),
+                         _is_scalar(pressure, reduced_thickness))
+
+    def strain(self, pressure, reduced_thickness):
+        r"""Hoop strain :math:`\lambda - 1 = u/a`, computed without forming ``stretch - 1``.
+
+        Raises
+        ------
+        NoSteadyStateError
+            If ``pressure`` reaches the wall's limit pressure.
+        """
+        tb = self._check_thickness(reduced_thickness)
+        p = self._check_pressure(pressure, tb)
+        return as_output(self._strain(p, tb), _is_scalar(pressure, reduced_thickness))
+
+    def stiffness(self, stretch, reduced_thickness):
+        r"""Tube-law slope :math:`dP/d\lambda` (Pa)."""
+        tb = self._check_thickness(reduced_thickness)
+        lam = self._check_stretch(stretch, tb)
+        return as_output(self._stiffness(lam, tb), _is_scalar(stretch, reduced_thickness))
+
+    def limit_pressure(self, reduced_thickness) -> float:
+        r"""The pressure the wall can never reach (Pa); ``inf`` for most laws."""
+        return float(self._limit_pressure(self._check_thickness(reduced_thickness)))
+
+    def max_stretch(self, reduced_thickness) -> float:
+        """The largest admissible stretch (``inf`` unless the material locks)."""
+        return float(self._max_stretch(self._check_thickness(reduced_thickness)))
+
+    def small_strain_modulus(self, reduced_thickness) -> float:
+        r""":math:`dP/d\lambda` at :math:`\lambda = 1` (Pa): the slope of the linear limit."""
+        tb = self._check_thickness(reduced_thickness)
+        return float(self._stiffness(np.asarray(1.0), tb))
+
+    def plot(self, reduced_thickness, *, ax=None, max_stretch=3.0, **kwargs):
+        """Plot this wall's tube law; see :func:`tubefsi.plotting.plot_tube_law`."""
+        from ..plotting import plot_tube_law
+
+        return plot_tube_law(self, reduced_thickness, ax=ax, max_stretch=max_stretch, **kwargs)
+
+    # ------------------------------------------------------------------ hooks
+    def _natural(self) -> str:
+        """Which side of the tube law the subclass implements: 'pressure' or 'stretch'."""
+        if _overrides(self, "_pressure") or _overrides(self, "_pressure_at_strain"):
+            return "pressure"
+        if _overrides(self, "_stretch") or _overrides(self, "_strain"):
+            return "stretch"
+        raise TypeError(f"{type(self).__name__} must implement _pressure or _stretch")
+
+    def _pressure(self, stretch, tb):
+        """Natural hook: pressure at ``stretch`` (array, >= 1) for thickness ratio ``tb``."""
+        self._natural()
+        return self._pressure_at_strain(stretch - 1.0, tb)
+
+    def _pressure_at_strain(self, strain, tb):
+        """Pressure at hoop strain; override for accuracy at tiny strain."""
+        if _overrides(self, "_pressure"):
+            return self._pressure(1.0 + strain, tb)
+        self._natural()
+        return self._invert_strain(strain, tb)
+
+    def _stretch(self, pressure, tb):
+        return 1.0 + self._strain(pressure, tb)
+
+    def _strain(self, pressure, tb):
+        self._natural()
+        if _overrides(self, "_stretch"):
+            return self._stretch(pressure, tb) - 1.0
+        return self._invert_pressure(pressure, tb)
+
+    def _stiffness(self, stretch, tb):
+        if self._natural() == "pressure":
+            res = differentiate.derivative(lambda s: self._pressure_at_strain(s - 1.0, tb),
+                                           stretch, step_direction=1, initial_step=0.01)
+            return res.df
+        # only the inverse is natural: dP/dlam = 1 / (d lam / dp)
+        p = self._pressure_at_strain(stretch - 1.0, tb)
+        res = differentiate.derivative(lambda q: self._strain(q, tb), p, step_direction=1,
+                                       initial_step=0.01 * np.maximum(p, 1.0))
+        return 1.0 / res.df
+
+    def _limit_pressure(self, tb):
+        return math.inf
+
+    def _stiffness_decay_exponent(self, tb):
+        r"""``kappa`` with :math:`dP/d\lambda \sim \lambda^{-\kappa}` as :math:`\lambda \to \infty`.
+
+        Only used where the limit pressure is finite (to decide whether a maximum
+        flow rate exists); estimated numerically unless overridden.
+        """
+        lam = np.array([1e5, 1e6])
+        d = self._stiffness(lam, tb)
+        return float(-np.log(d[1] / d[0]) / np.log(lam[1] / lam[0]))
+
+    def _power_law_integral(self, log_ratio, outlet_stretch, exponent, tb):
+        r"""Closed form of :math:`\int_0^v s^{k+1} P'(s)\,du`, :math:`s = \lambda_{out} e^u`, or None.
+
+        Walls that return an array here get the ``closed-form`` coupler for
+        power-law fluids (:math:`k = 3n+1`).
+        """
+        return None
+
+    def _max_stretch(self, tb):
+        return math.inf
+
+    # ------------------------------------------------------------------ generic inverses
+    def _invert_pressure(self, pressure, tb):
+        """Hoop strain at ``pressure`` by bracketed root finding on ``_pressure_at_strain``."""
+        p = np.asarray(pressure, dtype=float)
+        emax = self._max_stretch(tb) - 1.0
+        scale = max(self._stiffness(np.asarray(1.0), tb), 1e-300)
+
+        def f(e, p):
+            return self._pressure_at_strain(e, tb) - p
+
+        guess = np.minimum(np.maximum(p / scale, 1e-300), 0.5 * emax if math.isfinite(emax) else np.inf)
+        xmax = emax if math.isfinite(emax) else 1e15
+        bracket = elementwise.bracket_root(f, np.zeros_like(p) + 0.0, np.maximum(guess, 1e-300) * 1.0,
+                                           xmin=0.0, xmax=xmax, args=(p,))
+        if not np.all(bracket.success | (p == 0)):
+            bad = ~(bracket.success | (p == 0))
+            limit = float(np.max(self._pressure_at_strain(np.asarray(xmax * 0.999999), tb)))
+            raise NoSteadyStateError("pressure", min(limit, self._limit_pressure(tb)),
+                                     p[bad].flat[0], "the tube law never reaches it")
+        res = elementwise.find_root(f, bracket.bracket, args=(p,),
+                                    tolerances=dict(xrtol=2 * np.finfo(float).eps, xatol=1e-300))
+        return np.where(p == 0, 0.0, res.x)
+
+    def _invert_strain(self, strain, tb):
+        """Pressure at a strain when only the inverse law ``_strain`` is natural."""
+        e = np.asarray(strain, dtype=float)
+
+        def f(p, e):
+            return self._strain(p, tb) - e
+
+        lim = self._limit_pressure(tb)
+        hi = np.maximum(e, 1e-300) * 10.0
+        bracket = elementwise.bracket_root(f, np.zeros_like(e), hi, xmin=0.0,
+                                           xmax=lim if math.isfinite(lim) else None, args=(e,))
+        res = elementwise.find_root(f, bracket.bracket, args=(e,),
+                                    tolerances=dict(xrtol=2 * np.finfo(float).eps, xatol=1e-300))
+        return np.where(e == 0, 0.0, res.x)
+
+    # ------------------------------------------------------------------ validation
+    @staticmethod
+    def _check_thickness(reduced_thickness) -> float:
+        try:
+            tb = float(reduced_thickness)
+        except (TypeError, ValueError):
+            raise InvalidParameterError("reduced_thickness", "(0, inf)", reduced_thickness) from None
+        if not (math.isfinite(tb) and tb > 0):
+            raise InvalidParameterError("reduced_thickness", "(0, inf)", tb)
+        return tb
+
+    def _check_stretch(self, stretch, tb):
+        lam_max = self._max_stretch(tb)
+        if math.isfinite(lam_max):
+            return as_array("stretch", stretch, f"[1, {lam_max:.10g})", lambda a: (a >= 1) & (a < lam_max))
+        return as_array("stretch", stretch, "[1, inf)", lambda a: a >= 1)
+
+    def _check_pressure(self, pressure, tb):
+        p = as_array("pressure", pressure, "[0, inf)", lambda a: a >= 0)
+        lim = self._limit_pressure(tb)
+        if np.any(p >= lim):
+            raise NoSteadyStateError("pressure", lim, p[p >= lim].flat[0],
+                                     f"{type(self).__name__} cannot sustain it")
+        return p
+
+
+def _is_scalar(*values) -> bool:
+    return all(np.ndim(v) == 0 for v in values)

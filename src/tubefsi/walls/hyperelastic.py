@@ -1,0 +1,137 @@
+r"""Hyperelastic walls: an incompressible isotropic material in plane strain.
+
+The tube is clamped (axial stretch 1), so a material point at radius :math:`r`
+moves to :math:`R` with stretches :math:`(r/R, R/r, 1)`. The reduced strain
+energy is :math:`\hat W(\lambda) = W(1/\lambda, \lambda, 1)` and a material
+subclass gives only its derivative ``_dW(stretch)`` (or ``_energy(stretch)``,
+differentiated numerically). The wall theory is chosen by composition:
+
+================================  ==========================================================
+theory                            tube law :math:`P(\lambda; \bar t)`
+================================  ==========================================================
+thin, reference thickness         :math:`\bar t\,\hat W'(\lambda)`  (hoop stress :math:`pR/t`)
+thin, current thickness           :math:`\bar t\,\hat W'(\lambda)/\lambda`  (thickness :math:`t/\lambda`)
+thick (Lamé, exact)               :math:`\int_{\lambda_o}^{\lambda} \frac{\hat W'(s)}{s^2-1}\,ds`,
+                                  :math:`\lambda_o^2 = 1 + (\lambda^2-1)/(1+\bar t)^2`
+================================  ==========================================================
+
+A new material is a dozen lines::
+
+    @attrs.frozen(kw_only=True)
+    class Gent(HyperelasticWall):                 # the material: parameters and dW
+        shear_modulus: float = positive(unit="Pa")
+        locking_parameter: float = positive()
+
+        def _dW(self, stretch):
+            i1 = (stretch - 1 / stretch) ** 2     # I1 - 3 in plane strain
+            return self.shear_modulus * (stretch - stretch**-3) / (1 - i1 / self.locking_parameter)
+
+    @attrs.frozen(kw_only=True)
+    class ThinGent(ThinWall, Gent): ...           # the wall theories, by composition
+
+    @attrs.frozen(kw_only=True)
+    class ThickGent(ThickWall, Gent): ...
+"""
+
+from __future__ import annotations
+
+import abc
+
+import attrs
+import numpy as np
+from scipy import differentiate
+
+from .._numerics import gauss_legendre
+from .._validation import choice
+from .base import WallModel
+
+__all__ = ["HyperelasticWall", "ThinWall", "ThickWall", "THICKNESS_CONVENTIONS"]
+
+THICKNESS_CONVENTIONS = ("reference", "current")
+
+
+class HyperelasticWall(WallModel):
+    """Abstract base of plane-strain incompressible hyperelastic walls."""
+
+    __slots__ = ()
+
+    def dW(self, stretch):
+        r"""Reduced strain-energy derivative :math:`\hat W'(\lambda)` (Pa)."""
+        lam = np.asarray(stretch, dtype=float)
+        out = self._dW(lam)
+        return float(out) if np.ndim(stretch) == 0 else out
+
+    def _dW(self, stretch):
+        if type(self)._energy is HyperelasticWall._energy:
+            raise TypeError(f"{type(self).__name__} must implement _dW or _energy")
+        return differentiate.derivative(self._energy, stretch).df
+
+    def _energy(self, stretch):
+        """Reduced strain energy :math:`\\hat W(\\lambda)` (optional natural hook)."""
+        raise NotImplementedError
+
+    def _d2W(self, stretch):
+        r""":math:`\hat W''(\lambda)`, numerically unless overridden."""
+        return differentiate.derivative(self._dW, stretch).df
+
+    def _thick_integrand(self, s):
+        r""":math:`\hat W'(s)/(s^2-1)`; override with a form free of the removable singularity."""
+        s = np.asarray(s, dtype=float)
+        near = np.abs(s - 1.0) < 1e-7
+        with np.errstate(invalid="ignore", divide="ignore"):
+            g = self._dW(s) / ((s - 1.0) * (s + 1.0))
+        if np.any(near):
+            g = np.where(near, 0.5 * self._d2W(np.ones_like(s)), g)
+        return g
+
+    @abc.abstractmethod
+    def _pressure_at_strain(self, strain, tb): ...
+
+
+@attrs.frozen(kw_only=True, slots=False)
+class ThinWall(HyperelasticWall):
+    r"""Thin-walled (membrane) theory; ``thickness_convention`` picks the hoop stress.
+
+    ``"reference"``: :math:`\sigma_\theta = pR/t` with the undeformed thickness
+    (the chapter's convention), :math:`P = \bar t\,\hat W'(\lambda)`.
+    ``"current"``: the thickness thins to :math:`t/\lambda` by incompressibility,
+    :math:`P = \bar t\,\hat W'(\lambda)/\lambda`; this is the :math:`\bar t\to 0`
+    limit of the thick theory.
+    """
+
+    thickness_convention: str = choice(THICKNESS_CONVENTIONS, default="reference",
+                                       doc="hoop stress with the reference or current thickness")
+
+    def _pressure_at_strain(self, strain, tb):
+        lam = 1.0 + strain
+        p = tb * self._dW(lam)
+        return p if self.thickness_convention == "reference" else p / lam
+
+    def _stiffness(self, stretch, tb):
+        if self.thickness_convention == "reference":
+            return tb * self._d2W(stretch)
+        return tb * (self._d2W(stretch) - self._dW(stretch) / stretch) / stretch
+
+
+class ThickWall(HyperelasticWall):
+    r"""Thick-walled theory: the exact plane-strain Lamé solution (see module docstring)."""
+
+    __slots__ = ()
+
+    _ORDER = 24
+
+    def _pressure_at_strain(self, strain, tb):
+        e = np.asarray(strain, dtype=float)
+        b = (1.0 + tb) ** 2
+        x = e * (2.0 + e)                       # lam^2 - 1
+        lam_o = np.sqrt(1.0 + x / b)
+        width = 0.5 * np.log1p(x * (b - 1.0) / (b + x))   # ln(lam / lam_o), no cancellation
+        nodes, weights = gauss_legendre(self._ORDER)
+        s = lam_o[..., None] * np.exp(width[..., None] * nodes)
+        return width * np.sum(weights * s * self._thick_integrand(s), axis=-1)
+
+    def _stiffness(self, stretch, tb):
+        lam = np.asarray(stretch, dtype=float)
+        b = (1.0 + tb) ** 2
+        lam_o = np.sqrt(1.0 + (lam * lam - 1.0) / b)
+        return self._thick_integrand(lam) - self._thick_integrand(lam_o) * lam / (b * lam_o)

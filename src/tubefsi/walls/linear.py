@@ -1,0 +1,75 @@
+r"""Linearly elastic walls (small-strain pressure-vessel theory).
+
+Thin: :math:`\lambda = 1 + (1 - \nu/2)\,p/(E\bar t)`. Thick (Lamé, hoop strain at the
+inner surface, clamped ends): :math:`\lambda = 1 + K p/(E\bar t)` with
+:math:`K = [(1+\bar t)^2(1+\nu) + (1-2\nu)]/(2+\bar t)`, which tends to :math:`1-\nu/2`
+as :math:`\bar t\to 0`. An incompressible hyperelastic wall (:math:`\nu = 1/2`,
+:math:`E = 3\mu`) has these as its small-strain limit.
+"""
+
+from __future__ import annotations
+
+import attrs
+import numpy as np
+
+from .._numerics import expm1_ratio
+from .._validation import positive, real
+from .base import WallModel
+
+__all__ = ["ThinLinear", "ThickLinear"]
+
+
+class _LinearWall(WallModel):
+    __slots__ = ()
+
+    def _compliance(self, tb):
+        """:math:`d\\lambda/dp` (1/Pa)."""
+        return self._factor(tb) / (self.youngs_modulus * tb)
+
+    def _strain(self, pressure, tb):
+        return self._compliance(tb) * np.asarray(pressure, dtype=float)
+
+    def _pressure_at_strain(self, strain, tb):
+        return np.asarray(strain, dtype=float) / self._compliance(tb)
+
+    def _stiffness(self, stretch, tb):
+        return np.ones_like(np.asarray(stretch, dtype=float)) / self._compliance(tb)
+
+    def _stiffness_decay_exponent(self, tb):
+        return 0.0
+
+    def _power_law_integral(self, log_ratio, outlet_stretch, exponent, tb):
+        k = exponent
+        return outlet_stretch ** (k + 1) * expm1_ratio(k + 1, log_ratio) / self._compliance(tb)
+
+
+def _young():
+    return positive(unit="Pa", doc="Young's modulus E")
+
+
+def _poisson():
+    return real(low=-1.0, high=0.5, high_open=False, doc="Poisson ratio nu")
+
+
+@attrs.frozen(kw_only=True)
+class ThinLinear(_LinearWall):
+    r"""Thin linearly elastic tube, :math:`\lambda = 1 + (1-\nu/2)p/(E\bar t)`."""
+
+    youngs_modulus: float = _young()
+    poisson_ratio: float = _poisson()
+
+    def _factor(self, tb):
+        return 1.0 - 0.5 * self.poisson_ratio
+
+
+@attrs.frozen(kw_only=True)
+class ThickLinear(_LinearWall):
+    r"""Thick linearly elastic tube, :math:`\lambda = 1 + K p/(E\bar t)`,
+    :math:`K = [(1+\bar t)^2(1+\nu) + (1-2\nu)]/(2+\bar t)`."""
+
+    youngs_modulus: float = _young()
+    poisson_ratio: float = _poisson()
+
+    def _factor(self, tb):
+        nu = self.poisson_ratio
+        return ((1.0 + tb) ** 2 * (1.0 + nu) + (1.0 - 2.0 * nu)) / (2.0 + tb)

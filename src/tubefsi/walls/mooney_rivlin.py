@@ -1,0 +1,49 @@
+r"""Mooney–Rivlin walls.
+
+Strain energy :math:`W = c_1(I_1 - 3) + c_2(I_2 - 3)`. Under plane strain
+:math:`I_1 = I_2 = \lambda^2 + \lambda^{-2} + 1`, so
+:math:`\hat W'(\lambda) = 2(c_1 + c_2)(\lambda - \lambda^{-3})`: only :math:`c_1 + c_2`
+matters, and it must be positive (:math:`c_2 < 0` is common). The tube laws are
+the neo-Hookean ones with shear modulus :math:`\mu = 2(c_1 + c_2)`
+(see :mod:`tubefsi.walls.neo_hookean`).
+"""
+
+from __future__ import annotations
+
+import attrs
+
+from .._validation import real
+from ..errors import InvalidParameterError
+from .hyperelastic import HyperelasticWall, ThickWall, ThinWall
+from .neo_hookean import _ThickForms, _ThinForms
+
+__all__ = ["MooneyRivlin", "ThinMooneyRivlin", "ThickMooneyRivlin"]
+
+
+@attrs.frozen(kw_only=True)
+class MooneyRivlin(HyperelasticWall):
+    """Mooney–Rivlin material (abstract: pick a theory). Requires ``c1 + c2 > 0``."""
+
+    c1: float = real(unit="Pa", doc="first Mooney–Rivlin constant")
+    c2: float = real(unit="Pa", doc="second Mooney–Rivlin constant (often negative)")
+
+    def __attrs_post_init__(self):
+        if not self.c1 + self.c2 > 0:
+            raise InvalidParameterError("c1 + c2", "(0, inf)", self.c1 + self.c2,
+                                        "the small-strain shear modulus 2 (c1 + c2) must be positive")
+
+    @property
+    def shear_modulus(self) -> float:
+        """Small-strain shear modulus :math:`\\mu = 2(c_1 + c_2)` (Pa)."""
+        return 2.0 * (self.c1 + self.c2)
+
+
+@attrs.frozen(kw_only=True)
+class ThinMooneyRivlin(_ThinForms, ThinWall, MooneyRivlin):
+    r"""Thin-walled Mooney–Rivlin tube: :math:`P = 2(c_1+c_2)\bar t(\lambda - \lambda^{-3})`
+    (reference thickness, the chapter's eq.) or :math:`2(c_1+c_2)\bar t(1 - \lambda^{-4})` (current)."""
+
+
+@attrs.frozen(kw_only=True)
+class ThickMooneyRivlin(_ThickForms, ThickWall, MooneyRivlin):
+    r"""Thick-walled Mooney–Rivlin tube: :math:`P = (c_1+c_2)[f(x_o) - f(x_i)]`, :math:`f(x) = x + \ln x`."""

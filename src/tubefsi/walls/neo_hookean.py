@@ -1,0 +1,130 @@
+r"""Neo-Hookean walls, and the closed forms every :math:`\hat W' = \mu(\lambda - \lambda^{-3})` law shares.
+
+Strain energy :math:`W = \tfrac{\mu}{2}(I_1 - 3)`. In plane strain
+:math:`I_1 - 3 = (\lambda - 1/\lambda)^2`, so :math:`\hat W'(\lambda) = \mu(\lambda - \lambda^{-3})`.
+Mooney–Rivlin reduces to the same law with :math:`\mu = 2(c_1 + c_2)`.
+
+Tube laws (:math:`x = \lambda^2 - 1`, :math:`b = (1+\bar t)^2`, :math:`d = b - 1`):
+
+* thin, reference thickness: :math:`P = \mu\bar t(\lambda - \lambda^{-3})`, no limit;
+* thin, current thickness: :math:`P = \mu\bar t(1 - \lambda^{-4})`, limit :math:`\mu\bar t`;
+* thick: :math:`P = \tfrac{\mu}{2}\left[\ln\left(1 + \tfrac{x d}{b + x}\right) + \tfrac{x d}{\lambda^2 (b + x)}\right]`,
+  limit :math:`\mu\ln(1+\bar t)`, slope
+  :math:`P' = \mu\lambda d\,\frac{\lambda^2(d+2) + d}{\lambda^4(\lambda^2+d)^2}`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import attrs
+import numpy as np
+
+from .._numerics import expm1_ratio, solve_increasing
+from .._validation import positive
+from .hyperelastic import HyperelasticWall, ThickWall, ThinWall
+
+__all__ = ["NeoHookean", "ThinNeoHookean", "ThickNeoHookean"]
+
+
+class _NeoHookeanLaw:
+    """Closed forms in terms of ``self.shear_modulus`` (mixed into the concrete classes)."""
+
+    __slots__ = ()
+
+    def _dW(self, stretch):
+        return self.shear_modulus * (stretch - stretch**-3)
+
+    def _d2W(self, stretch):
+        return self.shear_modulus * (1.0 + 3.0 * stretch**-4)
+
+    def _thick_integrand(self, s):
+        return self.shear_modulus * (s * s + 1.0) / s**3
+
+
+class _ThinForms(_NeoHookeanLaw):
+    __slots__ = ()
+
+    def _pressure_at_strain(self, strain, tb):
+        e = np.asarray(strain, dtype=float)
+        lam = 1.0 + e
+        quartic = e * (4.0 + e * (6.0 + e * (4.0 + e)))          # lam^4 - 1
+        if self.thickness_convention == "reference":
+            return self.shear_modulus * tb * quartic / lam**3
+        return self.shear_modulus * tb * quartic / lam**4
+
+    def _stiffness(self, stretch, tb):
+        if self.thickness_convention == "reference":
+            return self.shear_modulus * tb * (1.0 + 3.0 * stretch**-4)
+        return 4.0 * self.shear_modulus * tb * stretch**-5
+
+    def _strain(self, pressure, tb):
+        k = np.asarray(pressure, dtype=float) / (self.shear_modulus * tb)
+        if self.thickness_convention == "current":
+            return np.expm1(-0.25 * np.log1p(-k))
+        e, _ = solve_increasing(
+            lambda e, i: e * (4.0 + e * (6.0 + e * (4.0 + e))) / (1.0 + e) ** 3,
+            lambda e, i: 1.0 + 3.0 * (1.0 + e) ** -4,
+            k, guess=np.where(k < 1.0, 0.25 * k, k))
+        return e
+
+    def _limit_pressure(self, tb):
+        return math.inf if self.thickness_convention == "reference" else self.shear_modulus * tb
+
+    def _stiffness_decay_exponent(self, tb):
+        return 0.0 if self.thickness_convention == "reference" else 5.0
+
+    def _power_law_integral(self, log_ratio, outlet_stretch, exponent, tb):
+        k, s0, mt = exponent, outlet_stretch, self.shear_modulus * tb
+        if self.thickness_convention == "reference":
+            return mt * (s0 ** (k + 1) * expm1_ratio(k + 1, log_ratio)
+                         + 3.0 * s0 ** (k - 3) * expm1_ratio(k - 3, log_ratio))
+        return 4.0 * mt * s0 ** (k - 4) * expm1_ratio(k - 4, log_ratio)
+
+
+class _ThickForms(_NeoHookeanLaw):
+    __slots__ = ()
+
+    def _pressure_at_strain(self, strain, tb):
+        e = np.asarray(strain, dtype=float)
+        b = (1.0 + tb) ** 2
+        d = tb * (2.0 + tb)
+        x = e * (2.0 + e)
+        return 0.5 * self.shear_modulus * (np.log1p(x * d / (b + x)) + x * d / ((1.0 + x) * (b + x)))
+
+    def _stiffness(self, stretch, tb):
+        lam2 = stretch * stretch
+        d = tb * (2.0 + tb)
+        return self.shear_modulus * stretch * d * (lam2 * (d + 2.0) + d) / (lam2 * lam2 * (lam2 + d) ** 2)
+
+    def _strain(self, pressure, tb):
+        p = np.asarray(pressure, dtype=float)
+        e, _ = solve_increasing(lambda e, i: self._pressure_at_strain(e, tb),
+                                lambda e, i: self._stiffness(1.0 + e, tb),
+                                p, guess=p / self._stiffness(np.asarray(1.0), tb))
+        return e
+
+    def _limit_pressure(self, tb):
+        return self.shear_modulus * math.log1p(tb)
+
+    def _stiffness_decay_exponent(self, tb):
+        return 5.0
+
+
+@attrs.frozen(kw_only=True)
+class NeoHookean(HyperelasticWall):
+    r"""Neo-Hookean material, :math:`W = \tfrac{\mu}{2}(I_1 - 3)` (abstract: pick a theory)."""
+
+    shear_modulus: float = positive(unit="Pa", doc="small-strain shear modulus mu")
+
+
+@attrs.frozen(kw_only=True)
+class ThinNeoHookean(_ThinForms, ThinWall, NeoHookean):
+    r"""Thin-walled neo-Hookean tube: :math:`P = \mu\bar t(\lambda - \lambda^{-3})` (reference)
+    or :math:`\mu\bar t(1 - \lambda^{-4})` (current thickness)."""
+
+
+@attrs.frozen(kw_only=True)
+class ThickNeoHookean(_ThickForms, ThickWall, NeoHookean):
+    r"""Thick-walled neo-Hookean tube (exact plane-strain Lamé solution); limit pressure
+    :math:`\mu\ln(1+\bar t)`."""
