@@ -124,6 +124,10 @@ class Rheology(abc.ABC):
     def _flow_rate(self, radius, pressure_gradient):
         if self.separable:
             return self._flow_factor_inverse(pressure_gradient / self._radius_factor(radius))
+        return self._rabinowitsch_mooney(radius, pressure_gradient)
+
+    def _rabinowitsch_mooney(self, radius, pressure_gradient):
+        """The generic flow function: tanh-sinh quadrature of the Rabinowitsch–Mooney integral."""
         tau_w = 0.5 * pressure_gradient * radius
 
         def integrand(x, tau_w):
@@ -143,6 +147,11 @@ class Rheology(abc.ABC):
         return np.exp(elementwise.find_root(f, b.bracket, args=(flow_rate, radius), tolerances=_TOL).x)
 
     def _velocity(self, r, radius, pressure_gradient):
+        return self._velocity_generic(r, radius, pressure_gradient)
+
+    def _velocity_generic(self, r, radius, pressure_gradient):
+        """v(r) = integral of the shear rate from r to R (tanh-sinh quadrature)."""
+
         def integrand(rho, g):
             return self._shear_rate(0.5 * g * rho)
 

@@ -17,6 +17,8 @@ __all__ = ["Newtonian"]
 class Newtonian(_PowerLawForms):
     r"""Newtonian fluid of dynamic viscosity :math:`\mu`."""
 
+    _examples = ({"viscosity": 1e-3}, {"viscosity": 3.5e-3})
+
     viscosity: float = positive(unit="Pa s", doc="dynamic viscosity mu")
 
     @property

@@ -57,5 +57,8 @@ class _PowerLawForms(Rheology):
 class PowerLaw(_PowerLawForms):
     r"""Power-law fluid, :math:`\tau = m\dot\gamma^n`: shear-thinning for :math:`n<1`."""
 
+    _examples = ({"consistency": 0.017, "index": 0.7}, {"consistency": 1.0, "index": 2 / 3},
+                 {"consistency": 0.5, "index": 1.5}, {"consistency": 1e-3, "index": 1.0})
+
     consistency: float = positive(unit="Pa s^n", doc="consistency m")
     index: float = positive(doc="power-law index n")

@@ -27,6 +27,9 @@ from .._numerics import as_output
 from .._validation import as_array
 from ..errors import InvalidParameterError, NoSteadyStateError
 
+#: scipy.differentiate tolerances: as tight as the error estimate allows
+_DIFF_TOL = dict(rtol=1e-12, atol=0.0)
+
 __all__ = ["WallModel"]
 
 
@@ -122,14 +125,20 @@ class WallModel(abc.ABC):
         return self._invert_pressure(pressure, tb)
 
     def _stiffness(self, stretch, tb):
+        lam = np.asarray(stretch, dtype=float)
         if self._natural() == "pressure":
-            res = differentiate.derivative(lambda s: self._pressure_at_strain(s - 1.0, tb),
-                                           stretch, step_direction=1, initial_step=0.01)
+            # central differences (the law is evaluated slightly below stretch 1, where it
+            # still exists), steps kept clear of a locking stretch
+            room = self._max_stretch(tb) - lam
+            step = 0.1 * np.minimum(lam, np.where(np.isfinite(room), 0.2 * room, np.inf))
+            res = differentiate.derivative(lambda s: self._pressure_at_strain(s - 1.0, tb), lam,
+                                           initial_step=step, tolerances=_DIFF_TOL)
             return res.df
         # only the inverse is natural: dP/dlam = 1 / (d lam / dp)
-        p = self._pressure_at_strain(stretch - 1.0, tb)
-        res = differentiate.derivative(lambda q: self._strain(q, tb), p, step_direction=1,
-                                       initial_step=0.01 * np.maximum(p, 1.0))
+        p = self._pressure_at_strain(lam - 1.0, tb)
+        res = differentiate.derivative(lambda q: self._strain(q, tb), p,
+                                       step_direction=np.where(p > 0, 0, 1),
+                                       initial_step=np.where(p > 0, 0.1 * p, 1.0), tolerances=_DIFF_TOL)
         return 1.0 / res.df
 
     def _limit_pressure(self, tb):

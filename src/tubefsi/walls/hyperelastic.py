@@ -45,6 +45,9 @@ from .._numerics import gauss_legendre
 from .._validation import choice
 from .base import WallModel
 
+#: scipy.differentiate tolerances: as tight as the error estimate allows
+_DIFF_TOL = dict(rtol=1e-12, atol=0.0)
+
 __all__ = ["HyperelasticWall", "ThinWall", "ThickWall", "THICKNESS_CONVENTIONS"]
 
 THICKNESS_CONVENTIONS = ("reference", "current")
@@ -64,7 +67,8 @@ class HyperelasticWall(WallModel):
     def _dW(self, stretch):
         if type(self)._energy is HyperelasticWall._energy:
             raise TypeError(f"{type(self).__name__} must implement _dW or _energy")
-        return differentiate.derivative(self._energy, stretch).df
+        return differentiate.derivative(self._energy, stretch, initial_step=0.1 * stretch,
+                                        tolerances=_DIFF_TOL).df
 
     def _energy(self, stretch):
         """Reduced strain energy :math:`\\hat W(\\lambda)` (optional natural hook)."""
@@ -72,7 +76,8 @@ class HyperelasticWall(WallModel):
 
     def _d2W(self, stretch):
         r""":math:`\hat W''(\lambda)`, numerically unless overridden."""
-        return differentiate.derivative(self._dW, stretch).df
+        return differentiate.derivative(self._dW, stretch, initial_step=0.1 * stretch,
+                                        tolerances=_DIFF_TOL).df
 
     def _thick_integrand(self, s):
         r""":math:`\hat W'(s)/(s^2-1)`; override with a form free of the removable singularity."""

@@ -55,6 +55,8 @@ def _poisson():
 class ThinLinear(_LinearWall):
     r"""Thin linearly elastic tube, :math:`\lambda = 1 + (1-\nu/2)p/(E\bar t)`."""
 
+    _examples = ({"youngs_modulus": 6e3, "poisson_ratio": 0.5}, {"youngs_modulus": 1e6, "poisson_ratio": 0.3})
+
     youngs_modulus: float = _young()
     poisson_ratio: float = _poisson()
 
@@ -66,6 +68,8 @@ class ThinLinear(_LinearWall):
 class ThickLinear(_LinearWall):
     r"""Thick linearly elastic tube, :math:`\lambda = 1 + K p/(E\bar t)`,
     :math:`K = [(1+\bar t)^2(1+\nu) + (1-2\nu)]/(2+\bar t)`."""
+
+    _examples = ({"youngs_modulus": 6e3, "poisson_ratio": 0.5}, {"youngs_modulus": 1e6, "poisson_ratio": -0.2})
 
     youngs_modulus: float = _young()
     poisson_ratio: float = _poisson()

@@ -43,7 +43,11 @@ class ThinMooneyRivlin(_ThinForms, ThinWall, MooneyRivlin):
     r"""Thin-walled Mooney–Rivlin tube: :math:`P = 2(c_1+c_2)\bar t(\lambda - \lambda^{-3})`
     (reference thickness, the chapter's eq.) or :math:`2(c_1+c_2)\bar t(1 - \lambda^{-4})` (current)."""
 
+    _examples = ({"c1": 1.5e3, "c2": -0.5e3}, {"c1": 1e3, "c2": 0.2e3, "thickness_convention": "current"})
+
 
 @attrs.frozen(kw_only=True)
 class ThickMooneyRivlin(_ThickForms, ThickWall, MooneyRivlin):
     r"""Thick-walled Mooney–Rivlin tube: :math:`P = (c_1+c_2)[f(x_o) - f(x_i)]`, :math:`f(x) = x + \ln x`."""
+
+    _examples = ({"c1": 1.5e3, "c2": -0.5e3}, {"c1": 1e3, "c2": 1e3})

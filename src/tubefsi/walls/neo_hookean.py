@@ -123,8 +123,12 @@ class ThinNeoHookean(_ThinForms, ThinWall, NeoHookean):
     r"""Thin-walled neo-Hookean tube: :math:`P = \mu\bar t(\lambda - \lambda^{-3})` (reference)
     or :math:`\mu\bar t(1 - \lambda^{-4})` (current thickness)."""
 
+    _examples = ({"shear_modulus": 2e3}, {"shear_modulus": 2e3, "thickness_convention": "current"})
+
 
 @attrs.frozen(kw_only=True)
 class ThickNeoHookean(_ThickForms, ThickWall, NeoHookean):
     r"""Thick-walled neo-Hookean tube (exact plane-strain Lamé solution); limit pressure
     :math:`\mu\ln(1+\bar t)`."""
+
+    _examples = ({"shear_modulus": 2e3},)

@@ -18,6 +18,7 @@ class Rigid(WallModel):
     """A wall that does not deform under any pressure; its tube law is the line ``stretch = 1``."""
 
     is_rigid = True
+    _examples = ({},)
 
     def _strain(self, pressure, tb):
         return np.zeros_like(np.asarray(pressure, dtype=float))
