@@ -34,6 +34,19 @@ def expm1_ratio(k: float, x):
     return np.expm1(k * np.asarray(x, dtype=float)) / k
 
 
+def log1p_ratio(k: float, y):
+    r"""Inverse of :func:`expm1_ratio` in ``x``: :math:`\ln(1 + k y)/k`, ``y`` at ``k = 0``.
+
+    Returns ``inf`` where :math:`1 + k y \le 0` (the integral never reaches ``y``).
+    """
+    y = np.asarray(y, dtype=float)
+    if k == 0.0:
+        return y * 1.0
+    arg = k * y
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(arg > -1.0, np.log1p(np.maximum(arg, -1.0)) / k, np.inf)
+
+
 def integrate_panels(f, upper, *, order=16, panel_width=2.0):
     r"""``∫_0^upper f(u) du`` for each entry of ``upper`` (>= 0), by composite Gauss–Legendre.
 

@@ -20,7 +20,7 @@ from typing import ClassVar
 import attrs
 import numpy as np
 
-from .base import Coupler
+from .base import MAX_LOG_STRETCH, Coupler, State
 
 __all__ = ["ClosedForm"]
 
@@ -47,3 +47,18 @@ class ClosedForm(Coupler):
 
     def _J_infinity(self, scene, q=None):
         return float(self._J(scene, np.asarray(np.inf), None))
+
+    def flow_controlled(self, scene, flow_rate):
+        """Explicit inverse where the wall has one (linear, thin current thickness), else Newton."""
+        q = np.asarray(flow_rate, dtype=float)
+        if scene.wall.is_rigid:
+            return super().flow_controlled(scene, q)
+        k = scene.rheology.radius_exponent
+        target = scene.target(q) / scene.tube.radius**k
+        v = scene.wall._power_law_integral_inverse(target, scene.outlet_stretch, k, scene.tb)
+        if v is None:
+            return super().flow_controlled(scene, q)
+        v = np.where(q == 0, 0.0, v)
+        if not np.all(v <= MAX_LOG_STRETCH):
+            self._raise_runaway(scene, q, v <= MAX_LOG_STRETCH)
+        return State(q, scene.pressure_rise(v), scene.strain_at(v), v)

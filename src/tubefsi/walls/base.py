@@ -162,6 +162,10 @@ class WallModel(abc.ABC):
         """
         return None
 
+    def _power_law_integral_inverse(self, integral, outlet_stretch, exponent, tb):
+        """Inverse of ``_power_law_integral`` in ``log_ratio`` where it is explicit, else None."""
+        return None
+
     def _max_stretch(self, tb):
         return math.inf
 

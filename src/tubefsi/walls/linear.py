@@ -12,7 +12,7 @@ from __future__ import annotations
 import attrs
 import numpy as np
 
-from .._numerics import expm1_ratio
+from .._numerics import expm1_ratio, log1p_ratio
 from .._validation import positive, real
 from .base import WallModel
 
@@ -41,6 +41,10 @@ class _LinearWall(WallModel):
     def _power_law_integral(self, log_ratio, outlet_stretch, exponent, tb):
         k = exponent
         return outlet_stretch ** (k + 1) * expm1_ratio(k + 1, log_ratio) / self._compliance(tb)
+
+    def _power_law_integral_inverse(self, integral, outlet_stretch, exponent, tb):
+        k = exponent
+        return log1p_ratio(k + 1, integral * self._compliance(tb) / outlet_stretch ** (k + 1))
 
 
 def _young():

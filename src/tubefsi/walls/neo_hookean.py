@@ -20,7 +20,7 @@ import math
 import attrs
 import numpy as np
 
-from .._numerics import expm1_ratio, solve_increasing
+from .._numerics import expm1_ratio, log1p_ratio, solve_increasing
 from .._validation import positive
 from .hyperelastic import HyperelasticWall, ThickWall, ThinWall
 
@@ -80,6 +80,12 @@ class _ThinForms(_NeoHookeanLaw):
             return mt * (s0 ** (k + 1) * expm1_ratio(k + 1, log_ratio)
                          + 3.0 * s0 ** (k - 3) * expm1_ratio(k - 3, log_ratio))
         return 4.0 * mt * s0 ** (k - 4) * expm1_ratio(k - 4, log_ratio)
+
+    def _power_law_integral_inverse(self, integral, outlet_stretch, exponent, tb):
+        if self.thickness_convention == "reference":
+            return None
+        k = exponent
+        return log1p_ratio(k - 4, integral / (4.0 * self.shear_modulus * tb * outlet_stretch ** (k - 4)))
 
 
 class _ThickForms(_NeoHookeanLaw):
