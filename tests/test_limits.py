@@ -152,3 +152,18 @@ def test_velocity_profile_matches_power_law_formula():
     np.testing.assert_allclose(sol.velocity(r, z), expected, rtol=1e-13, atol=0)
     mean = 1e-9 / (math.pi * big_r**2)
     assert sol.velocity(0.0, z) == pytest.approx(mean * (3 * n + 1) / (n + 1), rel=1e-12)
+
+
+def test_chunked_sweep_equals_one_call(monkeypatch):
+    import tubefsi.solve as solve_module
+
+    fluid = rheologies["power-law"](consistency=0.017, index=0.7)
+    wall = walls["thick-neo-hookean"](shear_modulus=2e3)
+    q = np.linspace(0, 1e-8, 301).reshape(7, 43)
+    whole = tubefsi.solve(fluid, wall, TUBE, flow_rate=q)
+    monkeypatch.setattr(solve_module, "CHUNK", 50)
+    parts = tubefsi.solve(fluid, wall, TUBE, flow_rate=q)
+    assert parts.pressure_drop.shape == q.shape
+    np.testing.assert_allclose(parts.pressure_drop, whole.pressure_drop, rtol=1e-14, atol=0)
+    back = tubefsi.solve(fluid, wall, TUBE, pressure_drop=whole.pressure_drop)
+    np.testing.assert_allclose(back.flow_rate, q, rtol=1e-12, atol=0)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import attrs
 import numpy as np
 
-from ._numerics import as_output, solve_increasing
+from ._numerics import as_output
 from ._validation import as_array
 from .couplers.base import Scene, State
 from .errors import InvalidParameterError
@@ -86,23 +86,13 @@ class Solution:
         if self.wall.is_rigid:
             return z, q, np.zeros_like(z)
         frac = (L - z) / L
-        target = frac * scene.target(q)
-        sep = scene.rheology.separable
-        qflat = q.ravel()
         engine = self.coupler
         if not engine.separates_variables:
             from .couplers.quadrature import Quadrature
 
             engine = Quadrature()
-
-        def F(v, i):
-            return engine._J(scene, v, None if sep else qflat[i])
-
-        def dF(v, i):
-            return scene.integrand(v, None if sep else qflat[i])
-
-        v, _ = solve_increasing(F, dF, np.where(q == 0, 0.0, target), guess=frac * v_in,
-                                upper=v_in * (1 + 1e-12) + 1e-300)
+        v, _ = engine.solve_log_stretch(scene, np.where(q == 0, 0.0, frac * scene.target(q)), q,
+                                        upper=v_in * (1 + 1e-12) + 1e-300)
         return z, q, np.where(frac == 1.0, v_in, v)
 
     def pressure(self, z):

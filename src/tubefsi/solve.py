@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import math
 
+import attrs
 import numpy as np
 
 from ._validation import as_load
-from .couplers.base import Coupler, Scene
+from .couplers.base import Coupler, Scene, State
 from .errors import InvalidParameterError, NoSteadyStateError
 from .geometry import Tube
 from .rheology.base import Rheology
@@ -120,13 +121,28 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
         if q_max is not None and np.any(q >= q_max):
             raise NoSteadyStateError("flow_rate", q_max, q[q >= q_max].flat[0],
                                      "the tube inflates without bound")
-        state = chosen.flow_controlled(scene, q)
+        state = _chunked(chosen.flow_controlled, scene, q)
         scalar = np.ndim(flow_rate) == 0
     else:
         dp = as_load("pressure_drop", pressure_drop)
-        state = chosen.pressure_controlled(scene, dp)
+        state = _chunked(chosen.pressure_controlled, scene, dp)
         scalar = np.ndim(pressure_drop) == 0
     return Solution(scene=scene, coupler=chosen, state=state, scalar=scalar)
+
+
+#: Loads per coupler call: bounds the working memory (a few tens of MB) of any sweep.
+CHUNK = 1 << 14
+
+
+def _chunked(method, scene, load):
+    """Run ``method`` on slices of at most CHUNK loads; cost stays linear, memory bounded."""
+    if load.size <= CHUNK:
+        return method(scene, load)
+    flat = load.ravel()
+    parts = [method(scene, flat[i:i + CHUNK]) for i in range(0, flat.size, CHUNK)]
+    fields = {f.name: np.concatenate([getattr(p, f.name) for p in parts]).reshape(load.shape)
+              for f in attrs.fields(State)}
+    return State(**fields)
 
 
 def _finite_max_flow(coupler, scene, q):

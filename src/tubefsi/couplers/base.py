@@ -23,6 +23,7 @@ from typing import ClassVar
 
 import attrs
 import numpy as np
+from scipy import interpolate
 from scipy.optimize import elementwise
 
 from .._numerics import integrate_panels, solve_increasing
@@ -58,13 +59,15 @@ class Scene:
     def tb(self) -> float:
         return self.tube.reduced_thickness
 
-    @property
-    def outlet_strain(self) -> float:
-        return float(self.wall._strain(np.asarray(self.outlet_pressure), self.tb))
+    outlet_strain: float = attrs.field(init=False)
+    outlet_stretch: float = attrs.field(init=False)
 
-    @property
-    def outlet_stretch(self) -> float:
-        return 1.0 + self.outlet_strain
+    def __attrs_post_init__(self):
+        # the hoop strain at the outlet, once: every J evaluation needs it
+        strain = 0.0 if self.outlet_pressure == 0 else float(
+            self.wall._strain(np.asarray(self.outlet_pressure), self.tb))
+        object.__setattr__(self, "outlet_strain", strain)
+        object.__setattr__(self, "outlet_stretch", 1.0 + strain)
 
     # -- tube law along u
     def stretch_at(self, u):
@@ -79,7 +82,7 @@ class Scene:
         v = np.asarray(v, dtype=float)
         if self.outlet_pressure == 0.0:
             return self.wall._pressure_at_strain(np.expm1(v), self.tb)
-        return integrate_panels(lambda u: self._slope(u), v)
+        return integrate_panels(lambda u, idx: self._slope(u), v)
 
     def _slope(self, u):
         s = self.stretch_at(u)
@@ -154,9 +157,22 @@ class Coupler(abc.ABC):
             dp = np.where(q == 0, 0.0, dp)
             zero = np.zeros_like(q)
             return State(q, dp, zero + scene.outlet_strain, zero)
-        target = scene.target(q)
+        v, ok = self.solve_log_stretch(scene, np.where(q == 0, 0.0, scene.target(q)), q)
+        if not np.all(ok):
+            self._raise_runaway(scene, q, ok)
+        dp = scene.pressure_rise(v)
+        return State(q, dp, scene.strain_at(v), v)
+
+    def solve_log_stretch(self, scene: Scene, target, q=None, upper=None):
+        r"""Log-stretch :math:`v` with :math:`J(v; q) = ` ``target``, elementwise; returns ``(v, ok)``.
+
+        Safeguarded Newton on :math:`\ln J`. For a separable rheology a whole curve
+        shares :math:`J`, so a coarse solve on a few quantiles of the targets gives
+        every point a starting value within a few Newton steps of its root.
+        """
         sep = scene.rheology.separable
-        qflat = q.ravel()
+        target = np.asarray(target, dtype=float)
+        qflat = None if sep else np.broadcast_to(q, target.shape).ravel()
 
         def F(v, i):
             return self._J(scene, v, None if sep else qflat[i])
@@ -164,14 +180,23 @@ class Coupler(abc.ABC):
         def dF(v, i):
             return scene.integrand(v, None if sep else qflat[i])
 
-        slope0 = scene.integrand(np.zeros_like(q), None if sep else q)
-        guess = np.minimum(target / slope0, 1.0)
-        v, ok = solve_increasing(F, dF, np.where(q == 0, 0.0, target), guess=guess,
-                                 xmax=MAX_LOG_STRETCH, max_step=2.0)
-        if not np.all(ok):
-            self._raise_runaway(scene, q, ok)
-        dp = scene.pressure_rise(v)
-        return State(q, dp, scene.strain_at(v), v)
+        positive = target[target > 0]
+        if sep and positive.size > 256:
+            anchors = np.geomspace(positive.min(), positive.max(), 129)
+            v_anchor, ok = self.solve_log_stretch(scene, anchors)
+            keep = ok & (v_anchor < MAX_LOG_STRETCH)
+            if np.count_nonzero(keep) >= 2:
+                shape = interpolate.PchipInterpolator(np.log(anchors[keep]), v_anchor[keep], extrapolate=True)
+                guess = np.maximum(shape(np.log(np.where(target > 0, target, anchors[0]))), 0.0)
+            else:
+                guess = np.ones(target.shape)
+        else:
+            slope0 = scene.integrand(np.zeros(target.shape), None if sep else np.broadcast_to(q, target.shape))
+            guess = np.minimum(target / slope0, 1.0)
+        if upper is not None:
+            guess = np.minimum(guess, upper)
+        return solve_increasing(F, dF, target, guess=guess, upper=upper, xmax=MAX_LOG_STRETCH, max_step=2.0,
+                                log=True)
 
     def pressure_controlled(self, scene: Scene, pressure_drop) -> State:
         """Solve for the flow rate at each pressure drop (array)."""

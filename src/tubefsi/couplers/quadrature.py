@@ -34,6 +34,9 @@ class Quadrature(Coupler):
 
     def _J(self, scene, v, q):
         v = np.asarray(v, dtype=float)
-        qq = None if q is None else np.asarray(q, dtype=float)[..., None]
-        return integrate_panels(lambda u: scene.integrand(u, qq), v, order=self.order,
+        if q is None:
+            return integrate_panels(lambda u, idx: scene.integrand(u), v, order=self.order,
+                                    panel_width=self.panel_width)
+        qflat = np.broadcast_to(np.asarray(q, dtype=float), v.shape).ravel()
+        return integrate_panels(lambda u, idx: scene.integrand(u, qflat[idx, None]), v, order=self.order,
                                 panel_width=self.panel_width)
