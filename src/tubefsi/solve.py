@@ -148,8 +148,6 @@ def _chunked(method, scene, load):
 def _finite_max_flow(coupler, scene, q):
     if scene.wall.is_rigid or not math.isfinite(scene.wall.limit_pressure(scene.tb)):
         return None
-    if not scene.rheology.separable:
-        return None
     q_max = coupler.max_flow_rate(scene)
     return q_max if math.isfinite(q_max) else None
 

@@ -24,6 +24,7 @@ from typing import ClassVar
 import attrs
 import numpy as np
 from scipy import interpolate
+from scipy import optimize
 from scipy.optimize import elementwise
 
 from .._numerics import integrate_panels, solve_increasing
@@ -136,16 +137,17 @@ class Coupler(abc.ABC):
         rheo = scene.rheology
         mu = getattr(rheo, "radius_exponent", None)
         if mu is None:
-            r = scene.tube.radius * np.array([1e6, 1e7])
-            qq = 1.0 if q is None else q
-            g = rheo._pressure_gradient(np.full(2, qq), r) if not rheo.separable else rheo._radius_factor(r)
+            # local exponent of G in R far out, where the probe of J(inf) ends
+            r = scene.tube.radius * np.exp(_PROBE_LOG_STRETCH) * np.array([1.0, 10.0])
+            g = rheo._radius_factor(r) if rheo.separable else rheo._pressure_gradient(np.full(2, q), r)
             mu = float(-np.log(g[1] / g[0]) / np.log(10.0))
         alpha = scene.wall._stiffness_decay_exponent(tb) - 1.0 - mu
         if not alpha > 1e-12:
             return math.inf
         v1 = np.asarray(_PROBE_LOG_STRETCH)
-        head = self._J(scene, v1, q)
-        tail = scene.integrand(v1, q) / alpha
+        qq = None if q is None else np.asarray(q, dtype=float)
+        head = self._J(scene, v1, qq)
+        tail = scene.integrand(v1, qq) / alpha
         return float(head + tail)
 
     # --------------------------------------------------------------- problems
@@ -234,14 +236,33 @@ class Coupler(abc.ABC):
 
     def max_flow_rate(self, scene: Scene) -> float:
         """Largest flow rate with a steady state (``inf`` if none)."""
-        if scene.wall.is_rigid:
+        if scene.wall.is_rigid or not math.isfinite(scene.wall._limit_pressure(scene.tb)):
             return math.inf
+        if not scene.rheology.separable:
+            return self._max_flow_rate_general(scene)
         j_inf = self._J_infinity(scene)
         if not math.isfinite(j_inf):
             return math.inf
-        if scene.rheology.separable:
-            return float(scene.rheology._flow_factor_inverse(j_inf / scene.tube.length))
-        raise NotImplementedError("maximum flow rate of a non-separable rheology")
+        return float(scene.rheology._flow_factor_inverse(j_inf / scene.tube.length))
+
+    def _max_flow_rate_general(self, scene: Scene) -> float:
+        """Non-separable rheology: the q with H(inf; q) = L (H decreases with q), by Brent's method."""
+        L = scene.tube.length
+
+        def excess(log_q):
+            return math.log(self._J_infinity(scene, math.exp(log_q))) - math.log(L)
+
+        a = scene.tube.radius
+        g0 = scene.wall._limit_pressure(scene.tb) / L
+        log_q = math.log(float(scene.rheology._flow_rate(np.asarray([a]), np.asarray([g0]))[0]))
+        lo, hi = log_q, log_q
+        while excess(lo) < 0:
+            lo -= 2.0
+        while excess(hi) > 0:
+            hi += 2.0
+            if hi - log_q > 200:
+                return math.inf
+        return math.exp(optimize.brentq(excess, lo, hi, xtol=1e-15, rtol=4 * np.finfo(float).eps))
 
     def _raise_runaway(self, scene, q, ok):
         q_max = self.max_flow_rate(scene)
@@ -253,6 +274,7 @@ class Coupler(abc.ABC):
         if sep:
             reach = float(scene.rheology._flow_factor_inverse(self._J(scene, v, None) / scene.tube.length))
         else:
-            reach = float("nan")
+            v1 = np.array([MAX_LOG_STRETCH])
+            reach = float(self._solve_flow_rate(scene, v1, scene.pressure_rise(v1))[0])
         raise NoSteadyStateError("flow_rate", reach, bad,
                                  "the inlet stretch would exceed 1e15 (the tube inflates without practical bound)")

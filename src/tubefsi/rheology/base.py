@@ -124,27 +124,35 @@ class Rheology(abc.ABC):
     def _flow_rate(self, radius, pressure_gradient):
         if self.separable:
             return self._flow_factor_inverse(pressure_gradient / self._radius_factor(radius))
-        return self._rabinowitsch_mooney(radius, pressure_gradient)
+        return 0.25 * math.pi * radius**3 * self._apparent_shear_rate(0.5 * pressure_gradient * radius)
 
     def _rabinowitsch_mooney(self, radius, pressure_gradient):
-        """The generic flow function: tanh-sinh quadrature of the Rabinowitsch–Mooney integral."""
-        tau_w = 0.5 * pressure_gradient * radius
+        """The generic flow function (quadrature), whatever the subclass overrides."""
+        return 0.25 * math.pi * radius**3 * Rheology._apparent_shear_rate(self, 0.5 * pressure_gradient * radius)
 
-        def integrand(x, tau_w):
-            return x * x * self._shear_rate(x * tau_w)
+    def _apparent_shear_rate(self, wall_stress):
+        r"""Apparent wall shear rate :math:`\Gamma = 4q/(\pi R^3)` at wall stress :math:`\tau_w`.
 
-        res = integrate.tanhsinh(integrand, 0.0, 1.0, args=(tau_w,), rtol=1e-14)
-        return math.pi * radius**3 * res.integral
+        :math:`\Gamma = 4\int_0^1 t^2\dot\gamma(\tau_w t)\,dt` (fixed tanh-sinh rule) when the
+        shear rate is natural; else, integrating by parts in the shear rate,
+        :math:`\Gamma = \tfrac43\dot\gamma_w\left[1 - \int_0^1 (\tau(\dot\gamma_w t)/\tau_w)^3 dt\right]`.
+        Yield-stress fluids override it with their closed form.
+        """
+        from ._flow_table import _T, _W
+
+        tau_w = np.asarray(wall_stress, dtype=float)
+        if _overrides(self, "_shear_rate"):
+            return 4.0 * (self._shear_rate(tau_w[..., None] * _T) * _T * _T) @ _W
+        rate_w = self._shear_rate(tau_w)
+        ratio = self._stress(rate_w[..., None] * _T) / tau_w[..., None]
+        return (4.0 / 3.0) * rate_w * (1.0 - (ratio**3) @ _W)
 
     def _pressure_gradient(self, flow_rate, radius):
         if self.separable:
             return self._flow_factor(flow_rate) * self._radius_factor(radius)
+        from ._flow_table import flow_table
 
-        def f(log_g, q, r):
-            return np.log(self._flow_rate(r, np.exp(log_g))) - np.log(q)
-
-        b = elementwise.bracket_root(f, np.zeros_like(flow_rate), 1.0, args=(flow_rate, radius))
-        return np.exp(elementwise.find_root(f, b.bracket, args=(flow_rate, radius), tolerances=_TOL).x)
+        return 2.0 * flow_table(self).wall_stress(4.0 * flow_rate / (math.pi * radius**3)) / radius
 
     def _velocity(self, r, radius, pressure_gradient):
         return self._velocity_generic(r, radius, pressure_gradient)
