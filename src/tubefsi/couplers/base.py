@@ -255,6 +255,8 @@ class Coupler(abc.ABC):
         a = scene.tube.radius
         g0 = scene.wall._limit_pressure(scene.tb) / L
         log_q = math.log(float(scene.rheology._flow_rate(np.asarray([a]), np.asarray([g0]))[0]))
+        if not math.isfinite(excess(log_q)):
+            return math.inf  # G(q, R) falls off too fast in R: every flow rate has a steady state
         lo, hi = log_q, log_q
         while excess(lo) < 0:
             lo -= 2.0

@@ -24,7 +24,6 @@ import abc
 import math
 
 import numpy as np
-from scipy import integrate
 from scipy.optimize import elementwise
 
 from .._numerics import as_output
@@ -158,13 +157,20 @@ class Rheology(abc.ABC):
         return self._velocity_generic(r, radius, pressure_gradient)
 
     def _velocity_generic(self, r, radius, pressure_gradient):
-        """v(r) = integral of the shear rate from r to R (tanh-sinh quadrature)."""
+        r""":math:`v(r) = \int_r^R \dot\gamma(G\rho/2)\,d\rho` by the fixed tanh-sinh rule; for a
+        stress-natural law, by parts: :math:`\frac{2}{G}\big([\tau\dot\gamma] - \int \tau\,d\dot\gamma\big)`."""
+        from ._flow_table import _T, _W
 
-        def integrand(rho, g):
-            return self._shear_rate(0.5 * g * rho)
-
-        res = integrate.tanhsinh(integrand, r, radius, args=(pressure_gradient,), rtol=1e-14)
-        return res.integral
+        r, radius, g = (np.asarray(x, dtype=float) for x in (r, radius, pressure_gradient))
+        if _overrides(self, "_shear_rate"):
+            rho = r[..., None] + (radius - r)[..., None] * _T
+            return (radius - r) * (self._shear_rate(0.5 * g[..., None] * rho) @ _W)
+        tau_r, tau_w = 0.5 * g * r, 0.5 * g * radius
+        rate_r = np.where(tau_r > 0, self._shear_rate(np.where(tau_r > 0, tau_r, 1.0)), 0.0)
+        rate_w = self._shear_rate(tau_w)
+        nodes = rate_r[..., None] + (rate_w - rate_r)[..., None] * _T
+        mean_stress = self._stress(np.maximum(nodes, 1e-300)) @ _W
+        return (2.0 / g) * (tau_w * rate_w - tau_r * rate_r - (rate_w - rate_r) * mean_stress)
 
     # separable rheologies implement these three
     def _flow_factor(self, flow_rate):
