@@ -11,6 +11,7 @@ Quick start::
 """
 
 from . import registry
+from .advise import Advice, Diagnostics, ModelValidityWarning, advise
 from .errors import ConvergenceError, InvalidParameterError, NoSteadyStateError, TubefsiError
 from .geometry import Tube
 from .solution import Solution
@@ -18,6 +19,7 @@ from .solve import max_flow_rate, select_coupler, solve
 
 __all__ = [
     "Tube", "solve", "max_flow_rate", "select_coupler", "Solution", "registry",
+    "advise", "Advice", "Diagnostics", "ModelValidityWarning",
     "TubefsiError", "InvalidParameterError", "NoSteadyStateError", "ConvergenceError",
 ]
 

@@ -140,6 +140,19 @@ class Solution:
         out = self.rheology.velocity(np.minimum(r_arr, big_r), big_r, g)
         return as_output(out, self.scalar and np.ndim(z) == 0 and np.ndim(r) == 0)
 
+    def diagnostics(self, *, density=None, warn=True):
+        """Validity of the model's assumptions for this solution.
+
+        Reports the slenderness a/L, the largest hoop strain, the closeness to a
+        limit pressure and to the maximum flow rate, and (given the fluid's
+        ``density`` in kg/m^3) the Metzner–Reed Reynolds number; each failed
+        assumption is a :class:`~tubefsi.advise.ModelValidityWarning` (unless
+        ``warn=False``) and a line in the result's ``warnings``.
+        """
+        from .advise import diagnostics
+
+        return diagnostics(self, density=density, warn=warn)
+
     def plot(self, **kwargs):
         """Pressure and radius profiles; see :func:`tubefsi.plotting.plot_profiles`."""
         from .plotting import plot_profiles
