@@ -12,6 +12,7 @@ Quick start::
 
 from . import registry
 from .advise import Advice, Diagnostics, ModelValidityWarning, advise
+from .fit import FitResult, fit
 from .errors import ConvergenceError, InvalidParameterError, NoSteadyStateError, TubefsiError
 from .geometry import Tube
 from .solution import Solution
@@ -19,7 +20,7 @@ from .solve import max_flow_rate, select_coupler, solve
 
 __all__ = [
     "Tube", "solve", "max_flow_rate", "select_coupler", "Solution", "registry",
-    "advise", "Advice", "Diagnostics", "ModelValidityWarning",
+    "advise", "Advice", "Diagnostics", "ModelValidityWarning", "fit", "FitResult",
     "TubefsiError", "InvalidParameterError", "NoSteadyStateError", "ConvergenceError",
 ]
 

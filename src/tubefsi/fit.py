@@ -1,0 +1,146 @@
+r"""Calibrate wall and rheology parameters from measured (flow rate, pressure drop) data.
+
+:func:`fit` minimizes the sum of squared *relative* residuals
+:math:`r_i = \ln(\Delta p_{model}(q_i;\theta)/\Delta p_i)` with
+:func:`scipy.optimize.least_squares`; parameters whose admissible range is
+:math:`(0, \infty)` are fitted through their logarithm, so they stay positive. Standard
+errors come from the Gauss–Newton covariance :math:`s^2 (J^T J)^{-1}`,
+:math:`s^2 = \sum r_i^2/(m - k)`, mapped back by the delta method.
+"""
+
+from __future__ import annotations
+
+import math
+
+import attrs
+import numpy as np
+from scipy import optimize
+
+from .errors import InvalidParameterError, TubefsiError
+
+__all__ = ["fit", "FitResult"]
+
+
+@attrs.frozen
+class FitResult:
+    """Fitted models, parameter values and standard errors."""
+
+    rheology: object
+    wall: object
+    parameters: dict
+    standard_errors: dict
+    covariance: np.ndarray
+    residuals: np.ndarray
+    success: bool
+    message: str
+
+    def __str__(self) -> str:
+        lines = [f"{'parameter':28s} {'value':>14s} {'std. error':>12s}"]
+        for name, value in self.parameters.items():
+            lines.append(f"{name:28s} {value:14.6g} {self.standard_errors[name]:12.3g}")
+        rms = float(np.sqrt(np.mean(self.residuals**2)))
+        return "\n".join(lines) + f"\nrms relative residual {rms:.3g} ({self.message})"
+
+
+def _split(name):
+    owner, _, field = name.partition(".")
+    if owner not in ("wall", "rheology") or not field:
+        raise InvalidParameterError("parameters", "names like 'wall.shear_modulus' or 'rheology.index'", name)
+    return owner, field
+
+
+def fit(flow_rate, pressure_drop, rheology, wall, tube, *, parameters, outlet_pressure=0.0,
+        coupler="auto") -> FitResult:
+    """Least-squares calibration of ``parameters`` from data.
+
+    Parameters
+    ----------
+    flow_rate, pressure_drop : array_like
+        Measured pairs (m^3/s, Pa), all positive.
+    rheology, wall : model instances
+        Starting values for the fitted parameters; the others stay fixed.
+    tube : Tube
+    parameters : sequence of str
+        Fields to fit, as ``"wall.<field>"`` or ``"rheology.<field>"``,
+        e.g. ``["wall.shear_modulus", "rheology.consistency", "rheology.index"]``.
+
+    Returns
+    -------
+    FitResult
+    """
+    from .solve import _scene, max_flow_rate, solve
+
+    scene = _scene(rheology, wall, tube, outlet_pressure)
+    models = {"rheology": scene.rheology, "wall": scene.wall}
+    q = np.asarray(flow_rate, dtype=float)
+    dp = np.asarray(pressure_drop, dtype=float)
+    if q.shape != dp.shape or q.ndim != 1 or q.size == 0:
+        raise InvalidParameterError("flow_rate / pressure_drop", "1-D arrays of one length", q.shape)
+    if np.any(~np.isfinite(q) | (q <= 0)) or np.any(~np.isfinite(dp) | (dp <= 0)):
+        raise InvalidParameterError("flow_rate / pressure_drop", "(0, inf) elementwise", None)
+    names = list(parameters)
+    if len(names) >= q.size:
+        raise InvalidParameterError("parameters", f"fewer than the {q.size} data points", len(names))
+    logs, start = [], []
+    for name in names:
+        owner, field = _split(name)
+        model = models[owner]
+        fields = {f.name: f for f in attrs.fields(type(model))}
+        if field not in fields:
+            raise InvalidParameterError("parameters", f"fields of {type(model).__name__}: {', '.join(fields)}", name)
+        positive = fields[field].metadata.get("admissible", "").startswith("(0,")
+        logs.append(positive)
+        value = float(getattr(model, field))
+        start.append(math.log(value) if positive else value)
+    logs = np.array(logs)
+
+    def natural(theta):
+        return np.array([math.exp(t) if lg else t for t, lg in zip(theta, logs)])
+
+    def build(theta):
+        values = natural(theta)
+        new = dict(models)
+        for owner in ("rheology", "wall"):
+            changes = {_split(n)[1]: float(v) for n, v in zip(names, values) if _split(n)[0] == owner}
+            if changes:
+                new[owner] = attrs.evolve(new[owner], **changes)
+        return new
+
+    def model_drop(m):
+        # beyond the maximum flow rate the drop is continued by its supremum, the limit
+        # pressure rise, so trial parameters with no steady state still steer the fit
+        q_max = max_flow_rate(m["rheology"], m["wall"], tube, outlet_pressure=outlet_pressure)
+        ok = q < q_max
+        out = np.empty_like(q)
+        if np.any(ok):
+            out[ok] = solve(m["rheology"], m["wall"], tube, flow_rate=q[ok], outlet_pressure=outlet_pressure,
+                            coupler=coupler).pressure_drop
+        if not np.all(ok):
+            out[~ok] = m["wall"].limit_pressure(tube.reduced_thickness) - outlet_pressure
+        return out
+
+    def residuals(theta):
+        try:
+            return np.log(model_drop(build(theta)) / dp)
+        except (TubefsiError, ArithmeticError, FloatingPointError):
+            return np.full(q.size, 10.0)   # outside the models' admissible range
+
+    # log parameters may move by a factor of up to 1e4 from their starting values
+    start = np.array(start)
+    span = np.where(logs, math.log(1e4), np.inf)
+    res = optimize.least_squares(residuals, start, bounds=(start - span, start + span), x_scale="jac",
+                                 xtol=1e-12, ftol=1e-12, gtol=1e-12)
+    dof = max(q.size - len(names), 1)
+    s2 = 2.0 * res.cost / dof
+    try:
+        cov_theta = s2 * np.linalg.inv(res.jac.T @ res.jac)
+    except np.linalg.LinAlgError:
+        cov_theta = np.full((len(names), len(names)), np.inf)
+    values = natural(res.x)
+    scale = np.where(logs, values, 1.0)                    # delta method for log parameters
+    cov = cov_theta * np.outer(scale, scale)
+    fitted = build(res.x)
+    return FitResult(rheology=fitted["rheology"], wall=fitted["wall"],
+                     parameters={n: float(v) for n, v in zip(names, values)},
+                     standard_errors={n: float(math.sqrt(max(cov[i, i], 0.0))) for i, n in enumerate(names)},
+                     covariance=cov, residuals=res.fun, success=bool(res.success), message=str(res.message))
