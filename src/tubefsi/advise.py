@@ -168,9 +168,15 @@ def advise(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, toleranc
         from .errors import InvalidParameterError
 
         raise InvalidParameterError("flow_rate / pressure_drop", "exactly one of the two", None)
+    if not (isinstance(tolerance, (int, float)) and math.isfinite(tolerance) and tolerance >= 0):
+        from .errors import InvalidParameterError
+
+        raise InvalidParameterError("tolerance", "[0, inf)", tolerance)
     if flow_rate is None:
         flow_rate = solve(rheology, wall, tube, pressure_drop=pressure_drop,
                           outlet_pressure=outlet_pressure).flow_rate
+    else:  # the requested model must solve: its errors are the caller's, not a candidate's
+        solve(rheology, wall, tube, flow_rate=flow_rate, outlet_pressure=outlet_pressure)
     load = ("flow_rate", flow_rate)
     results = []
     reference = None

@@ -189,7 +189,8 @@ _OUTPUT_UNITS = {
 }
 
 
-def _cmd_solve(args, out) -> int:
+def _scene_from_args(args):
+    """(fluid, wall, tube, coupler) from the shared scene options."""
     import tubefsi
     from . import registry
 
@@ -208,6 +209,13 @@ def _cmd_solve(args, out) -> int:
     coupler = args.coupler
     if coupler != "auto":
         coupler = _build("coupler", registry.couplers, coupler)
+    return fluid, wall, tube, coupler
+
+
+def _cmd_solve(args, out) -> int:
+    import tubefsi
+
+    fluid, wall, tube, coupler = _scene_from_args(args)
     load = {}
     if args.flow_rate is not None:
         load["flow_rate"] = _load_values("--flow-rate", args.flow_rate)
@@ -391,24 +399,117 @@ def _parser() -> argparse.ArgumentParser:
     p.set_defaults(run=_cmd_demo)
 
     p = sub.add_parser("solve", help="solve one scene (or a list of loads)",
-                       description="Solve steady flow through a soft tube. Models are NAME or "
-                                   "NAME:key=value,...; see 'tubefsi list'. SI units throughout.")
+                       description="Solve steady flow through a soft tube. " + _SCENE_HELP)
+    _add_scene_args(p)
+    load = p.add_mutually_exclusive_group(required=True)
+    load.add_argument("--flow-rate", metavar="Q[,Q...]", help="flow rate(s) (m^3/s)")
+    load.add_argument("--pressure-drop", metavar="DP[,DP...]", help="pressure drop(s) (Pa)")
+    p.add_argument("--json", action="store_true", help="print the result as JSON")
+    p.set_defaults(run=_cmd_solve)
+
+    p = sub.add_parser("curve", help="a flow-rate–pressure-drop curve as CSV or JSON (optionally a plot)",
+                       description="Sweep flow rates or pressure drops. " + _SCENE_HELP)
+    _add_scene_args(p)
+    load = p.add_mutually_exclusive_group(required=True)
+    load.add_argument("--flow-rate", metavar="START:STOP[:N]", help="flow-rate range (m^3/s), N points")
+    load.add_argument("--pressure-drop", metavar="START:STOP[:N]", help="pressure-drop range (Pa), N points")
+    p.add_argument("--log", action="store_true", help="log-spaced points (START > 0)")
+    p.add_argument("--format", choices=("csv", "json"), default="csv", help="output format (default csv)")
+    p.add_argument("--output", metavar="FILE", help="write the table to FILE instead of standard output")
+    p.add_argument("--plot", metavar="FILE", help="also save a plot of the curve (PNG, SVG, PDF)")
+    p.set_defaults(run=_cmd_curve)
+
+    p = sub.add_parser("advise", help="compare the model with simpler ones on the same scene",
+                       description="Recommend the cheapest model within a tolerance. " + _SCENE_HELP)
+    _add_scene_args(p)
+    load = p.add_mutually_exclusive_group(required=True)
+    load.add_argument("--flow-rate", type=float, metavar="Q", help="flow rate (m^3/s)")
+    load.add_argument("--pressure-drop", type=float, metavar="DP", help="pressure drop (Pa)")
+    p.add_argument("--tolerance", type=float, default=0.01, help="relative pressure-drop tolerance (0.01)")
+    p.add_argument("--density", type=float, metavar="RHO", help="fluid density (kg/m^3), for diagnostics")
+    p.set_defaults(run=_cmd_advise)
+    return parser
+
+
+_SCENE_HELP = "Models are NAME or NAME:key=value,...; see 'tubefsi list'. SI units throughout."
+
+
+def _add_scene_args(p):
     p.add_argument("--rheology", required=True, metavar="NAME[:k=v,...]",
                    help="e.g. power-law:consistency=0.017,index=0.7")
     p.add_argument("--wall", required=True, metavar="NAME[:k=v,...]",
                    help="e.g. thick-neo-hookean:shear_modulus=2e3")
     p.add_argument("--tube", required=True, metavar="radius=..,thickness=..,length=..",
                    help="undeformed tube (m)")
-    load = p.add_mutually_exclusive_group(required=True)
-    load.add_argument("--flow-rate", metavar="Q[,Q...]", help="flow rate(s) (m^3/s)")
-    load.add_argument("--pressure-drop", metavar="DP[,DP...]", help="pressure drop(s) (Pa)")
     p.add_argument("--outlet-pressure", type=float, default=0.0, metavar="P",
                    help="transmural outlet pressure (Pa, default 0)")
     p.add_argument("--coupler", default="auto", metavar="NAME[:k=v,...]",
                    help="auto (default), closed-form, quadrature, ode, or a plugin's")
-    p.add_argument("--json", action="store_true", help="print the result as JSON")
-    p.set_defaults(run=_cmd_solve)
-    return parser
+
+
+def _range(option, text, log):
+    parts = text.split(":")
+    if len(parts) not in (2, 3):
+        raise UsageError(f"{option} takes START:STOP or START:STOP:N, got {text!r}")
+    try:
+        start, stop = float(parts[0]), float(parts[1])
+        count = int(parts[2]) if len(parts) == 3 else 101
+    except ValueError:
+        raise UsageError(f"{option} takes numbers START:STOP[:N], got {text!r}") from None
+    if not (np.isfinite(start) and np.isfinite(stop) and 0 <= start < stop and count >= 2):
+        raise UsageError(f"{option} needs 0 <= START < STOP and N >= 2, got {text!r}")
+    if log:
+        if start <= 0:
+            raise UsageError(f"--log needs START > 0 in {option}")
+        return np.geomspace(start, stop, count)
+    return np.linspace(start, stop, count)
+
+
+def _cmd_curve(args, out) -> int:
+    import tubefsi
+
+    fluid, wall, tube, coupler = _scene_from_args(args)
+    if args.flow_rate is not None:
+        sol = tubefsi.solve(fluid, wall, tube, coupler=coupler, outlet_pressure=args.outlet_pressure,
+                            flow_rate=_range("--flow-rate", args.flow_rate, args.log))
+    else:
+        sol = tubefsi.solve(fluid, wall, tube, coupler=coupler, outlet_pressure=args.outlet_pressure,
+                            pressure_drop=_range("--pressure-drop", args.pressure_drop, args.log))
+    columns = list(_OUTPUT_UNITS)
+    data = {k: np.atleast_1d(getattr(sol, k)).tolist() for k in columns}
+    stream = open(args.output, "w", encoding="utf-8") if args.output else out
+    try:
+        if args.format == "json":
+            json.dump({"coupler": sol.coupler_name, "units": _OUTPUT_UNITS, **data}, stream, allow_nan=False)
+            stream.write("\n")
+        else:
+            stream.write(",".join(f"{k} ({_OUTPUT_UNITS[k]})" for k in columns) + "\n")
+            for row in zip(*(data[k] for k in columns)):
+                stream.write(",".join(repr(float(v)) for v in row) + "\n")
+    finally:
+        if args.output:
+            stream.close()
+    if args.plot:
+        from .plotting import plot_flow_curve
+
+        ax = plot_flow_curve(fluid, wall, tube, flow_rates=np.atleast_1d(sol.flow_rate))
+        ax.figure.savefig(args.plot, dpi=130)
+    return 0
+
+
+def _cmd_advise(args, out) -> int:
+    import tubefsi
+
+    fluid, wall, tube, _ = _scene_from_args(args)
+    load = {"flow_rate": args.flow_rate} if args.flow_rate is not None else {"pressure_drop": args.pressure_drop}
+    advice = tubefsi.advise(fluid, wall, tube, tolerance=args.tolerance, outlet_pressure=args.outlet_pressure,
+                            **load)
+    print(advice, file=out)
+    print(f"\nrecommended: {advice.recommended.label}", file=out)
+    sol = tubefsi.solve(fluid, wall, tube, outlet_pressure=args.outlet_pressure, **load)
+    print("\ndiagnostics of the requested model:", file=out)
+    print(sol.diagnostics(density=args.density, warn=False), file=out)
+    return 0
 
 
 def _error(message) -> int:
@@ -429,7 +530,7 @@ def main(argv=None) -> int:
     except SystemExit as exc:  # --help, --version
         return exc.code if isinstance(exc.code, int) else 0
     if args.command is None:
-        return _error("a command is required: list, solve or demo (see 'tubefsi --help')")
+        return _error("a command is required: list, solve, curve, advise or demo (see 'tubefsi --help')")
     try:
         return args.run(args, sys.stdout)
     except (UsageError, ValueError, TubefsiError) as exc:
@@ -439,6 +540,8 @@ def main(argv=None) -> int:
         return _error(exc.args[0] if exc.args else exc)
     except BrokenPipeError:  # `tubefsi list | head`
         return 0
+    except Exception as exc:  # a bug of ours: still one line, but say what it was
+        return _error(f"internal error ({type(exc).__name__}: {exc}); please report it")
 
 
 if __name__ == "__main__":
