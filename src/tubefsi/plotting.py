@@ -6,18 +6,14 @@ backend, so the module is safe in scripts, notebooks and headless test runs
 (``MPLBACKEND=Agg``). :mod:`matplotlib.pyplot` is imported only when a function
 is called.
 
-=========================  =====================================================  ===========
-function                   what it shows                                          returns
-=========================  =====================================================  ===========
-:func:`plot_tube_law`      transmural pressure against hoop stretch, with the     Axes
-                           small-strain tangent and the limit pressure
-:func:`plot_flow_curve`    flow rate against pressure drop, with the rigid-tube   Axes
-                           (generalized Hagen–Poiseuille) curve
-:func:`plot_profiles`      pressure :math:`p(z)` and radius :math:`R(z)/a`        Figure
-:func:`plot_deformed_tube` the inflated tube in :math:`(z, r)`, lumen coloured    Axes
-                           by pressure
-:func:`plot_velocity_profiles`  axial velocity :math:`v(r)` at a few sections     Axes
-=========================  =====================================================  ===========
+* :func:`plot_tube_law` — transmural pressure against hoop stretch, with the
+  small-strain tangent and the limit pressure (returns the Axes);
+* :func:`plot_flow_curve` — flow rate against pressure drop, with the rigid-tube
+  (generalized Hagen–Poiseuille) curve (Axes);
+* :func:`plot_profiles` — pressure :math:`p(z)` and radius :math:`R(z)/a` (Figure);
+* :func:`plot_deformed_tube` — the inflated tube in :math:`(z, r)`, lumen coloured by
+  pressure (Axes);
+* :func:`plot_velocity_profiles` — axial velocity :math:`v(r)` at a few sections (Axes).
 
 ``WallModel.plot`` and ``Solution.plot`` are shortcuts for :func:`plot_tube_law`
 and :func:`plot_profiles`. Quantities are SI except lengths on the axes of
