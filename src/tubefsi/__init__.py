@@ -13,7 +13,7 @@ Quick start::
 from . import registry
 from .advise import Advice, Diagnostics, ModelValidityWarning, advise
 from .fit import FitResult, fit
-from .errors import ConvergenceError, InvalidParameterError, NoSteadyStateError, TubefsiError
+from .errors import AccuracyWarning, ConvergenceError, InvalidParameterError, NoSteadyStateError, TubefsiError
 from .geometry import Tube
 from .solution import Solution
 from .solve import max_flow_rate, select_coupler, solve
@@ -21,7 +21,7 @@ from .solve import max_flow_rate, select_coupler, solve
 __all__ = [
     "Tube", "solve", "max_flow_rate", "select_coupler", "Solution", "registry",
     "advise", "Advice", "Diagnostics", "ModelValidityWarning", "fit", "FitResult",
-    "TubefsiError", "InvalidParameterError", "NoSteadyStateError", "ConvergenceError",
+    "TubefsiError", "InvalidParameterError", "NoSteadyStateError", "ConvergenceError", "AccuracyWarning",
 ]
 
 __version__ = "0.1.0"

@@ -11,6 +11,7 @@ __all__ = [
     "InvalidParameterError",
     "NoSteadyStateError",
     "ConvergenceError",
+    "AccuracyWarning",
 ]
 
 
@@ -71,3 +72,7 @@ def _short(value) -> str:
     if a.ndim == 0:
         return f"{a.item()!r}"
     return f"array of shape {a.shape}"
+
+
+class AccuracyWarning(UserWarning):
+    """A non-default method's result is less accurate than its tolerance promises."""

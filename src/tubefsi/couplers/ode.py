@@ -18,13 +18,14 @@ runs per point; this coupler is a reference, not a default.
 from __future__ import annotations
 
 import math
+import warnings
 from typing import ClassVar
 
 import attrs
 import numpy as np
 from scipy import integrate, optimize
 
-from ..errors import ConvergenceError, NoSteadyStateError
+from ..errors import AccuracyWarning, ConvergenceError, NoSteadyStateError
 from .base import Coupler, State
 
 __all__ = ["ODE"]
@@ -46,6 +47,10 @@ class ODE(Coupler):
     method: str = attrs.field(default="LSODA", validator=_check_method)
     rtol: float | None = attrs.field(default=None)
     atol: float | None = attrs.field(default=None)
+    #: Re-integrate at 1/100 of the tolerances and warn (AccuracyWarning) where the two
+    #: results differ by more than ten times the tolerance: the global error of a
+    #: local-error-controlled integrator can exceed its tolerance, e.g. near a limit.
+    check_error: bool = attrs.field(default=True, converter=bool)
 
     cost_rank: ClassVar[int] = 1000
     meets_accuracy_contract: ClassVar[bool] = False
@@ -62,34 +67,64 @@ class ODE(Coupler):
 
         return Quadrature().max_flow_rate(scene)
 
-    def _integrate(self, scene, q):
-        """Return (inlet stretch, pressure rise) for one flow rate."""
+    def _tolerances(self):
+        """The tolerances in force: the integrator's defaults when not given."""
+        if self.method == "odeint":
+            return (self.rtol or 1.49012e-8), (self.atol or 1.49012e-8)
+        return (self.rtol or 1e-3), (self.atol or 1e-6)
+
+    def _integrate(self, scene, q, scale=1.0):
+        """Return (inlet stretch, pressure rise) for one flow rate; tolerances times ``scale``."""
         tb, a, L = scene.tb, scene.tube.radius, scene.tube.length
         wall, rheo = scene.wall, scene.rheology
         lam_max = wall._max_stretch(tb)
+        rtol, atol = self._tolerances()
 
         def rhs(z, y):
             lam = min(max(y[0], 1.0), lam_max * (1 - 1e-15)) if math.isfinite(lam_max) else max(y[0], 1.0)
-            g = float(rheo._pressure_gradient(np.asarray([q]), np.asarray([a * lam]))[0])
-            stiff = float(wall._stiffness(np.asarray(lam), tb))
+            with np.errstate(all="ignore"):
+                g = float(rheo._pressure_gradient(np.asarray([q]), np.asarray([a * lam]))[0])
+                stiff = float(wall._stiffness(np.asarray(lam), tb))
+            if not (math.isfinite(g) and stiff > 0):
+                raise ConvergenceError(f"the ODE left the tube law's range (stretch {lam:.3g}) at q = {q!r}")
             return [-g / stiff, -g]
 
         y0 = [scene.outlet_stretch, 0.0]
-        if self.method == "odeint":
-            kw = {k: v for k, v in (("rtol", self.rtol), ("atol", self.atol)) if v is not None}
-            y, info = integrate.odeint(rhs, y0, [L, 0.0], tfirst=True, full_output=True, **kw)
-            if info["message"] != "Integration successful.":
-                raise ConvergenceError(f"odeint failed at q = {q!r}: {info['message']}")
-            lam_in, rise = y[-1]
-        else:
-            kw = {k: v for k, v in (("rtol", self.rtol), ("atol", self.atol)) if v is not None}
-            sol = integrate.solve_ivp(rhs, (L, 0.0), y0, method=self.method, **kw)
-            if not sol.success:
-                raise ConvergenceError(f"solve_ivp({self.method}) failed at q = {q!r}: {sol.message}")
-            lam_in, rise = sol.y[:, -1]
+        try:
+            if self.method == "odeint":
+                y, info = integrate.odeint(rhs, y0, [L, 0.0], tfirst=True, full_output=True,
+                                           rtol=rtol * scale, atol=atol * scale)
+                if info["message"] != "Integration successful.":
+                    raise ConvergenceError(f"odeint failed at q = {q!r}: {info['message']}")
+                lam_in, rise = y[-1]
+            else:
+                sol = integrate.solve_ivp(rhs, (L, 0.0), y0, method=self.method, rtol=rtol * scale,
+                                          atol=atol * scale)
+                if not sol.success:
+                    raise ConvergenceError(f"solve_ivp({self.method}) failed at q = {q!r}: {sol.message}")
+                lam_in, rise = sol.y[:, -1]
+        except (ArithmeticError, FloatingPointError) as exc:
+            if isinstance(exc, ConvergenceError):
+                raise
+            raise ConvergenceError(f"{self.method} failed at q = {q!r}: {type(exc).__name__}: {exc}") from exc
         if not (np.isfinite(lam_in) and np.isfinite(rise)):
             raise ConvergenceError(f"the ODE solution is not finite at q = {q!r}")
         return lam_in, rise
+
+    def _integrate_checked(self, scene, q, errors):
+        lam, rise = self._integrate(scene, q)
+        if self.check_error:
+            lam_fine, rise_fine = self._integrate(scene, q, scale=0.01)
+            errors.append(max(abs(rise / rise_fine - 1.0),
+                              abs((lam - lam_fine) / max(lam_fine - 1.0, 1e-300))))
+        return lam, rise
+
+    def _warn_accuracy(self, errors):
+        rtol = self._tolerances()[0]
+        if errors and max(errors) > 10 * rtol:
+            warnings.warn(f"ODE({self.method}, rtol={rtol:g}): estimated relative error {max(errors):.2g} "
+                          f"exceeds ten times the tolerance; tighten rtol/atol or use coupler='auto'",
+                          AccuracyWarning, stacklevel=5)
 
     def flow_controlled(self, scene, flow_rate) -> State:
         q = np.asarray(flow_rate, dtype=float)
@@ -100,8 +135,10 @@ class ODE(Coupler):
             raise NoSteadyStateError("flow_rate", q_max, q[q >= q_max].flat[0])
         lam = np.empty(q.size)
         rise = np.empty(q.size)
+        errors = []
         for i, qi in enumerate(q.ravel()):
-            lam[i], rise[i] = (scene.outlet_stretch, 0.0) if qi == 0 else self._integrate(scene, qi)
+            lam[i], rise[i] = (scene.outlet_stretch, 0.0) if qi == 0 else self._integrate_checked(scene, qi, errors)
+        self._warn_accuracy(errors)
         lam, rise = lam.reshape(q.shape), rise.reshape(q.shape)
         v = np.log(lam / scene.outlet_stretch)
         return State(q, rise, lam - 1.0, v)
@@ -114,6 +151,7 @@ class ODE(Coupler):
         scene.wall._check_pressure(scene.outlet_pressure + dp, tb)
         e_in = scene.wall._strain(scene.outlet_pressure + dp, tb)
         q = np.zeros(dp.size)
+        errors = []
         for i, (d, e) in enumerate(zip(dp.ravel(), np.ravel(e_in))):
             if d == 0:
                 continue
@@ -124,6 +162,11 @@ class ODE(Coupler):
                 continue
             q[i] = optimize.brentq(lambda qq: self._integrate(scene, qq)[1] - d, lo, hi,
                                    xtol=1e-300, rtol=8 * np.finfo(float).eps)
+            if self.check_error:
+                fine = optimize.brentq(lambda qq: self._integrate(scene, qq, scale=0.01)[1] - d, lo, hi,
+                                       xtol=1e-300, rtol=8 * np.finfo(float).eps)
+                errors.append(abs(q[i] / fine - 1.0))
+        self._warn_accuracy(errors)
         q = q.reshape(dp.shape)
         v = np.log1p((e_in - scene.outlet_strain) / scene.outlet_stretch)
         return State(q, dp, e_in, v)
