@@ -3,7 +3,7 @@ r"""Accuracy of the default ``tubefsi.solve`` against an independent 40-digit re
 Where the reference comes from
 ------------------------------
 Nothing in this file calls tubefsi's numerics to build the expected values. The
-reference is written here in ``mpmath`` (``mp.dps = 40``, set for this module only by a
+reference (shared with ``test_accuracy_contract.py``, in ``tests/_reference.py``) is written in ``mpmath`` (``mp.dps = 40``, set for this module only by a
 fixture) straight from the physics in ``DESIGN.md`` §2 (the tube laws of §2.3, the
 power-law flow law of §2.2 and the separation of variables of §2.4):
 
@@ -63,6 +63,16 @@ from hypothesis import strategies as st
 from mpmath import mp, mpf
 
 import tubefsi
+from _reference import (
+    WALLS,
+    RefWall,
+    ref_J,
+    ref_J_inf,
+    ref_phi,
+    ref_phi_inverse,
+    rel_err,
+    stretch_at_pressure,
+)
 
 DPS = 40   # working precision of the reference (set per module, restored afterwards)
 
@@ -79,25 +89,6 @@ TB_VALUES = (0.05, 0.3, 1.0)
 STRAIN_LEVELS = ("1e-4", "0.1", "1", "top")   # "top": strain 3, or 97 % of the limit pressure
 NEAR_LIMIT = mpf("0.97")
 
-# name -> (registry name, constructor kwargs, reference law kind, reference parameters)
-WALLS = {
-    "thick-mooney-rivlin": ("thick-mooney-rivlin", dict(c1=3.0e3, c2=-1.0e3), "thick"),
-    "thick-neo-hookean": ("thick-neo-hookean", dict(shear_modulus=2.0e4), "thick"),
-    "thin-mooney-rivlin-reference": ("thin-mooney-rivlin",
-                                     dict(c1=2.0e4, c2=5.0e3, thickness_convention="reference"),
-                                     "thin-reference"),
-    "thin-mooney-rivlin-current": ("thin-mooney-rivlin",
-                                   dict(c1=8.0e3, c2=-2.5e3, thickness_convention="current"),
-                                   "thin-current"),
-    "thin-neo-hookean-reference": ("thin-neo-hookean",
-                                   dict(shear_modulus=1.0e3, thickness_convention="reference"),
-                                   "thin-reference"),
-    "thin-neo-hookean-current": ("thin-neo-hookean",
-                                 dict(shear_modulus=6.0e4, thickness_convention="current"),
-                                 "thin-current"),
-    "thin-linear": ("thin-linear", dict(youngs_modulus=3.0e4, poisson_ratio=0.45), "thin-linear"),
-    "thick-linear": ("thick-linear", dict(youngs_modulus=1.0e5, poisson_ratio=0.3), "thick-linear"),
-}
 DEFORMABLE = tuple(WALLS)
 
 
@@ -109,88 +100,10 @@ def _mp_precision():
 
 
 # ---------------------------------------------------------------------------- reference (mpmath)
-class RefWall:
-    """The tube law P(lam; tb) in mpmath, from DESIGN.md §2.3 (no tubefsi numerics)."""
-
-    def __init__(self, kind, params, tb):
-        self.kind = kind
-        self.tb = tb
-        if "c1" in params:
-            self.mu = 2 * (mpf(params["c1"]) + mpf(params["c2"]))
-        elif "shear_modulus" in params:
-            self.mu = mpf(params["shear_modulus"])
-        else:
-            E, nu = mpf(params["youngs_modulus"]), mpf(params["poisson_ratio"])
-            if kind == "thin-linear":
-                factor = 1 - nu / 2
-            else:
-                factor = ((1 + tb) ** 2 * (1 + nu) + (1 - 2 * nu)) / (2 + tb)
-            self.compliance = factor / (E * tb)      # d lam / dp
-
-    def P(self, lam):
-        tb = self.tb
-        if self.kind == "thick":
-            b = (1 + tb) ** 2
-            xo = b / (b - 1 + lam**2)
-            xi = 1 / lam**2
-            return self.mu / 2 * ((xo + mpmath.log(xo)) - (xi + mpmath.log(xi)))
-        if self.kind == "thin-reference":
-            return self.mu * tb * (lam - lam**-3)
-        if self.kind == "thin-current":
-            return self.mu * tb * (1 - lam**-4)
-        return (lam - 1) / self.compliance            # linear walls
-
-    def limit_pressure(self):
-        if self.kind == "thick":
-            return self.mu * mpmath.log(1 + self.tb)
-        if self.kind == "thin-current":
-            return self.mu * self.tb
-        return mpmath.inf
-
-    def dP(self, s):
-        """Hand-derived P'(s) (see the module docstring); used only for J_inf."""
-        if self.kind == "thin-current":
-            return 4 * self.mu * self.tb * s**-5
-        if self.kind == "thick":
-            d = (1 + self.tb) ** 2 - 1
-            return self.mu * d * ((d + 2) * s**2 + d) / (s**3 * (s**2 + d) ** 2)
-        raise ValueError(self.kind)
-
-
-def _split(lo, hi):
-    """Geometric sub-intervals of [lo, hi] (lo >= 1) for mpmath.quad."""
-    pts = [lo]
-    while pts[-1] * 2 < hi:
-        pts.append(pts[-1] * 2)
-    pts.append(hi)
-    return pts
-
-
-def ref_J(wall, lam, k):
-    """Jhat(lam) = int_1^lam P'(s) s^k ds = P(lam) lam^k - k int_1^lam P(s) s^(k-1) ds."""
-    if lam == 1:
-        return mpf(0)
-    tail = mpmath.quad(lambda s: wall.P(s) * s ** (k - 1), _split(mpf(1), lam))
-    return wall.P(lam) * lam**k - k * tail
-
-
-def ref_phi(q, n, m):
-    return 2 * m * ((3 * n + 1) * q / (mpmath.pi * n)) ** n
-
-
-def ref_phi_inverse(phi, n, m):
-    return mpmath.pi * n / (3 * n + 1) * (phi / (2 * m)) ** (1 / n)
-
-
+# The tube laws, Jhat by parts, phi and its inverse, J_inf live in tests/_reference.py.
 def near_limit_stretch(wall):
     """lam with P(lam) = 0.97 p_max (bracketed, then polished by findroot)."""
-    target = NEAR_LIMIT * wall.limit_pressure()
-    lo, hi = mpf(1), mpf(2)
-    while wall.P(hi) < target:
-        lo, hi = hi, 2 * hi
-    lam = mpmath.findroot(lambda s: wall.P(s) - target, (lo, hi), solver="anderson")
-    assert abs(wall.P(lam) / target - 1) < mpf(10) ** -30
-    return lam
+    return stretch_at_pressure(wall, NEAR_LIMIT * wall.limit_pressure(), polish=False)
 
 
 @functools.lru_cache(maxsize=None)
@@ -220,22 +133,8 @@ def ref_max_flow_rate(wall_name, tb_float, n_float, m_float):
     wall = RefWall(kind, params, tb)
     n, m = mpf(n_float), mpf(m_float)
     k = 3 * n + 1
-    if kind == "thin-current":
-        J_inf = 4 * wall.mu * tb / (4 - k)
-    else:
-        d = (1 + tb) ** 2 - 1
-        alpha = 4 - k
-
-        def integrand(w):               # t = w^(1/alpha): t^(3-k) dt = dw / alpha
-            t2 = w ** (2 / alpha)
-            return ((d + 2) + d * t2) / (1 + d * t2) ** 2
-
-        J_inf = wall.mu * d / alpha * mpmath.quad(integrand, [0, 1])
+    J_inf = ref_J_inf(wall, k)
     return ref_phi_inverse(J_inf * mpf(A) ** k / mpf(L), n, m)
-
-
-def rel_err(got, ref):
-    return float(abs((mpf(got) - ref) / ref))
 
 
 # ---------------------------------------------------------------------------- library side
