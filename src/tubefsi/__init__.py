@@ -10,7 +10,7 @@ Quick start::
     sol.pressure_drop, sol.inlet_displacement
 """
 
-from . import registry
+from . import dimensionless, registry
 from .advise import Advice, Diagnostics, ModelValidityWarning, advise
 from .fit import FitResult, fit
 from .errors import AccuracyWarning, ConvergenceError, InvalidParameterError, NoSteadyStateError, TubefsiError
@@ -19,7 +19,7 @@ from .solution import Solution
 from .solve import max_flow_rate, select_coupler, solve
 
 __all__ = [
-    "Tube", "solve", "max_flow_rate", "select_coupler", "Solution", "registry",
+    "dimensionless", "Tube", "solve", "max_flow_rate", "select_coupler", "Solution", "registry",
     "advise", "Advice", "Diagnostics", "ModelValidityWarning", "fit", "FitResult",
     "TubefsiError", "InvalidParameterError", "NoSteadyStateError", "ConvergenceError", "AccuracyWarning",
 ]

@@ -407,6 +407,12 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.set_defaults(run=_cmd_solve)
 
+    p = sub.add_parser("reproduce", help="the chapter's figures, as printed and consistent (PNG and CSV)")
+    p.add_argument("out", nargs="?", default="chapter-figures", metavar="OUTDIR",
+                   help="output directory (default: ./chapter-figures)")
+    p.add_argument("--png-only", action="store_true", help="write the figures without their CSV data")
+    p.set_defaults(run=_cmd_reproduce)
+
     p = sub.add_parser("curve", help="a flow-rate–pressure-drop curve as CSV or JSON (optionally a plot)",
                        description="Sweep flow rates or pressure drops. " + _SCENE_HELP)
     _add_scene_args(p)
@@ -497,6 +503,13 @@ def _cmd_curve(args, out) -> int:
     return 0
 
 
+def _cmd_reproduce(args, out) -> int:
+    from .dimensionless import reproduce_chapter
+
+    reproduce_chapter(args.out, formats=("png",) if args.png_only else ("png", "csv"), file=out)
+    return 0
+
+
 def _cmd_advise(args, out) -> int:
     import tubefsi
 
@@ -530,7 +543,7 @@ def main(argv=None) -> int:
     except SystemExit as exc:  # --help, --version
         return exc.code if isinstance(exc.code, int) else 0
     if args.command is None:
-        return _error("a command is required: list, solve, curve, advise or demo (see 'tubefsi --help')")
+        return _error("a command is required: list, solve, curve, advise, demo or reproduce (see 'tubefsi --help')")
     try:
         return args.run(args, sys.stdout)
     except (UsageError, ValueError, TubefsiError) as exc:

@@ -1,16 +1,18 @@
 r"""``ode``: integrate the lubrication ODE along the tube, as the chapter does.
 
-The state is :math:`y = (\lambda, p - p_{out})`, integrated from :math:`z = L`
-(:math:`\lambda = \lambda_{out}`, :math:`p = p_{out}`) to :math:`z = 0`:
+The state is the hoop strain and the pressure rise, :math:`y = (\lambda - 1, p - p_{out})`,
+each divided by its rigid-tube scale (:math:`\Delta p_0 = L\,G(q, a)` and
+:math:`\Delta p_0/P'(1)`) so that the tolerances act on O(1) numbers, integrated from
+:math:`z = L` (outlet strain, :math:`p = p_{out}`) to :math:`z = 0`:
 
 .. math::
 
     \frac{d\lambda}{dz} = -\frac{G(q, a\lambda)}{P'(\lambda)}, \qquad
     \frac{dp}{dz} = -G(q, a\lambda).
 
-``method`` is any :func:`scipy.integrate.solve_ivp` method, or ``"odeint"`` for
-:func:`scipy.integrate.odeint` (LSODA) with its default tolerances — the chapter's
-method, kept as the speed baseline. Pressure-controlled problems are solved by
+``method`` is any :func:`scipy.integrate.solve_ivp` method (default tolerances
+rtol = 1e-8, atol = 1e-10), or ``"odeint"`` for :func:`scipy.integrate.odeint` (LSODA)
+with its own defaults — the chapter's method, kept as the speed baseline. Pressure-controlled problems are solved by
 shooting on the flow rate (Brent's method inside the rigid-tube bracket). One ODE
 runs per point; this coupler is a reference, not a default.
 """
@@ -68,63 +70,87 @@ class ODE(Coupler):
         return Quadrature().max_flow_rate(scene)
 
     def _tolerances(self):
-        """The tolerances in force: the integrator's defaults when not given."""
+        """The tolerances in force: odeint's own defaults, or 1e-8 / 1e-10 for solve_ivp."""
         if self.method == "odeint":
             return (self.rtol or 1.49012e-8), (self.atol or 1.49012e-8)
-        return (self.rtol or 1e-3), (self.atol or 1e-6)
+        return (self.rtol or 1e-8), (self.atol or 1e-10)
 
     def _integrate(self, scene, q, scale=1.0):
-        """Return (inlet stretch, pressure rise) for one flow rate; tolerances times ``scale``."""
+        """Return (inlet strain, pressure rise) for one flow rate; tolerances times ``scale``."""
         tb, a, L = scene.tb, scene.tube.radius, scene.tube.length
         wall, rheo = scene.wall, scene.rheology
         lam_max = wall._max_stretch(tb)
         rtol, atol = self._tolerances()
+        drop0 = L * float(rheo._pressure_gradient(np.asarray([q]), np.asarray([a * scene.outlet_stretch]))[0])
+        strain0 = drop0 / float(wall._stiffness(np.asarray(scene.outlet_stretch), tb))
 
         def rhs(z, y):
-            lam = min(max(y[0], 1.0), lam_max * (1 - 1e-15)) if math.isfinite(lam_max) else max(y[0], 1.0)
+            lam = 1.0 + y[0] * strain0
+            lam = min(max(lam, 1.0), lam_max * (1 - 1e-15)) if math.isfinite(lam_max) else max(lam, 1.0)
             with np.errstate(all="ignore"):
                 g = float(rheo._pressure_gradient(np.asarray([q]), np.asarray([a * lam]))[0])
                 stiff = float(wall._stiffness(np.asarray(lam), tb))
             if not (math.isfinite(g) and stiff > 0):
                 raise ConvergenceError(f"the ODE left the tube law's range (stretch {lam:.3g}) at q = {q!r}")
-            return [-g / stiff, -g]
+            return [-g / stiff / strain0, -g / drop0]
 
-        y0 = [scene.outlet_stretch, 0.0]
+        y0 = [scene.outlet_strain / strain0, 0.0]
         try:
             if self.method == "odeint":
                 y, info = integrate.odeint(rhs, y0, [L, 0.0], tfirst=True, full_output=True,
                                            rtol=rtol * scale, atol=atol * scale)
                 if info["message"] != "Integration successful.":
                     raise ConvergenceError(f"odeint failed at q = {q!r}: {info['message']}")
-                lam_in, rise = y[-1]
+                strain, rise = y[-1]
             else:
                 sol = integrate.solve_ivp(rhs, (L, 0.0), y0, method=self.method, rtol=rtol * scale,
                                           atol=atol * scale)
                 if not sol.success:
                     raise ConvergenceError(f"solve_ivp({self.method}) failed at q = {q!r}: {sol.message}")
-                lam_in, rise = sol.y[:, -1]
+                strain, rise = sol.y[:, -1]
         except (ArithmeticError, FloatingPointError) as exc:
             if isinstance(exc, ConvergenceError):
                 raise
             raise ConvergenceError(f"{self.method} failed at q = {q!r}: {type(exc).__name__}: {exc}") from exc
-        if not (np.isfinite(lam_in) and np.isfinite(rise)):
+        strain, rise = strain * strain0, rise * drop0
+        if not (np.isfinite(strain) and np.isfinite(rise)):
             raise ConvergenceError(f"the ODE solution is not finite at q = {q!r}")
-        return lam_in, rise
+        return strain, rise
 
     def _integrate_checked(self, scene, q, errors):
-        lam, rise = self._integrate(scene, q)
+        strain, rise = self._integrate(scene, q)
         if self.check_error:
-            lam_fine, rise_fine = self._integrate(scene, q, scale=0.01)
+            strain_fine, rise_fine = self._integrate(scene, q, scale=0.01)
             errors.append(max(abs(rise / rise_fine - 1.0),
-                              abs((lam - lam_fine) / max(lam_fine - 1.0, 1e-300))))
-        return lam, rise
+                              abs((strain - strain_fine) / max(strain_fine, 1e-300))))
+        return strain, rise
 
     def _warn_accuracy(self, errors):
         rtol = self._tolerances()[0]
-        if errors and max(errors) > 10 * rtol:
+        if errors and max(errors) > min(10 * rtol, 1e-3):
             warnings.warn(f"ODE({self.method}, rtol={rtol:g}): estimated relative error {max(errors):.2g} "
                           f"exceeds ten times the tolerance; tighten rtol/atol or use coupler='auto'",
                           AccuracyWarning, stacklevel=5)
+
+    def _shoot(self, scene, drop, lo, hi, scale):
+        """The flow rate whose integrated pressure rise is ``drop``, by Brent's method in [lo, hi]."""
+
+        def miss(qq):
+            return self._integrate(scene, qq, scale)[1] - drop
+
+        f_lo, f_hi = miss(lo), miss(hi)
+        for _ in range(20):  # integration error may shift the root just outside the exact bracket
+            if f_lo <= 0 <= f_hi:
+                break
+            if f_lo > 0:
+                lo *= 0.999
+                f_lo = miss(lo)
+            if f_hi < 0:
+                hi = hi * 1.001 if not math.isfinite(self.max_flow_rate(scene)) else 0.5 * (hi + self.max_flow_rate(scene))
+                f_hi = miss(hi)
+        else:
+            raise ConvergenceError(f"{self.method}: shooting could not bracket the flow rate for Δp = {drop!r}")
+        return optimize.brentq(miss, lo, hi, xtol=1e-300, rtol=8 * np.finfo(float).eps)
 
     def flow_controlled(self, scene, flow_rate) -> State:
         q = np.asarray(flow_rate, dtype=float)
@@ -133,15 +159,16 @@ class ODE(Coupler):
         q_max = self.max_flow_rate(scene)
         if np.any(q >= q_max):
             raise NoSteadyStateError("flow_rate", q_max, q[q >= q_max].flat[0])
-        lam = np.empty(q.size)
+        strain = np.empty(q.size)
         rise = np.empty(q.size)
         errors = []
         for i, qi in enumerate(q.ravel()):
-            lam[i], rise[i] = (scene.outlet_stretch, 0.0) if qi == 0 else self._integrate_checked(scene, qi, errors)
+            strain[i], rise[i] = ((scene.outlet_strain, 0.0) if qi == 0
+                                  else self._integrate_checked(scene, qi, errors))
         self._warn_accuracy(errors)
-        lam, rise = lam.reshape(q.shape), rise.reshape(q.shape)
-        v = np.log(lam / scene.outlet_stretch)
-        return State(q, rise, lam - 1.0, v)
+        strain, rise = strain.reshape(q.shape), rise.reshape(q.shape)
+        v = np.log1p((strain - scene.outlet_strain) / scene.outlet_stretch)
+        return State(q, rise, strain, v)
 
     def pressure_controlled(self, scene, pressure_drop) -> State:
         dp = np.asarray(pressure_drop, dtype=float)
@@ -152,20 +179,20 @@ class ODE(Coupler):
         e_in = scene.wall._strain(scene.outlet_pressure + dp, tb)
         q = np.zeros(dp.size)
         errors = []
+        q_max = self.max_flow_rate(scene)
         for i, (d, e) in enumerate(zip(dp.ravel(), np.ravel(e_in))):
             if d == 0:
                 continue
+            # the flow lies between the rigid-tube flows at the outlet and inlet radii (and below q_max)
             lo = float(rheo._flow_rate(np.asarray([a * scene.outlet_stretch]), np.asarray([d / L]))[0])
-            hi = float(rheo._flow_rate(np.asarray([a * (1.0 + e)]), np.asarray([d / L]))[0])
+            hi = min(float(rheo._flow_rate(np.asarray([a * (1.0 + e)]), np.asarray([d / L]))[0]),
+                     q_max * (1 - 1e-12))
             if hi <= lo * (1 + 1e-14):
                 q[i] = lo
                 continue
-            q[i] = optimize.brentq(lambda qq: self._integrate(scene, qq)[1] - d, lo, hi,
-                                   xtol=1e-300, rtol=8 * np.finfo(float).eps)
+            q[i] = self._shoot(scene, d, lo, hi, 1.0)
             if self.check_error:
-                fine = optimize.brentq(lambda qq: self._integrate(scene, qq, scale=0.01)[1] - d, lo, hi,
-                                       xtol=1e-300, rtol=8 * np.finfo(float).eps)
-                errors.append(abs(q[i] / fine - 1.0))
+                errors.append(abs(q[i] / self._shoot(scene, d, lo, hi, 0.01) - 1.0))
         self._warn_accuracy(errors)
         q = q.reshape(dp.shape)
         v = np.log1p((e_in - scene.outlet_strain) / scene.outlet_stretch)
