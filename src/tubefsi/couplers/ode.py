@@ -32,6 +32,9 @@ from .base import Coupler, State
 
 __all__ = ["ODE"]
 
+#: Right-hand-side evaluations allowed per integration before giving up.
+_MAX_EVALUATIONS = 20_000
+
 _METHODS = ("odeint", "RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 
 
@@ -84,7 +87,13 @@ class ODE(Coupler):
         drop0 = L * float(rheo._pressure_gradient(np.asarray([q]), np.asarray([a * scene.outlet_stretch]))[0])
         strain0 = drop0 / float(wall._stiffness(np.asarray(scene.outlet_stretch), tb))
 
+        calls = [0]
+
         def rhs(z, y):
+            calls[0] += 1
+            if calls[0] > _MAX_EVALUATIONS:
+                raise ConvergenceError(f"{self.method} needed more than {_MAX_EVALUATIONS} steps at q = {q!r} "
+                                       "(a stiff or nearly unbounded inflation)")
             lam = 1.0 + y[0] * strain0
             lam = min(max(lam, 1.0), lam_max * (1 - 1e-15)) if math.isfinite(lam_max) else max(lam, 1.0)
             with np.errstate(all="ignore"):
