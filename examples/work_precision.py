@@ -436,7 +436,7 @@ def methods_for(scene):
     if scene.key == "thin":
         out.append(("closed form", "ClosedForm()", ClosedForm(), False))
     for k in QUAD_ORDERS:
-        out.append(("quadrature", f"Quadrature(order={k})", Quadrature(order=k), False))
+        out.append(("quadrature", f"Quadrature(order={k})", Quadrature(order=k, check_error=False), False))
     # the generic (non-separable) flow law makes each right-hand side evaluation a root find:
     # fewer tolerances there keep the script within a few minutes
     rtols = RTOLS[::2] if scene.key == "carreau" else RTOLS
