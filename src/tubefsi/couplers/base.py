@@ -13,11 +13,18 @@ so the inlet log-stretch :math:`v` solves :math:`H(v; q) = L` and the pressure d
 :math:`J(v) = L\,\phi(q)` with :math:`J` independent of :math:`q`, so one function serves a
 whole flow curve. Couplers differ only in how they evaluate :math:`J` (closed form or
 Gauss–Legendre quadrature) or in integrating the ODE instead.
+
+A wall with a maximum stretch :math:`\lambda_{max}` (a locking material such as Gent, the
+first pressure peak of a non-monotone tube law, the representable end of a Fung law) bounds
+:math:`v` by :math:`v_{max} = \ln(\lambda_{max}/\lambda_{out})`. :meth:`Scene.integrate`
+grades its panels geometrically toward :math:`v_{max}` where the pressure is unbounded there
+(:math:`P'` singular: a lock), and narrows them where the integrand grows fast.
 """
 
 from __future__ import annotations
 
 import abc
+import functools
 import math
 from typing import ClassVar
 
@@ -27,8 +34,9 @@ from scipy import interpolate
 from scipy import optimize
 from scipy.optimize import elementwise
 
-from .._numerics import integrate_panels, solve_increasing
+from .._numerics import EPS, integrate_graded, solve_increasing
 from ..errors import NoSteadyStateError
+from ..rheology.base import yield_stress_of
 
 __all__ = ["Coupler", "Scene", "State"]
 
@@ -62,6 +70,8 @@ class Scene:
 
     outlet_strain: float = attrs.field(init=False)
     outlet_stretch: float = attrs.field(init=False)
+    #: :math:`\ln(\lambda_{max}/\lambda_{out})`: the largest log-stretch (``inf`` for most walls)
+    log_stretch_max: float = attrs.field(init=False)
 
     def __attrs_post_init__(self):
         # the hoop strain at the outlet, once: every J evaluation needs it
@@ -69,6 +79,18 @@ class Scene:
             self.wall._strain(np.asarray(self.outlet_pressure), self.tb))
         object.__setattr__(self, "outlet_strain", strain)
         object.__setattr__(self, "outlet_stretch", 1.0 + strain)
+        lam_max = math.inf if self.wall.is_rigid else float(self.wall._max_stretch(self.tb))
+        object.__setattr__(self, "log_stretch_max", math.log(lam_max / (1.0 + strain)))
+        # a maximum stretch with an unbounded pressure (a locking wall) is a singularity of P'
+        singular = math.isfinite(lam_max) and not math.isfinite(self.wall._limit_pressure(self.tb))
+        object.__setattr__(self, "_pole", self.log_stretch_max if singular else math.inf)
+
+    _pole: float = attrs.field(init=False, repr=False)
+
+    def integrate(self, f, upper, *, order=16, panel_width=2.0):
+        """``∫_0^upper f(u, idx) du`` over log-stretch: composite Gauss–Legendre, panels narrowed
+        where ``f`` grows fast and graded toward a locking stretch (see :func:`integrate_graded`)."""
+        return integrate_graded(f, upper, self._pole, order=order, panel_width=panel_width)
 
     # -- tube law along u
     def stretch_at(self, u):
@@ -83,7 +105,7 @@ class Scene:
         v = np.asarray(v, dtype=float)
         if self.outlet_pressure == 0.0:
             return self.wall._pressure_at_strain(np.expm1(v), self.tb)
-        return integrate_panels(lambda u, idx: self._slope(u), v)
+        return self.integrate(lambda u, idx: self._slope(u), v)
 
     def _slope(self, u):
         s = self.stretch_at(u)
@@ -134,6 +156,10 @@ class Coupler(abc.ABC):
         tb = scene.tb
         if not math.isfinite(scene.wall._limit_pressure(tb)):
             return math.inf
+        qq = None if q is None else np.asarray(q, dtype=float)
+        if math.isfinite(scene.log_stretch_max):
+            # the tube law ends at its pressure peak: J stays finite up to it
+            return float(self._J(scene, np.asarray(scene.log_stretch_max * (1 - 8 * EPS)), qq))
         rheo = scene.rheology
         mu = getattr(rheo, "radius_exponent", None)
         if mu is None:
@@ -145,7 +171,6 @@ class Coupler(abc.ABC):
         if not alpha > 1e-12:
             return math.inf
         v1 = np.asarray(_PROBE_LOG_STRETCH)
-        qq = None if q is None else np.asarray(q, dtype=float)
         head = self._J(scene, v1, qq)
         tail = scene.integrand(v1, qq) / alpha
         return float(head + tail)
@@ -193,12 +218,31 @@ class Coupler(abc.ABC):
             else:
                 guess = np.ones(target.shape)
         else:
-            slope0 = scene.integrand(np.zeros(target.shape), None if sep else np.broadcast_to(q, target.shape))
-            guess = np.minimum(target / slope0, 1.0)
+            with np.errstate(divide="ignore", invalid="ignore"):   # G(0, R) = 0: only where target = 0
+                slope0 = scene.integrand(np.zeros(target.shape), None if sep else np.broadcast_to(q, target.shape))
+                guess = np.where(target > 0, np.minimum(target / slope0, 1.0), 0.0)
         if upper is not None:
             guess = np.minimum(guess, upper)
-        return solve_increasing(F, dF, target, guess=guess, upper=upper, xmax=MAX_LOG_STRETCH, max_step=2.0,
-                                log=True)
+        cap = self._log_stretch_cap(scene)
+        if math.isfinite(scene.log_stretch_max):
+            upper = cap if upper is None else np.minimum(upper, cap)
+            guess = np.minimum(guess, 0.5 * cap)
+        v, ok = solve_increasing(F, dF, target, guess=guess, upper=upper, xmax=MAX_LOG_STRETCH, max_step=2.0,
+                                 log=True)
+        if math.isfinite(scene.log_stretch_max):
+            # converged onto the maximum stretch without reaching the target: out of reach
+            at_cap = np.flatnonzero((v.ravel() >= cap * (1 - 1e-12)) & (target.ravel() > 0))
+            if at_cap.size:
+                short = F(v.ravel()[at_cap], at_cap) < target.ravel()[at_cap] * (1 - 1e-9)
+                ok = ok.copy()
+                ok.ravel()[at_cap[short]] = False
+        return v, ok
+
+    @staticmethod
+    def _log_stretch_cap(scene):
+        """The largest log-stretch a solve may reach: below a maximum stretch, and ln(1e15)."""
+        v_max = scene.log_stretch_max
+        return min(MAX_LOG_STRETCH, v_max * (1 - 8 * EPS)) if math.isfinite(v_max) else MAX_LOG_STRETCH
 
     def pressure_controlled(self, scene: Scene, pressure_drop) -> State:
         """Solve for the flow rate at each pressure drop (array)."""
@@ -220,19 +264,47 @@ class Coupler(abc.ABC):
         return State(q, dp, e_in, v)
 
     def _solve_flow_rate(self, scene, v, dp):
-        """Non-separable rheology: find q with H(v; q) = L, bracketed by rigid tubes."""
+        r"""Non-separable rheology: find q with H(v; q) = L (H decreases with q).
+
+        Rigid tubes of the outlet and inlet radii under the mean gradient dp/L bracket q.
+        A yield-stress fluid has a finite :math:`H(v; 0^+)`, with :math:`G = 2\tau_y/R`:
+        where it does not exceed L the pressure drop cannot yield the fluid all along
+        the tube, and q = 0.
+        """
         a, L, rheo = scene.tube.radius, scene.tube.length, scene.rheology
+        shape = np.shape(v)
+        v = np.asarray(v, dtype=float).ravel()
+        dp = np.broadcast_to(np.asarray(dp, dtype=float), shape).ravel()
         g = np.where(dp == 0, 1.0, dp) / L
         q_lo = rheo._flow_rate(np.full_like(g, a * scene.outlet_stretch), g)
         q_hi = rheo._flow_rate(a * scene.stretch_at(v), g)
+        flowing = (q_hi > 0) & (dp > 0)
+        if yield_stress_of(rheo) > 0 and np.any(flowing):
+            flowing[flowing] = self._J(scene, v[flowing], np.zeros(np.count_nonzero(flowing))) > L
+        q = np.zeros(v.shape)
+        if not np.any(flowing):
+            return q.reshape(shape)
+        v, q_lo, q_hi = v[flowing], q_lo[flowing], q_hi[flowing]
 
         def f(log_q, v):
-            return np.log(self._J(scene, v, np.exp(log_q))) - np.log(L)
+            return np.log(self._J(scene, v, np.exp(log_q))) - math.log(L)
 
-        lo, hi = np.log(q_lo), np.log(q_hi) * (1 + 1e-15) + 1e-15
-        res = elementwise.find_root(f, (lo - 1e-12 * np.abs(lo), hi), args=(v,),
+        hi = np.log(q_hi) * (1 + 1e-15) + 1e-15
+        with np.errstate(divide="ignore"):
+            lo = np.log(q_lo)
+        lo = lo - 1e-12 * np.abs(lo)
+        found = np.ones(v.shape, dtype=bool)
+        unyielded = q_lo <= 0          # the outlet section alone would not yield: search down
+        if np.any(unyielded):
+            top = hi[unyielded]
+            br = elementwise.bracket_root(f, top - 2.0, top, xmin=top - 700.0, xmax=top, args=(v[unyielded],))
+            lo[unyielded] = br.bracket[0]
+            hi[unyielded] = np.where(br.success, br.bracket[1], hi[unyielded])
+            found[unyielded] = br.success   # else q < 1e-304 q_hi: zero in double precision
+        res = elementwise.find_root(f, (lo, hi), args=(v,),
                                     tolerances=dict(xrtol=4 * np.finfo(float).eps, xatol=1e-300))
-        return np.exp(res.x)
+        q[flowing] = np.where(found, np.exp(res.x), 0.0)
+        return q.reshape(shape)
 
     def max_flow_rate(self, scene: Scene) -> float:
         """Largest flow rate with a steady state (``inf`` if none)."""
@@ -243,17 +315,31 @@ class Coupler(abc.ABC):
         j_inf = self._J_infinity(scene)
         if not math.isfinite(j_inf):
             return math.inf
-        return float(scene.rheology._flow_factor_inverse(j_inf / scene.tube.length))
+        try:
+            with np.errstate(over="ignore"):
+                return float(scene.rheology._flow_factor_inverse(j_inf / scene.tube.length))
+        except OverflowError:  # beyond double precision (e.g. the representable end of a Fung wall)
+            return math.inf
 
     def _max_flow_rate_general(self, scene: Scene) -> float:
-        """Non-separable rheology: the q with H(inf; q) = L (H decreases with q), by Brent's method."""
+        """Non-separable rheology: the q with H(inf; q) = L (H decreases with q), by Brent's method;
+        cached per (coupler, scene), since every flow-controlled solve asks for it."""
+        try:
+            return _cached_max_flow_rate(self, scene)
+        except TypeError:  # an unhashable model
+            return self._max_flow_rate_search(scene)
+
+    def _max_flow_rate_search(self, scene: Scene) -> float:
         L = scene.tube.length
+        tau_y = yield_stress_of(scene.rheology)
+        if tau_y > 0 and not self._J_infinity(scene, 0.0) > L:
+            return 0.0  # even the limit pressure cannot yield the fluid all along the tube
 
         def excess(log_q):
             return math.log(self._J_infinity(scene, math.exp(log_q))) - math.log(L)
 
         a = scene.tube.radius
-        g0 = scene.wall._limit_pressure(scene.tb) / L
+        g0 = max(scene.wall._limit_pressure(scene.tb) / L, 4.0 * tau_y / a)
         log_q = math.log(float(scene.rheology._flow_rate(np.asarray([a]), np.asarray([g0]))[0]))
         if not math.isfinite(excess(log_q)):
             return math.inf  # G(q, R) falls off too fast in R: every flow rate has a steady state
@@ -271,12 +357,21 @@ class Coupler(abc.ABC):
         bad = q[~ok].flat[0]
         if math.isfinite(q_max) and bad >= q_max:
             raise NoSteadyStateError("flow_rate", q_max, bad, "the tube inflates without bound")
-        v = np.asarray(MAX_LOG_STRETCH)
+        cap = self._log_stretch_cap(scene)
+        v = np.asarray(cap)
         sep = scene.rheology.separable
         if sep:
             reach = float(scene.rheology._flow_factor_inverse(self._J(scene, v, None) / scene.tube.length))
         else:
-            v1 = np.array([MAX_LOG_STRETCH])
+            v1 = np.array([cap])
             reach = float(self._solve_flow_rate(scene, v1, scene.pressure_rise(v1))[0])
+        if cap < MAX_LOG_STRETCH:
+            raise NoSteadyStateError("flow_rate", reach, bad,
+                                     "the inlet stretch would reach the wall's maximum stretch")
         raise NoSteadyStateError("flow_rate", reach, bad,
                                  "the inlet stretch would exceed 1e15 (the tube inflates without practical bound)")
+
+
+@functools.lru_cache(maxsize=256)
+def _cached_max_flow_rate(coupler, scene) -> float:
+    return coupler._max_flow_rate_search(scene)

@@ -10,7 +10,7 @@ apparent wall shear rate
 so :math:`G(q, R) = 2\,\tau_w(\Gamma = 4q/\pi R^3)/R`. One monotone function of one
 variable serves every radius and flow rate. :class:`FlowTable` samples
 :math:`\ln\Gamma` as a function of :math:`s = \ln(\tau_w - \tau_y)` (``tau_y`` the
-yield stress, 0 for most fluids) on unit panels with degree-20 Chebyshev
+yield stress, 0 for most fluids) on unit panels with degree-28 Chebyshev
 interpolants, extended on demand, and inverts it by Newton's method on the
 interpolant: after a one-off set-up of a few thousand flow-function evaluations,
 :math:`G(q, R)` costs a handful of polynomial evaluations per point.
@@ -25,7 +25,7 @@ import numpy as np
 
 __all__ = ["FlowTable", "flow_table", "tanh_sinh"]
 
-_DEGREE = 20
+_DEGREE = 28
 _CHEB = np.cos(np.pi * (np.arange(_DEGREE + 1) + 0.5) / (_DEGREE + 1))  # Chebyshev points on [-1, 1]
 
 
@@ -41,7 +41,29 @@ def tanh_sinh(levels: int = 6):
     return t[keep], w[keep]
 
 
-_T, _W = tanh_sinh(6)
+def graded_rule(panels: int = 30, order: int = 12, levels: int = 6):
+    """Nodes/weights on [0, 1] graded geometrically toward 0: Gauss–Legendre on the panels
+    [2^-(k+1), 2^-k] (k < ``panels``) and the tanh-sinh rule on [0, 2^-panels].
+
+    A constitutive law with a transition at a small fraction of the interval (a Carreau fluid
+    whose wall shear rate is far above 1/lambda has complex singularities close to t = 0) is
+    integrated to ~1e-16: every panel is half as wide as its distance to 0, so a singularity
+    near 0 is at least three half-widths from it; the innermost panel carries the algebraic
+    endpoint behaviour (t**(1/n), the yield point) and a negligible share of the integral.
+    """
+    x, w = np.polynomial.legendre.leggauss(order)
+    x, w = 0.5 * (x + 1.0), 0.5 * w
+    lo = 2.0 ** -np.arange(1, panels + 1, dtype=float)           # panel k: [lo_k, 2 lo_k]
+    t = (lo[:, None] * (1.0 + x[None, :])).ravel()
+    wt = (lo[:, None] * w[None, :]).ravel()
+    ts, ws = tanh_sinh(levels)
+    t = np.concatenate([ts * lo[-1], t])
+    wt = np.concatenate([ws * lo[-1], wt])
+    order_ = np.argsort(t)
+    return t[order_], wt[order_]
+
+
+_T, _W = graded_rule()
 
 
 class FlowTable:
@@ -51,20 +73,26 @@ class FlowTable:
         self.rheology = rheology
         self.yield_stress = float(getattr(rheology, "yield_stress", 0.0))
         self.panels: dict[int, np.ndarray] = {}   # panel index -> Chebyshev coefficients
+        self._slopes: dict[int, np.ndarray] = {}  # panel index -> coefficients of the derivative
 
     # ------------------------------------------------------------ exact flow function
-    def apparent_shear_rate(self, wall_stress):
-        r""":math:`\Gamma(\tau_w)` by the rheology's hook (a closed form, or quadrature)."""
-        return self.rheology._apparent_shear_rate(np.asarray(wall_stress, dtype=float))
+    def apparent_shear_rate(self, excess):
+        r""":math:`\Gamma` at the wall stress :math:`\tau_y +` ``excess``, by the rheology's hook (a
+        closed form, or quadrature), given the excess itself: exact however close to yield."""
+        excess = np.asarray(excess, dtype=float)
+        if self.yield_stress == 0.0:
+            return self.rheology._apparent_shear_rate(excess)
+        return self.rheology._apparent_shear_rate(self.yield_stress + excess, excess=excess)
 
     # ------------------------------------------------------------ table
     def _panel(self, j: int) -> np.ndarray:
         coef = self.panels.get(j)
         if coef is None:
             s = j + 0.5 * (_CHEB + 1.0)
-            y = np.log(self.apparent_shear_rate(self.yield_stress + np.exp(s)))
+            y = np.log(self.apparent_shear_rate(np.exp(s)))
             coef = np.polynomial.chebyshev.chebfit(_CHEB, y, _DEGREE)
             self.panels[j] = coef
+            self._slopes[j] = np.append(2.0 * np.polynomial.chebyshev.chebder(coef), 0.0)  # d/ds
         return coef
 
     def _ensure(self, j_lo: int, j_hi: int):
@@ -76,23 +104,26 @@ class FlowTable:
         s = np.asarray(s, dtype=float)
         j = np.floor(s).astype(int)
         self._ensure(int(j.min()), int(j.max()))
-        y = np.empty_like(s)
-        dy = np.empty_like(s)
-        for jj in np.unique(j):
-            m = j == jj
-            x = 2.0 * (s[m] - jj) - 1.0
-            c = self.panels[int(jj)]
-            y[m] = np.polynomial.chebyshev.chebval(x, c)
-            dy[m] = 2.0 * np.polynomial.chebyshev.chebval(x, np.polynomial.chebyshev.chebder(c))
-        return y, dy
+        panels, where = np.unique(j.ravel(), return_inverse=True)
+        coef = np.stack([self.panels[int(jj)] for jj in panels])[where]      # one row per point
+        slope = np.stack([self._slopes[int(jj)] for jj in panels])[where]
+        x = 2.0 * (s.ravel() - j.ravel()) - 1.0
+        return _clenshaw(x, coef).reshape(s.shape), _clenshaw(x, slope).reshape(s.shape)
 
     def wall_stress(self, apparent_rate):
-        r""":math:`\tau_w` with :math:`\Gamma(\tau_w) =` ``apparent_rate`` (> 0), by Newton on the table."""
-        target = np.log(np.asarray(apparent_rate, dtype=float))
+        r""":math:`\tau_w` with :math:`\Gamma(\tau_w) =` ``apparent_rate``, by Newton on the table;
+        the yield stress (0 for most fluids) where ``apparent_rate`` is 0."""
+        rate = np.asarray(apparent_rate, dtype=float)
+        if np.any(rate <= 0):
+            out = np.full(rate.shape, self.yield_stress)
+            if np.any(rate > 0):
+                out[rate > 0] = self.wall_stress(rate[rate > 0])
+            return out
+        target = np.log(rate)
         # start from a coarse lookup on the panel ends, widening the table as needed
         lo, hi = self._bracket(float(target.min()), float(target.max()))
         grid = np.arange(lo, hi + 1, dtype=float)
-        ends = np.array([self.log_rate(np.array([g]))[0][0] for g in grid])
+        ends = self.log_rate(np.minimum(grid, hi + 1 - 1e-12))[0]
         s = np.interp(target, ends, grid)
         for _ in range(60):
             y, dy = self.log_rate(s)
@@ -115,6 +146,15 @@ class FlowTable:
             if hi > 690:
                 raise ArithmeticError("the flow function does not reach so large a shear rate")
         return lo, hi
+
+
+def _clenshaw(x, coef):
+    """Chebyshev series with one row of coefficients per point, vectorized over the points."""
+    b1 = np.zeros_like(x)
+    b2 = np.zeros_like(x)
+    for k in range(coef.shape[1] - 1, 0, -1):
+        b1, b2 = 2.0 * x * b1 - b2 + coef[:, k], b1
+    return x * b1 - b2 + coef[:, 0]
 
 
 _TABLES: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()

@@ -16,6 +16,13 @@ A *separable* rheology (Newtonian, power law) has
 :math:`G(q, R) = \phi(q)\,\psi(R)`; it sets ``separable = True`` and implements
 ``_flow_factor`` (:math:`\phi`), ``_flow_factor_inverse`` and ``_radius_factor``
 (:math:`\psi`). Couplers then reuse one integral for a whole flow curve.
+
+A *yield-stress* fluid (Bingham, Herschel–Bulkley, Casson, ...) has a field
+``yield_stress`` :math:`\tau_y > 0`: ``_shear_rate`` is 0 for :math:`\tau \le \tau_y`
+and ``_stress(shear_rate)`` tends to :math:`\tau_y` as the shear rate tends to 0. The
+generic paths integrate only over the yielded region: no flow while the wall stress
+:math:`GR/2 \le \tau_y`, a plug :math:`r < 2\tau_y/G` in the velocity profile, and
+:math:`G(q, R) \to 2\tau_y/R` (the yield gradient) as :math:`q \to 0^+`.
 """
 
 from __future__ import annotations
@@ -36,6 +43,11 @@ _TOL = dict(xrtol=4 * np.finfo(float).eps, xatol=1e-300)
 
 def _overrides(obj, name) -> bool:
     return getattr(type(obj), name) is not getattr(Rheology, name)
+
+
+def yield_stress_of(rheology) -> float:
+    """The yield stress of ``rheology`` (Pa): its ``yield_stress`` field, else 0."""
+    return float(getattr(rheology, "yield_stress", 0.0))
 
 
 class Rheology(abc.ABC):
@@ -113,12 +125,15 @@ class Rheology(abc.ABC):
         if not _overrides(self, "_stress"):
             raise TypeError(f"{type(self).__name__} must implement _stress or _shear_rate")
         t = np.asarray(stress, dtype=float)
+        tau_y = yield_stress_of(self)
+        flowing = t > tau_y
+        tt = np.where(flowing, t, tau_y + 1.0)
 
         def f(g, t):
             return self._stress(g) - t
 
-        b = elementwise.bracket_root(f, np.full_like(t, 1e-300), np.maximum(t, 1.0), xmin=0.0, args=(t,))
-        return elementwise.find_root(f, b.bracket, args=(t,), tolerances=_TOL).x
+        b = elementwise.bracket_root(f, np.full_like(tt, 1e-300), np.maximum(tt, 1.0), xmin=0.0, args=(tt,))
+        return np.where(flowing, elementwise.find_root(f, b.bracket, args=(tt,), tolerances=_TOL).x, 0.0)
 
     def _flow_rate(self, radius, pressure_gradient):
         if self.separable:
@@ -129,24 +144,40 @@ class Rheology(abc.ABC):
         """The generic flow function (quadrature), whatever the subclass overrides."""
         return 0.25 * math.pi * radius**3 * Rheology._apparent_shear_rate(self, 0.5 * pressure_gradient * radius)
 
-    def _apparent_shear_rate(self, wall_stress):
+    def _apparent_shear_rate(self, wall_stress, excess=None):
         r"""Apparent wall shear rate :math:`\Gamma = 4q/(\pi R^3)` at wall stress :math:`\tau_w`.
 
-        :math:`\Gamma = 4\int_0^1 t^2\dot\gamma(\tau_w t)\,dt` (fixed tanh-sinh rule) when the
-        shear rate is natural; else, integrating by parts in the shear rate,
+        ``excess``, if given, is :math:`\tau_w - \tau_y` computed by the caller without
+        cancellation (the flow table passes it): near the yield point the flow depends on it,
+        not on :math:`\tau_w`. Overrides must accept it.
+
+        :math:`\Gamma = 4\int_0^1 t^2\dot\gamma(\tau_w t)\,dt` (a fixed rule graded toward t = 0,
+        ``_flow_table.graded_rule``) when the shear rate is natural; else, integrating by parts
+        in the shear rate,
         :math:`\Gamma = \tfrac43\dot\gamma_w\left[1 - \int_0^1 (\tau(\dot\gamma_w t)/\tau_w)^3 dt\right]`.
-        Yield-stress fluids override it with their closed form.
+        With a yield stress the first rule runs over the yielded part
+        :math:`\tau_y/\tau_w < t < 1` only (0 when :math:`\tau_w \le \tau_y`). Closed forms
+        (Buckingham–Reiner for Bingham, ...) may override it.
         """
         from ._flow_table import _T, _W
 
         tau_w = np.asarray(wall_stress, dtype=float)
+        tau_y = yield_stress_of(self)
         if _overrides(self, "_shear_rate"):
-            return 4.0 * (self._shear_rate(tau_w[..., None] * _T) * _T * _T) @ _W
+            if tau_y == 0.0:
+                return 4.0 * (self._shear_rate(tau_w[..., None] * _T) * _T * _T) @ _W
+            excess = np.maximum(tau_w - tau_y, 0.0) if excess is None else np.asarray(excess, dtype=float)
+            tau = tau_y + excess[..., None] * _T           # the yielded stresses, tau_y .. tau_w
+            safe_w = np.where(excess > 0, tau_w, 1.0)
+            mean = (self._shear_rate(np.where(excess[..., None] > 0, tau, 2.0 * tau_y + 1.0)) * tau * tau) @ _W
+            return np.where(excess > 0, 4.0 * excess * mean / safe_w**3, 0.0)
         rate_w = self._shear_rate(tau_w)
         ratio = self._stress(rate_w[..., None] * _T) / tau_w[..., None]
         return (4.0 / 3.0) * rate_w * (1.0 - (ratio**3) @ _W)
 
     def _pressure_gradient(self, flow_rate, radius):
+        r""":math:`G(q, R)`; at ``q = 0`` the limit :math:`q \to 0^+`: 0, or the yield gradient
+        :math:`2\tau_y/R` of a yield-stress fluid (non-separable rheologies)."""
         if self.separable:
             return self._flow_factor(flow_rate) * self._radius_factor(radius)
         from ._flow_table import flow_table
@@ -157,12 +188,15 @@ class Rheology(abc.ABC):
         return self._velocity_generic(r, radius, pressure_gradient)
 
     def _velocity_generic(self, r, radius, pressure_gradient):
-        r""":math:`v(r) = \int_r^R \dot\gamma(G\rho/2)\,d\rho` by the fixed tanh-sinh rule; for a
+        r""":math:`v(r) = \int_r^R \dot\gamma(G\rho/2)\,d\rho` by the same graded rule; for a
         stress-natural law, by parts: :math:`\frac{2}{G}\big([\tau\dot\gamma] - \int \tau\,d\dot\gamma\big)`."""
         from ._flow_table import _T, _W
 
         r, radius, g = (np.asarray(x, dtype=float) for x in (r, radius, pressure_gradient))
         if _overrides(self, "_shear_rate"):
+            tau_y = yield_stress_of(self)
+            if tau_y > 0.0:  # integrate over the yielded annulus only: the plug moves rigidly
+                r = np.maximum(r, np.minimum(radius, 2.0 * tau_y / g))
             rho = r[..., None] + (radius - r)[..., None] * _T
             return (radius - r) * (self._shear_rate(0.5 * g[..., None] * rho) @ _W)
         tau_r, tau_w = 0.5 * g * r, 0.5 * g * radius

@@ -26,6 +26,10 @@ A new material is a dozen lines::
             i1 = (stretch - 1 / stretch) ** 2     # I1 - 3 in plane strain
             return self.shear_modulus * (stretch - stretch**-3) / (1 - i1 / self.locking_parameter)
 
+        def _locking_stretch(self):               # I1 - 3 = J_m: the tube's maximum stretch
+            jm = self.locking_parameter
+            return 0.5 * (jm**0.5 + (jm + 4) ** 0.5)
+
     @attrs.frozen(kw_only=True)
     class ThinGent(ThinWall, Gent): ...           # the wall theories, by composition
 
@@ -36,12 +40,13 @@ A new material is a dozen lines::
 from __future__ import annotations
 
 import abc
+import math
 
 import attrs
 import numpy as np
 from scipy import differentiate
 
-from .._numerics import gauss_legendre
+from .._numerics import gauss_legendre, integrate_graded, integrate_panels
 from .._validation import choice
 from .base import WallModel
 
@@ -75,9 +80,22 @@ class HyperelasticWall(WallModel):
         raise NotImplementedError
 
     def _d2W(self, stretch):
-        r""":math:`\hat W''(\lambda)`, numerically unless overridden."""
-        return differentiate.derivative(self._dW, stretch, initial_step=0.1 * stretch,
-                                        tolerances=_DIFF_TOL).df
+        r""":math:`\hat W''(\lambda)`, numerically unless overridden (steps clear of a locking stretch)."""
+        stretch = np.asarray(stretch, dtype=float)
+        room = self._locking_stretch() - stretch
+        step = 0.1 * np.minimum(stretch, np.where(np.isfinite(room), 0.2 * room, np.inf))
+        return differentiate.derivative(self._dW, stretch, initial_step=step, tolerances=_DIFF_TOL).df
+
+    def _locking_stretch(self) -> float:
+        r"""The stretch at which the material locks (:math:`\hat W' \to \infty`, e.g. Gent); ``inf``.
+
+        It is every tube's maximum stretch (the inner surface is the most stretched); the
+        thick-wall integral grades its nodes toward it.
+        """
+        return math.inf
+
+    def _max_stretch(self, tb):
+        return self._locking_stretch()
 
     def _thick_integrand(self, s):
         r""":math:`\hat W'(s)/(s^2-1)`; override with a form free of the removable singularity."""
@@ -133,7 +151,42 @@ class ThickWall(HyperelasticWall):
         width = 0.5 * np.log1p(x * (b - 1.0) / (b + x))   # ln(lam / lam_o), no cancellation
         nodes, weights = gauss_legendre(self._ORDER)
         s = lam_o[..., None] * np.exp(width[..., None] * nodes)
-        return width * np.sum(weights * s * self._thick_integrand(s), axis=-1)
+        values = s * self._thick_integrand(s)
+        p = width * np.sum(weights * values, axis=-1)
+        # a fast-growing integrand (strain stiffening, e.g. Fung) gets panels with kappa h <= ORDER,
+        # kappa = |d ln(integrand)/du| estimated from the nodes just used
+        with np.errstate(all="ignore"):
+            kappa = np.max(np.abs(np.diff(np.log(values), axis=-1)) / np.diff(nodes), axis=-1) / width
+        fast = np.flatnonzero(np.isfinite(kappa) & (kappa * width > self._ORDER))
+        if fast.size:
+            p = np.array(p, dtype=float).ravel()
+            lo, w = lam_o.ravel()[fast], width.ravel()[fast]
+            panels = kappa.ravel()[fast] * w / self._ORDER
+            h = w / panels
+
+            def g(x, idx):
+                s = lo[idx, None] * np.exp(x * h[idx, None])
+                return s * self._thick_integrand(s) * h[idx, None]
+
+            p[fast] = integrate_panels(g, panels, order=self._ORDER, panel_width=1.0)
+            p = p.reshape(width.shape)
+        lam_max = self._locking_stretch()
+        if math.isfinite(lam_max):
+            # toward a locking stretch the integrand may blow up: grade the panels there
+            gap = -np.log1p((e - (lam_max - 1.0)) / lam_max)        # ln(lam_max / lam), no cancellation
+            near = np.flatnonzero(gap < width)
+            if near.size:
+                p, lo = np.array(p, dtype=float).ravel(), lam_o.ravel()[near]
+
+                def f(u, idx):
+                    s = lo[idx, None] * np.exp(u)
+                    return s * self._thick_integrand(s)
+
+                w = width.ravel()[near]
+                p[near] = integrate_graded(f, w, w + gap.ravel()[near], gap=gap.ravel()[near], reach=np.inf,
+                                           order=self._ORDER)
+                p = p.reshape(width.shape)
+        return p
 
     def _stiffness(self, stretch, tb):
         lam = np.asarray(stretch, dtype=float)

@@ -1,0 +1,65 @@
+r"""Tube laws that may stop increasing: the first pressure peak (a limit point).
+
+A plane-strain tube of a material that softens in the hoop direction (an Ogden material with
+small exponents, a Yeoh material with :math:`c_2 < 0`, ...) can have a tube law
+:math:`P(\lambda)` that rises to a maximum and falls, as a balloon does. Uniform inflation
+is stable only up to that first peak: there the tube bulges. tubefsi then treats the peak
+stretch as the wall's maximum stretch and the peak pressure as its limit pressure, so
+``stretch(p)`` raises ``NoSteadyStateError`` above it and a shear-thinning flow has a
+maximum flow rate. Laws that keep increasing get the limit pressure of their asymptote.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+from scipy import optimize
+
+__all__ = ["LimitPoint"]
+
+#: hoop strains scanned for the first peak (the stiffness is evaluated in closed form)
+_SCAN = np.geomspace(1e-4, 1e4, 1601)
+
+
+@functools.lru_cache(maxsize=1024)
+def first_peak(wall, tb: float) -> tuple[float, float]:
+    """``(stretch, pressure)`` at the first zero of ``dP/dlam``, or ``(inf, nan)`` if there is none."""
+    lam = 1.0 + _SCAN
+    with np.errstate(over="ignore", invalid="ignore"):
+        slope = wall._stiffness(lam, tb)
+    bad = np.flatnonzero(~(slope > 0))
+    if bad.size == 0:
+        return math.inf, math.nan
+    i = bad[0]
+    lo = 1.0 if i == 0 else lam[i - 1]
+    peak = optimize.brentq(lambda s: float(wall._stiffness(np.asarray(s), tb)), lo, lam[i],
+                           xtol=1e-15, rtol=4 * np.finfo(float).eps)
+    # a hair above the computed peak pressure, so that no rounded P(lam) reaches it
+    return peak, float(wall._pressure_at_strain(np.asarray(peak - 1.0), tb)) * (1.0 + 1e-14)
+
+
+class LimitPoint:
+    """Mixin for a material class: maximum stretch and limit pressure from the first peak.
+
+    The material gives ``_asymptote(tb, theory)`` (the pressure as the stretch tends to
+    infinity: ``inf`` for a law that grows without bound) and ``_asymptotic_decay(tb, theory)``
+    (``kappa`` with :math:`P' \\sim \\lambda^{-\\kappa}`, where the asymptote is finite).
+    ``theory`` is ``"reference"``, ``"current"`` (thin walls) or ``"thick"``.
+    """
+
+    __slots__ = ()
+
+    def _theory(self) -> str:
+        return getattr(self, "thickness_convention", "thick")
+
+    def _max_stretch(self, tb):
+        return first_peak(self, float(tb))[0]
+
+    def _limit_pressure(self, tb):
+        peak, pressure = first_peak(self, float(tb))
+        return pressure if math.isfinite(peak) else self._asymptote(tb, self._theory())
+
+    def _stiffness_decay_exponent(self, tb):
+        return self._asymptotic_decay(tb, self._theory())

@@ -1,0 +1,122 @@
+r"""Ogden walls, with any number of terms.
+
+:math:`W = \sum_p \frac{2\mu_p}{\alpha_p^2}\left(\lambda_1^{\alpha_p} + \lambda_2^{\alpha_p}
++ \lambda_3^{\alpha_p} - 3\right)`, small-strain shear modulus :math:`\mu = \sum_p \mu_p`
+(neo-Hookean: one term, :math:`\alpha = 2`). In plane strain
+:math:`\hat W'(\lambda) = \sum_p \frac{2\mu_p}{\alpha_p}(\lambda^{\alpha_p - 1} - \lambda^{-\alpha_p - 1})`,
+which depends on :math:`|\alpha_p|` only.
+
+With :math:`A = \max|\alpha_p|`, the tube law grows without bound if :math:`A > 1` (thin,
+reference thickness) or :math:`A > 2` (thin current thickness, thick); at equality it
+saturates, and below it rises to a peak and falls. Terms of different signs can also make
+it non-monotone at moderate stretch (Treloar-type fits do, for thin current-thickness and
+thick tubes): the first peak is then the wall's maximum stretch and limit pressure
+(see :mod:`tubefsi_hyperelastic._limit_point`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import attrs
+import numpy as np
+from tubefsi import InvalidParameterError
+from tubefsi.walls import HyperelasticWall, ThickWall, ThinWall
+
+from ._limit_point import LimitPoint
+
+__all__ = ["Ogden", "ThinOgden", "ThickOgden"]
+
+
+def _floats(values):
+    try:
+        out = tuple(float(v) for v in np.atleast_1d(np.asarray(values, dtype=float)))
+    except (TypeError, ValueError):
+        raise InvalidParameterError("moduli / exponents", "sequences of real numbers", values) from None
+    return out
+
+
+def _check_terms(instance, attribute, value):
+    if not value or not all(math.isfinite(v) for v in value):
+        raise InvalidParameterError(attribute.name, "a non-empty sequence of finite numbers", value)
+    if attribute.name == "exponents" and any(v == 0 for v in value):
+        raise InvalidParameterError("exponents", "nonzero numbers", value)
+
+
+@attrs.frozen(kw_only=True)
+class Ogden(LimitPoint, HyperelasticWall):
+    """Ogden material (abstract: pick a theory, :class:`ThinOgden` or :class:`ThickOgden`)."""
+
+    moduli: tuple = attrs.field(converter=_floats, validator=_check_terms,
+                                metadata={"unit": "Pa", "doc": "moduli mu_p (sum = shear modulus)"})
+    exponents: tuple = attrs.field(converter=_floats, validator=_check_terms,
+                                   metadata={"unit": "", "doc": "exponents alpha_p (nonzero)"})
+
+    def __attrs_post_init__(self):
+        if len(self.moduli) != len(self.exponents):
+            raise InvalidParameterError("exponents", f"{len(self.moduli)} values, one per modulus",
+                                        self.exponents)
+        if not sum(self.moduli) > 0:
+            raise InvalidParameterError("moduli", "sum(moduli) > 0", self.moduli,
+                                        "the small-strain shear modulus must be positive")
+
+    def _terms(self):
+        return zip((2.0 * m / a for m, a in zip(self.moduli, self.exponents)), self.exponents)
+
+    def _dW(self, s):
+        # s^(a-1) - s^(-a-1) = s^(-a-1) expm1(2 a ln s): no cancellation near s = 1
+        u = np.log(s)
+        return sum(c * s ** (-a - 1.0) * np.expm1(2.0 * a * u) for c, a in self._terms())
+
+    def _d2W(self, s):
+        return sum(c * ((a - 1.0) * s ** (a - 2.0) + (a + 1.0) * s ** (-a - 2.0)) for c, a in self._terms())
+
+    def _thick_integrand(self, s):
+        u = np.log(s)
+        # (s^(a-1) - s^(-a-1)) / (s^2 - 1) = s^(-a-1) expm1(2 a u) / expm1(2 u)  ->  a at s = 1
+        with np.errstate(invalid="ignore", divide="ignore"):
+            ratios = [np.where(u == 0, a, np.expm1(2.0 * a * u) / np.expm1(2.0 * u)) for _, a in self._terms()]
+        return sum(c * s ** (-a - 1.0) * r for (c, a), r in zip(self._terms(), ratios))
+
+    # -- asymptotics (for the limit pressure when the law has no peak)
+    def _critical(self, theory):
+        return 1.0 if theory == "reference" else 2.0
+
+    def _asymptote(self, tb, theory):
+        crit, top = self._critical(theory), max(abs(a) for a in self.exponents)
+        if top > crit:
+            return math.inf
+        lead = sum(m for m, a in zip(self.moduli, self.exponents) if abs(a) == crit) * 2.0 / crit
+        if top < crit or not lead > 0:
+            return 0.0  # the law falls back to zero: its peak is the limit (found by the scan)
+        return tb * lead if theory != "thick" else math.log1p(tb) * lead
+
+    def _asymptotic_decay(self, tb, theory):
+        crit = self._critical(theory)
+        below = [abs(a) for a in self.exponents if abs(a) < crit]
+        return crit + 1.0 - max(below) if below else 2.0 * crit + 1.0
+
+
+@attrs.frozen(kw_only=True)
+class ThinOgden(ThinWall, Ogden):
+    r"""Thin-walled Ogden tube: :math:`P = \bar t\,\hat W'(\lambda)` (reference) or :math:`/\lambda` (current)."""
+
+    _examples = ({"moduli": (2e3,), "exponents": (3.0,)},
+                 {"moduli": (2008.5, 14.75, 49.05), "exponents": (1.3, 5.0, -2.0)},
+                 {"moduli": (2008.5, 14.75, 49.05), "exponents": (1.3, 5.0, -2.0), "thickness_convention": "current"})
+
+    def _stiffness(self, stretch, tb):
+        if self.thickness_convention == "reference":
+            return tb * self._d2W(stretch)
+        # d/dlam (dW/lam) = sum c [(a-2) s^(a-3) + (a+2) s^(-a-3)]: no cancellation at large stretch
+        s = stretch
+        return tb * sum(c * ((a - 2.0) * s ** (a - 3.0) + (a + 2.0) * s ** (-a - 3.0)) for c, a in self._terms())
+
+
+@attrs.frozen(kw_only=True)
+class ThickOgden(ThickWall, Ogden):
+    """Thick-walled Ogden tube (exact plane-strain Lamé solution)."""
+
+    _examples = ({"moduli": (2e3,), "exponents": (3.0,)},
+                 {"moduli": (2008.5, 14.75, 49.05), "exponents": (1.3, 5.0, -2.0)},
+                 {"moduli": (1e3, 1e3), "exponents": (2.0, -1.0)})

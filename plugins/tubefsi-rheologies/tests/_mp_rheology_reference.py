@@ -1,0 +1,256 @@
+r"""An independent ``mpmath`` reference for generalized Newtonian flow in a thick neo-Hookean tube.
+
+Nothing here calls tubefsi. Everything is written from the physics (``DESIGN.md`` §2) at the
+caller's ``mp.dps``, with fixed Gauss–Legendre rules (24 nodes) on geometrically graded
+sub-intervals, so that a whole solve costs well under a second.
+
+Fluid (Carreau–Yasuda): :math:`\tau(x) = x[\eta_\infty + (\eta_0-\eta_\infty)(1 + (\lambda x)^a)^{(n-1)/a}]`,
+:math:`\tau'(x) = \eta_\infty + (\eta_0-\eta_\infty)(1+(\lambda x)^a)^{(n-1)/a - 1}(1 + n(\lambda x)^a)`.
+
+The tube flow is parametrized by the wall *shear rate* :math:`g`, which avoids inverting the
+constitutive law: with :math:`\tau = \tau(x)` substituted in the Rabinowitsch–Mooney integral,
+
+.. math::
+
+    \Gamma(g) = \frac{4q}{\pi R^3} = \frac{4}{\tau(g)^3}\int_0^g \tau(x)^2\tau'(x)\,x\,dx,
+    \qquad \frac{d\Gamma}{dg} = \frac{\tau'(g)}{\tau(g)}(4g - 3\Gamma),
+
+and at fixed flow rate :math:`q` a section of wall shear rate :math:`g` has radius
+:math:`R = (4q/\pi\Gamma)^{1/3}` and pressure gradient :math:`G = 2\tau(g)/R`. Separating
+:math:`dp/dz = -G`, :math:`p = P(\lambda)` (outlet at zero pressure, :math:`\lambda = 1`):
+
+.. math::
+
+    L = \int_1^{\lambda_{in}} \frac{P'(\lambda)}{G}\,d\lambda
+      = \int_{g_{in}}^{g_{out}} \frac{P'(\lambda(g))\,\lambda(g)}{3\,G(g)}\frac{\Gamma'(g)}{\Gamma(g)}\,dg .
+
+:math:`g_{in}` is found by Newton's method on this identity (its derivative is minus the
+integrand at :math:`g_{in}`), the cumulative integral :math:`\int_0^g` along the sorted
+outer nodes, and :math:`\Delta p = P(\lambda_{in})`.
+
+Thick neo-Hookean tube law (Lamé, plane strain, §2.3), :math:`b = (1+\bar t)^2`,
+:math:`\lambda_o^2 = 1 + (\lambda^2-1)/b`: :math:`P(\lambda) = \int_{\lambda_o}^{\lambda}
+\frac{\hat W'(s)}{s^2-1}ds` with :math:`\hat W'(s) = \mu(s - s^{-3})`, i.e. the integrand
+:math:`\mu(s^2+1)/s^3`; by Leibniz, :math:`P'(\lambda) = h(\lambda) - h(\lambda_o)\lambda/(b\lambda_o)`.
+"""
+
+from __future__ import annotations
+
+import functools
+
+from mpmath import mp, mpf
+
+__all__ = ["CarreauYasudaRef", "RateLawRef", "ThickNeoHookeanRef", "solve_flow_controlled", "gauss_legendre",
+           "yield_pressure_drop", "velocity"]
+
+
+@functools.lru_cache(maxsize=None)
+def _gl(m: int, dps: int):
+    with mp.workdps(dps + 10):
+        nodes, weights = [], []
+        for k in range(1, m + 1):
+            x = mp.cos(mp.pi * (k - mpf(1) / 4) / (m + mpf(1) / 2))
+            for _ in range(100):                     # Newton on P_m
+                p0, p1 = mpf(1), x
+                for j in range(2, m + 1):
+                    p0, p1 = p1, ((2 * j - 1) * x * p1 - (j - 1) * p0) / j
+                dp = m * (x * p1 - p0) / (x * x - 1)
+                dx = p1 / dp
+                x -= dx
+                if abs(dx) < mpf(10) ** (-(dps + 8)):
+                    break
+            nodes.append(x)
+            weights.append(2 / ((1 - x * x) * dp * dp))
+    return tuple(nodes), tuple(weights)
+
+
+def gauss_legendre(f, a, b, m=24):
+    """``∫_a^b f`` by the ``m``-point Gauss–Legendre rule (nodes at the current precision)."""
+    nodes, weights = _gl(m, mp.dps)
+    c, h = (a + b) / 2, (b - a) / 2
+    return h * mp.fsum(w * f(c + h * x) for x, w in zip(nodes, weights))
+
+
+def geometric_breaks(lo, hi, ratio=2):
+    """lo = x_0 < x_1 < ... = hi with x_{k+1} <= ratio * x_k (lo > 0)."""
+    pts = [lo]
+    while pts[-1] * ratio < hi:
+        pts.append(pts[-1] * ratio)
+    pts.append(hi)
+    return pts
+
+
+class CarreauYasudaRef:
+    """Parametrized by the wall shear rate ``x``: wall stress ``tau(x)``, I = int_0^x tau^2 tau' x."""
+
+    lower = mpf(0)
+
+    def __init__(self, eta0, eta_inf, relaxation_time, index, transition, m=24):
+        self.e0, self.einf = mpf(eta0), mpf(eta_inf)
+        self.lam, self.n, self.a = mpf(relaxation_time), mpf(index), mpf(transition)
+        self.m = m
+
+    def tau(self, x):
+        y = (self.lam * x) ** self.a
+        return x * (self.einf + (self.e0 - self.einf) * (1 + y) ** ((self.n - 1) / self.a))
+
+    def dtau(self, x):
+        y = (self.lam * x) ** self.a
+        return self.einf + (self.e0 - self.einf) * (1 + y) ** ((self.n - 1) / self.a - 1) * (1 + self.n * y)
+
+    def _w(self, x):
+        t = self.tau(x)
+        return t * t * self.dtau(x) * x
+
+    def stress(self, x):
+        return self.tau(x)
+
+    def dlog_apparent(self, x, gam):
+        """d ln(Gamma) / dx."""
+        return self.dtau(x) / self.tau(x) * (4 * x - 3 * gam) / gam
+
+    def integral(self, g):
+        r""":math:`I(g) = \int_{lower}^g w` on panels halving toward the lower end until negligible."""
+        total, hi = mpf(0), g
+        eps = mpf(10) ** (-mp.dps - 5)
+        while True:
+            lo = self.lower + (hi - self.lower) / 2
+            part = gauss_legendre(self._w, lo, hi, self.m)
+            total += part
+            hi = lo
+            if abs(part) < eps * abs(total):
+                return total
+
+    def cumulative(self, g0, I0, points):
+        """I at each of the increasing ``points`` (> g0), from I(g0) = I0, piece by piece."""
+        out, prev, acc = [], g0, I0
+        for g in points:
+            br = geometric_breaks(prev - self.lower, g - self.lower)
+            for lo, hi in zip(br[:-1], br[1:]):
+                acc += gauss_legendre(self._w, self.lower + lo, self.lower + hi, self.m)
+            out.append(acc)
+            prev = g
+        return out
+
+    def apparent_rate(self, g, I=None):
+        I = self.integral(g) if I is None else I
+        return 4 * I / self.stress(g) ** 3
+
+    def at_apparent(self, target, guess):
+        """The parameter x with Gamma(x) = target (Newton on ln Gamma, exact derivative)."""
+        g = mpf(guess)
+        for _ in range(200):
+            gam = self.apparent_rate(g)
+            step = mp.log(gam / target) / self.dlog_apparent(g, gam)
+            g_new = g - step
+            if g_new <= self.lower:        # stay in the yielded range
+                g_new = self.lower + (g - self.lower) / 4
+            if abs(g_new - g) < abs(g) * mpf(10) ** (-mp.dps + 3):
+                return g_new
+            g = g_new
+        raise ArithmeticError("no convergence")
+
+    rate_at_apparent = at_apparent
+
+
+class RateLawRef(CarreauYasudaRef):
+    r"""A law given by its shear rate :math:`\dot\gamma(\tau)` (zero below ``yield_stress``),
+    parametrized by the wall stress ``x``: :math:`I(x) = \int_{\tau_y}^x \tau^2\dot\gamma\,d\tau`,
+    :math:`d\ln\Gamma/dx = (4\dot\gamma(x) - 3\Gamma)/(x\Gamma)`."""
+
+    def __init__(self, shear_rate, yield_stress=0, m=24):
+        self.rate, self.lower, self.m = shear_rate, mpf(yield_stress), m
+
+    def _w(self, t):
+        return t * t * self.rate(t)
+
+    def stress(self, x):
+        return x
+
+    def dlog_apparent(self, x, gam):
+        return (4 * self.rate(x) - 3 * gam) / (x * gam)
+
+
+class ThickNeoHookeanRef:
+    def __init__(self, shear_modulus, tb):
+        self.mu, self.tb = mpf(shear_modulus), mpf(tb)
+        self.b = (1 + self.tb) ** 2
+
+    def h(self, s):                     # dW(s) / (s^2 - 1), dW = mu (s - s^-3)
+        return self.mu * (s * s + 1) / s**3
+
+    def outer(self, lam):
+        return mp.sqrt(1 + (lam * lam - 1) / self.b)
+
+    def pressure(self, lam):
+        return mp.quad(self.h, [self.outer(lam), lam])
+
+    def slope(self, lam):
+        lo = self.outer(lam)
+        return self.h(lam) - self.h(lo) * lam / (self.b * lo)
+
+
+def solve_flow_controlled(fluid, wall, radius, length, q, stretch_guess, m=24, newton=8):
+    r"""(pressure drop, inlet stretch) of the flow-controlled problem, outlet pressure 0.
+
+    ``fluid`` is a :class:`CarreauYasudaRef` (parameter: wall shear rate) or a :class:`RateLawRef`
+    (parameter: wall stress); the separated identity is integrated over that parameter ``x``:
+    :math:`L = \int_{x_{in}}^{x_{out}} P'(\lambda)\,\lambda\,(d\ln\Gamma/dx)/(3G)\,dx`.
+    """
+    a, L, q = mpf(radius), mpf(length), mpf(q)
+    gam_out = 4 * q / (mp.pi * a**3)
+    x_out = fluid.at_apparent(gam_out, _guess(fluid, gam_out))
+
+    def state(x, I):
+        gam = 4 * I / fluid.stress(x) ** 3
+        R = (4 * q / (mp.pi * gam)) ** (mpf(1) / 3)
+        lam = R / a
+        G = 2 * fluid.stress(x) / R
+        return lam, wall.slope(lam) * lam / 3 * fluid.dlog_apparent(x, gam) / G
+
+    lam0 = mpf(stretch_guess)
+    x_in = fluid.at_apparent(gam_out / lam0**3, _guess(fluid, gam_out / lam0**3))
+    nodes, weights = _gl(m, mp.dps)
+    for _ in range(newton):
+        I_in = fluid.integral(x_in)
+        pieces = [fluid.lower + d for d in geometric_breaks(x_in - fluid.lower, x_out - fluid.lower)]
+        H = mpf(0)
+        for lo, hi in zip(pieces[:-1], pieces[1:]):
+            c, w = (lo + hi) / 2, (hi - lo) / 2
+            xs = [c + w * x for x in nodes]
+            order = sorted(range(m), key=lambda i: xs[i])
+            Is = fluid.cumulative(x_in, I_in, [xs[i] for i in order])
+            vals = {i: state(xs[i], I)[1] for i, I in zip(order, Is)}
+            H += w * mp.fsum(weights[i] * vals[i] for i in range(m))
+        lam_in, phi_in = state(x_in, I_in)
+        x_in += (H - L) / phi_in
+        if abs(H / L - 1) < mpf(10) ** (-mp.dps + 5):
+            break
+    lam_in, _ = state(x_in, fluid.integral(x_in))
+    return wall.pressure(lam_in), lam_in
+
+
+def _guess(fluid, gam):
+    """A starting value for ``at_apparent``: Newtonian-like with the zero-rate viscosity, or above yield."""
+    if isinstance(fluid, RateLawRef):
+        x = fluid.lower * 2 + 1
+        return x
+    return gam
+
+
+def yield_pressure_drop(yield_stress, wall, radius, length):
+    r"""The pressure drop as :math:`q \to 0^+`: :math:`G = 2\tau_y/R`, so
+    :math:`L = \int_1^{\lambda_{in}} P'(\lambda)\,a\lambda/(2\tau_y)\,d\lambda`; returns :math:`P(\lambda_{in})`."""
+    a, L, ty = mpf(radius), mpf(length), mpf(yield_stress)
+    H = lambda lam: mp.quad(lambda s: wall.slope(s) * a * s / (2 * ty), [1, lam])
+    lam = mp.findroot(lambda lam: H(lam) - L, mpf(1) + mpf("1e-3"))
+    return wall.pressure(lam)
+
+
+def velocity(rate, radius, gradient, r, yield_stress=0):
+    r""":math:`v(r) = \int_{\max(r, r_p)}^R \dot\gamma(G\rho/2)\,d\rho` (``mpmath.quad``)."""
+    R, G, r = mpf(radius), mpf(gradient), mpf(r)
+    start = max(r, min(R, 2 * mpf(yield_stress) / G))
+    if start >= R:
+        return mpf(0)
+    return mp.quad(lambda rho: rate(G * rho / 2), [start, R])
