@@ -23,9 +23,9 @@ import numpy as np
 from scipy import differentiate
 from scipy.optimize import elementwise
 
-from .._numerics import as_output
+from .._numerics import as_output, solve_increasing
 from .._validation import as_array
-from ..errors import InvalidParameterError, NoSteadyStateError
+from ..errors import ConvergenceError, InvalidParameterError, NoSteadyStateError
 
 #: scipy.differentiate tolerances: as tight as the error estimate allows
 _DIFF_TOL = dict(rtol=1e-12, atol=0.0)
@@ -171,10 +171,14 @@ class WallModel(abc.ABC):
 
     # ------------------------------------------------------------------ generic inverses
     def _invert_pressure(self, pressure, tb):
-        """Hoop strain at ``pressure`` by bracketed root finding on ``_pressure_at_strain``."""
+        """Hoop strain at ``pressure``: safeguarded Newton iteration with the stiffness (vectorized,
+        bracketed below a maximum stretch), else bracketed root finding on ``_pressure_at_strain``."""
         p = np.asarray(pressure, dtype=float)
         emax = self._max_stretch(tb) - 1.0
         scale = max(self._stiffness(np.asarray(1.0), tb), 1e-300)
+        fast = self._newton_strain(p, tb, emax, scale)
+        if fast is not None:
+            return fast
 
         def f(e, p):
             return self._pressure_at_strain(e, tb) - p
@@ -191,6 +195,22 @@ class WallModel(abc.ABC):
         res = elementwise.find_root(f, bracket.bracket, args=(p,),
                                     tolerances=dict(xrtol=2 * np.finfo(float).eps, xatol=1e-300))
         return np.where(p == 0, 0.0, res.x)
+
+    def _newton_strain(self, p, tb, emax, scale):
+        """The Newton path of :meth:`_invert_pressure`; None where it does not converge cleanly."""
+        if self._natural() != "pressure":
+            return None
+        upper = 0.999999 * emax if math.isfinite(emax) else None
+        guess = np.minimum(p / scale, 0.5 * emax) if math.isfinite(emax) else p / scale
+        try:
+            with np.errstate(all="ignore"):
+                e, ok = solve_increasing(lambda x, i: self._pressure_at_strain(x, tb),
+                                         lambda x, i: self._stiffness(1.0 + x, tb),
+                                         p, guess=guess, upper=upper, xmax=1e15, maxiter=100)
+                converged = ok & np.isfinite(e) & (np.abs(self._pressure_at_strain(e, tb) - p) <= 1e-12 * p)
+        except ConvergenceError:
+            return None
+        return e if np.all(converged) else None
 
     def _invert_strain(self, strain, tb):
         """Pressure at a strain when only the inverse law ``_strain`` is natural."""
