@@ -118,8 +118,9 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
     if flow_rate is not None:
         q = as_load("flow_rate", flow_rate)
         q_max = _finite_max_flow(chosen, scene, q)
-        if q_max is not None and np.any((q > 0) & (q >= q_max)):
-            raise NoSteadyStateError("flow_rate", q_max, q[q >= q_max].flat[0],
+        beyond = (q > 0) & (q >= q_max) if q_max is not None else None
+        if beyond is not None and np.any(beyond):
+            raise NoSteadyStateError("flow_rate", q_max, q[beyond].flat[0],
                                      "the tube inflates without bound")
         state = _chunked(chosen.flow_controlled, scene, q)
         scalar = np.ndim(flow_rate) == 0
