@@ -1,15 +1,28 @@
-# `make demo` and `make test` each set up .venv (tubefsi and its plugins, editable) first.
-PYTHON ?= python3
+# `make install` sets up .venv from the lock requirements/dev.txt (every dependency, test, docs
+# and build tool at an exact version), then tubefsi and its plugins editable without
+# dependencies; `make demo`, `make test` and `make docs` do that first whenever the lock or a
+# pyproject changed. `make test-latest` runs the tests in .venv-latest against the newest
+# releases instead, and `make lock` re-resolves the lock (README, "Development").
+PYTHON ?= python3.11
 VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
+LOCK   := requirements/dev.txt
 PLUGINS := $(wildcard plugins/*/pyproject.toml)
+EDITABLES := -e . $(foreach p,$(PLUGINS),-e $(dir $(p)))
+LATEST := .venv-latest
+# `make lock` refreshes every pin to the newest release; `make lock LOCK_FLAGS=` keeps the
+# current pins and resolves only what the inputs changed; `LOCK_FLAGS='-P numpy'` bumps one.
+UV_VERSION := 0.13.9
+LOCK_FLAGS ?= --upgrade
 
-.PHONY: demo test docs install clean
+.PHONY: demo test docs install test-latest lock clean
 
-$(STAMP): pyproject.toml $(PLUGINS)
-	$(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet -e '.[test,verify,docs]' $(foreach p,$(PLUGINS),-e $(dir $(p)))
+$(STAMP): $(LOCK) pyproject.toml $(PLUGINS)
+	test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet -r $(LOCK)
+	$(PY) -m pip install --quiet --no-deps --no-build-isolation $(EDITABLES)
+	$(PY) -m pip check
 	touch $(STAMP)
 
 install: $(STAMP)
@@ -26,5 +39,22 @@ docs: $(STAMP)
 	MPLBACKEND=Agg $(PY) examples/fit_synthetic.py docs/_generated/fit
 	$(PY) -m sphinx -W --keep-going -q -b html docs docs/_build/html
 
+# the same tests against the newest releases of everything (not the lock), in their own venv
+test-latest:
+	test -x $(LATEST)/bin/python || $(PYTHON) -m venv $(LATEST)
+	$(LATEST)/bin/python -m pip install --quiet --upgrade pip setuptools wheel
+	$(LATEST)/bin/python -m pip install --quiet --upgrade --upgrade-strategy eager \
+	  -e '.[test,verify,docs]' $(foreach p,$(PLUGINS),-e $(dir $(p)))
+	MPLBACKEND=Agg $(LATEST)/bin/python -m pytest -q -p no:cacheprovider
+
+# uv, at a fixed version in a throw-away venv, writes the lock from PyPI (not pip's indexes)
+lock:
+	tmp=$$(mktemp -d) && trap 'rm -rf "$$tmp"' EXIT && \
+	$(PYTHON) -m venv "$$tmp" && "$$tmp/bin/python" -m pip install --quiet uv==$(UV_VERSION) && \
+	"$$tmp/bin/uv" pip compile --quiet $(LOCK_FLAGS) --no-config --python-version 3.11 \
+	  --python-platform x86_64-unknown-linux-gnu --no-emit-package tubefsi \
+	  requirements/dev.in $(PLUGINS) -o $(LOCK) && \
+	sed -i '2a # with uv $(UV_VERSION), from the repository root; `make lock` runs it, adding --upgrade by default.' $(LOCK)
+
 clean:
-	rm -rf $(VENV) build src/*.egg-info docs/_build docs/_generated
+	rm -rf $(VENV) $(LATEST) build src/*.egg-info docs/_build docs/_generated
