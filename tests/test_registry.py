@@ -1,8 +1,12 @@
 """Entry-point registries: built-ins declared in pyproject, lazy, cached, warn on broken plugins."""
 
 import collections.abc
+import importlib
+import re
 import sys
 import textwrap
+import warnings
+from importlib import metadata
 
 import pytest
 
@@ -71,7 +75,135 @@ def test_broken_or_duplicate_plugin_is_a_warning_naming_it(fake_plugins):
     assert "'rigid'" in messages and "dup_plugin" in messages
     assert "broken-wall" not in names
     assert reg["thick-neo-hookean"] is registry.walls["thick-neo-hookean"]
-    assert reg["rigid"].__name__ in ("Rigid", "ThinLinear")  # first declaration wins, either way no crash
+    assert reg["rigid"].__name__ in ("Rigid", "ThinLinear")  # no crash (the built-in wins: see below)
+
+
+@pytest.fixture
+def install(tmp_path):
+    """Install throw-away distributions (dist-info + module) on sys.path for one test.
+
+    ``install(name, entry_points, modules, first=True)`` writes ``<name>-1.0.dist-info``
+    (escaped) and the modules into their own directory, puts it first (or last) on sys.path
+    and refreshes the registries. Afterwards sys.path, the modules and the registries are restored.
+    """
+    written = []
+    with pytest.MonkeyPatch.context() as mp:
+
+        def install(name, entry_points, modules=None, first=True):
+            root = tmp_path / name
+            # escaped as a wheel would (importlib reads the name up to the first '-' of the directory)
+            info = root / f"{re.sub(r'[-_.]+', '_', name)}-1.0.dist-info"
+            info.mkdir(parents=True)
+            (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {name}\nVersion: 1.0\n")
+            (info / "entry_points.txt").write_text(textwrap.dedent(entry_points))
+            for module, source in (modules or {}).items():
+                (root / f"{module}.py").write_text(textwrap.dedent(source))
+                written.append(module)
+            if first:
+                mp.syspath_prepend(str(root))
+            else:  # after site-packages (do not mix with first=True in one test)
+                mp.setattr(sys, "path", [*sys.path, str(root)])
+                importlib.invalidate_caches()
+            registry.refresh()
+
+        yield install
+    for module in written:
+        sys.modules.pop(module, None)
+    registry.refresh()
+
+
+def _providers(group, name):
+    """The distributions declaring ``name``, in discovery order."""
+    return [ep.dist.name for ep in metadata.entry_points(group=group) if ep.name == name]
+
+
+def _messages(record):
+    return [str(w.message) for w in record if issubclass(w.category, PluginWarning)]
+
+
+@pytest.mark.parametrize("first", [True, False], ids=["plugin-first", "plugin-last"])
+def test_builtin_name_cannot_be_taken_over(install, first):
+    from tubefsi.walls.neo_hookean import ThickNeoHookean
+
+    install("tubefsi-bad", """
+        [tubefsi.walls]
+        thick-neo-hookean = tubefsi_bad_walls:Impostor
+        """, {"tubefsi_bad_walls": "class Impostor:\n    pass\n"}, first=first)
+    # both discovery orders are really exercised
+    assert _providers("tubefsi.walls", "thick-neo-hookean") == (
+        ["tubefsi-bad", "tubefsi"] if first else ["tubefsi", "tubefsi-bad"])
+    with pytest.warns(PluginWarning) as record:
+        assert registry.walls["thick-neo-hookean"] is ThickNeoHookean
+    (message,) = _messages(record)
+    assert "'thick-neo-hookean'" in message and "tubefsi-bad" in message
+    assert re.search(r"using tubefsi\b(?!-)", message)
+    assert registry.walls.distribution("thick-neo-hookean") == "tubefsi"
+    assert registry.walls.name_of(ThickNeoHookean) == "thick-neo-hookean"
+    assert BUILTIN_WALLS <= set(registry.walls)
+    assert "tubefsi_bad_walls" not in sys.modules  # the losing entry point is never imported
+
+
+@pytest.mark.parametrize("order", [("alpha_walls", "Zeta-Walls"), ("Zeta-Walls", "alpha_walls")])
+def test_collision_between_plugins_does_not_depend_on_discovery_order(install, order):
+    # normalized names: alpha-walls < zeta-walls (the raw names sort the other way: 'Z' < 'a')
+    modules = {"alpha_walls": ("alpha_walls_mod", "AlphaWall"), "Zeta-Walls": ("zeta_walls_mod", "ZetaWall")}
+    for dist in order:
+        module, cls = modules[dist]
+        install(dist, f"""
+            [tubefsi.walls]
+            fake-wall = {module}:{cls}
+            only-{cls.lower()} = {module}:{cls}
+            """, {module: f"class {cls}:\n    pass\n"})
+    assert _providers("tubefsi.walls", "fake-wall") == list(reversed(order))  # each install goes first
+    registry.walls["rigid"]
+    assert "alpha_walls_mod" not in sys.modules and "zeta_walls_mod" not in sys.modules  # lazy per name
+    with pytest.warns(PluginWarning) as record:
+        assert registry.walls["fake-wall"].__name__ == "AlphaWall"
+    (message,) = _messages(record)
+    assert "'fake-wall'" in message and "alpha_walls" in message and "Zeta-Walls" in message
+    assert "using alpha_walls" in message
+    assert registry.walls.distribution("fake-wall") == "alpha_walls"
+    assert "zeta_walls_mod" not in sys.modules  # the losing entry point is never imported
+    assert registry.walls["only-zetawall"].__name__ == "ZetaWall"  # the loser's other names are unaffected
+
+
+@pytest.mark.parametrize("order", [("aaa-broken", "bbb-good"), ("bbb-good", "aaa-broken")])
+def test_broken_plugin_warns_and_does_not_block_a_lower_priority_provider(install, order):
+    plugins = {
+        "aaa-broken": ("""
+            [tubefsi.walls]
+            fake-wall = aaa_broken_walls:Wall
+            only-broken = aaa_broken_walls:Wall
+            """, {"aaa_broken_walls": "raise ImportError('needs the missing package xyzzy')\n"}),
+        "bbb-good": ("""
+            [tubefsi.walls]
+            fake-wall = bbb_good_walls:GoodWall
+            """, {"bbb_good_walls": "class GoodWall:\n    pass\n"}),
+    }
+    for dist in order:
+        install(dist, *plugins[dist])
+    with pytest.warns(PluginWarning) as record:
+        assert registry.walls["fake-wall"].__name__ == "GoodWall"
+    (message,) = _messages(record)
+    assert "'fake-wall'" in message and "aaa-broken" in message
+    assert "ImportError" in message and "xyzzy" in message
+    assert registry.walls.distribution("fake-wall") == "bbb-good"
+    with pytest.warns(PluginWarning, match=r"'only-broken' from aaa-broken failed to load: ImportError"):
+        names = list(registry.walls)
+    assert "only-broken" not in names and "only-broken" not in registry.walls
+    assert BUILTIN_WALLS | {"fake-wall"} <= set(names)
+    with pytest.raises(KeyError, match="known:"):
+        registry.walls["only-broken"]
+
+
+def test_same_distribution_seen_twice_is_silent(monkeypatch):
+    real = metadata.entry_points
+    monkeypatch.setattr(metadata, "entry_points", lambda **params: [*real(**params), *real(**params)])
+    reg = Registry("tubefsi.walls")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", PluginWarning)
+        assert BUILTIN_WALLS <= set(reg)
+    assert reg.distribution("rigid") == "tubefsi"
 
 
 def test_model_defined_in_a_script_needs_no_packaging():

@@ -7,21 +7,54 @@ own ``pyproject.toml``). An extension package adds names by declaring its own::
     [project.entry-points."tubefsi.walls"]
     thick-gent = "tubefsi_hyperelastic.gent:ThickGent"
 
-A name is loaded on first access of the registry; a plugin that fails to import,
-or a name declared twice, gives a warning naming the distribution, never an error.
+The entry points are read on first access of a registry, and a name's class is
+imported when that name is first looked up (iterating a registry imports them all);
+both are cached until :func:`refresh`.
+
+When several distributions declare the same name, the provider does not depend on
+the order of ``sys.path`` or of the entry points:
+
+1. a built-in name (declared by the distribution ``tubefsi``) always resolves to
+   tubefsi's own model: a plugin cannot take it over;
+2. between plugins, the distribution whose normalized name (PEP 503: lower case,
+   each run of ``-``, ``_`` and ``.`` as one ``-``) sorts first wins.
+
+Each provider left out is a :class:`PluginWarning` naming both distributions and the
+one used; its entry point is not imported. An entry point that fails to import is a
+:class:`PluginWarning` naming the distribution and the error, never an error, and the
+next provider in that order is tried. The same distribution seen twice (editable
+installs can list it twice) counts once, silently.
 """
 
 from __future__ import annotations
 
+import re
+import sys
 import warnings
 from collections.abc import Iterator, Mapping
 from importlib import metadata
 
 __all__ = ["rheologies", "walls", "couplers", "refresh", "Registry", "PluginWarning"]
 
+BUILTIN_DISTRIBUTION = "tubefsi"
+_UNKNOWN = "<unknown distribution>"
+
 
 class PluginWarning(UserWarning):
     """A plugin could not be loaded, or declared a name already taken."""
+
+
+def _normalize(name: str) -> str:
+    """PEP 503 normalized distribution name."""
+    return re.sub(r"[-_.]+", "-", name).lower()
+
+
+def _warn(message: str) -> None:
+    """Warn, attributing the warning to the first caller outside this module and the Mapping mixins."""
+    frame, level = sys._getframe(1), 2
+    while frame is not None and frame.f_globals.get("__name__") in (__name__, "_collections_abc"):
+        frame, level = frame.f_back, level + 1
+    warnings.warn(message, PluginWarning, stacklevel=level)
 
 
 class Registry(Mapping):
@@ -29,38 +62,70 @@ class Registry(Mapping):
 
     def __init__(self, group: str):
         self.group = group
-        self._entries: dict[str, type] | None = None
+        self._entries: dict[str, type] | None = None  # names resolved so far; None: entry points unread
         self._origin: dict[str, str] = {}
+        self._pending: dict[str, list[tuple[str, metadata.EntryPoint]]] = {}  # name -> providers, by priority
 
-    def _load(self) -> dict[str, type]:
+    def _read(self) -> dict[str, type]:
+        """Read the entry points (once) and order each name's providers; import nothing."""
         if self._entries is None:
-            entries: dict[str, type] = {}
-            origin: dict[str, str] = {}
+            providers: dict[str, dict[object, tuple[tuple, str, metadata.EntryPoint]]] = {}
             for ep in metadata.entry_points(group=self.group):
-                dist = ep.dist.name if ep.dist is not None else "<unknown distribution>"
-                if ep.name in entries:
-                    if origin[ep.name] == dist:  # the same distribution seen twice (editable installs)
-                        continue
-                    warnings.warn(f"{self.group}: {ep.name!r} from {dist} ignored; already provided by "
-                                  f"{origin[ep.name]}", PluginWarning, stacklevel=3)
-                    continue
-                try:
-                    entries[ep.name] = ep.load()
-                except Exception as exc:  # a broken plugin must not break the registry
-                    warnings.warn(f"{self.group}: {ep.name!r} from {dist} failed to load: "
-                                  f"{type(exc).__name__}: {exc}", PluginWarning, stacklevel=3)
-                    continue
-                origin[ep.name] = dist
-            self._entries, self._origin = entries, origin
+                dist = ep.dist.name if ep.dist is not None and ep.dist.name else None
+                if dist is None:  # no distribution to rank by: after every named one, by target
+                    key, rank, dist = ("?", ep.value), (2, "", ep.value), _UNKNOWN
+                else:
+                    key = _normalize(dist)
+                    rank = (0 if key == BUILTIN_DISTRIBUTION else 1, key, "")
+                # the same distribution seen twice (editable installs): the first one found counts
+                providers.setdefault(ep.name, {}).setdefault(key, (rank, dist, ep))
+            self._pending = {name: [(dist, ep) for _, dist, ep in sorted(found.values(), key=lambda t: t[0])]
+                             for name, found in providers.items()}
+            self._entries, self._origin = {}, {}
         return self._entries
 
+    def _resolve(self, name: str) -> None:
+        """Import the first provider of ``name`` that loads; warn of failures and of providers left out."""
+        candidates = self._pending.pop(name, None)
+        if not candidates:
+            return
+        for i, (dist, ep) in enumerate(candidates):
+            try:
+                obj = ep.load()
+            except Exception as exc:  # a broken plugin must not break the registry
+                _warn(f"{self.group}: {name!r} from {dist} failed to load: {type(exc).__name__}: {exc}")
+                continue
+            self._entries[name], self._origin[name] = obj, dist
+            if _normalize(dist) == BUILTIN_DISTRIBUTION:
+                why = "a built-in name cannot be taken over by a plugin"
+            else:
+                why = "between plugins, the distribution whose normalized name sorts first wins"
+            for other, _ in candidates[i + 1:]:
+                _warn(f"{self.group}: {name!r} is provided by both {dist} and {other}; using {dist} ({why})")
+            return
+
+    def _load(self) -> dict[str, type]:
+        """Resolve every name."""
+        entries = self._read()
+        for name in list(self._pending):
+            self._resolve(name)
+        return entries
+
+    def _get(self, name: str) -> type | None:
+        entries = self._read()
+        if name in self._pending:
+            self._resolve(name)
+        return entries.get(name)
+
     def __getitem__(self, name: str) -> type:
-        entries = self._load()
-        try:
-            return entries[name]
-        except KeyError:
+        obj = self._get(name)
+        if obj is None:
             raise KeyError(f"{name!r} is not a registered {self.group.split('.')[-1][:-1]}; "
-                           f"known: {', '.join(sorted(entries))}") from None
+                           f"known: {', '.join(sorted(self._load()))}")
+        return obj
+
+    def __contains__(self, name) -> bool:
+        return isinstance(name, str) and self._get(name) is not None
 
     def __iter__(self) -> Iterator[str]:
         return iter(sorted(self._load()))
@@ -85,6 +150,7 @@ class Registry(Mapping):
         """Forget the cache; the next access reads the entry points again."""
         self._entries = None
         self._origin = {}
+        self._pending = {}
 
     def __repr__(self) -> str:
         return f"Registry({self.group!r}: {', '.join(self)})"
