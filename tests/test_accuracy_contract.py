@@ -1,4 +1,4 @@
-r"""The accuracy contract of issue 3, checked against the 40-digit reference in ``_reference.py``.
+r"""The accuracy contract of issue 3, checked against the 40-digit reference of ``tubefsi.testing.reference``.
 
     "Default solve is accurate to 1e-12 relative (up to what the problem's condition number
     allows in double precision) in pressure drop, flow rate and inlet displacement, for every
@@ -47,7 +47,8 @@ far below 40 digits). So each case costs one ``mpmath.quad``.
 
 Near the maximum flow rate, ``lam`` reaches ~1e7 and integration by parts would cancel
 ``k log10(lam)`` digits, so ``Jhat = J_inf - tail(lam)`` is used (tail in closed form for thin
-current walls, a singularity-free quadrature for thick ones; see ``_reference.py``), and the
+current walls, a singularity-free quadrature for thick ones; see
+``tubefsi.testing.reference.power_law``), and the
 inlet stretch is found by Newton on ``ln tail`` in ``ln lam``.
 
 Beyond the documented inlet-stretch cap (1e15), e.g. 99 % of q_max at n = 0.99 (which needs
@@ -64,20 +65,19 @@ import pytest
 from mpmath import mp, mpf
 
 import tubefsi
-from _reference import (
-    LIMIT_KINDS,
-    WALLS,
-    RefWall,
+from tubefsi.testing.reference import rel_err
+from tubefsi.testing.reference.power_law import (
     ref_J,
     ref_J_inf,
     ref_J_log,
     ref_J_tail,
     ref_phi,
     ref_phi_inverse,
-    stretch_at_pressure,
 )
+from tubefsi.testing.reference.tube_laws import LIMIT_KINDS, WALLS, RefWall, stretch_at_pressure
 
 DPS = 40          # reference precision
+pytestmark = pytest.mark.usefixtures("mp_precision")
 RTOL = 1e-12      # the contract
 
 A = 2.0**-13      # undeformed inner radius (m); a power of two: tb * A and thickness / A are exact
@@ -108,13 +108,6 @@ def regime(level):
     if level.startswith("lim"):
         return "near limit"
     return "large strain"
-
-
-@pytest.fixture(autouse=True, scope="module")
-def _mp_precision():
-    """Run this module at mp.dps = DPS without leaking the setting into other test modules."""
-    with mp.workdps(DPS):
-        yield
 
 
 # ---------------------------------------------------------------------------- reference
@@ -273,11 +266,6 @@ def make_fluid(n, newtonian=False):
     return tubefsi.registry.rheologies["power-law"](consistency=M, index=n)
 
 
-def _rel(got, ref):
-    with mp.workdps(DPS):
-        return float(abs((mpf(float(got)) - ref) / ref))
-
-
 def grid_errors(wall_name, n, tb, level, mode, newtonian=False):
     """[(quantity, rel_err, kappa)] for one grid case, in one control mode."""
     ref = reference(wall_name, tb, n, level)
@@ -285,19 +273,19 @@ def grid_errors(wall_name, n, tb, level, mode, newtonian=False):
     if mode == "pressure":
         dp_in, q_ref, u_ref, k_q, k_u = ref["pressure"]
         sol = tubefsi.solve(fluid, wall, tube, pressure_drop=dp_in)
-        return [("q(dp)", _rel(sol.flow_rate, q_ref), float(k_q)),
-                ("u(dp)", _rel(sol.inlet_displacement, u_ref), float(k_u))]
+        return [("q(dp)", rel_err(sol.flow_rate, q_ref), float(k_q)),
+                ("u(dp)", rel_err(sol.inlet_displacement, u_ref), float(k_u))]
     q_in, dp_ref, u_ref, k_dp, k_u = ref["flow"]
     sol = tubefsi.solve(fluid, wall, tube, flow_rate=q_in)
-    return [("dp(q)", _rel(sol.pressure_drop, dp_ref), float(k_dp)),
-            ("u(q)", _rel(sol.inlet_displacement, u_ref), float(k_u))]
+    return [("dp(q)", rel_err(sol.pressure_drop, dp_ref), float(k_dp)),
+            ("u(q)", rel_err(sol.inlet_displacement, u_ref), float(k_u))]
 
 
 def near_qmax_errors(wall_name, n, tb, fraction):
     q_in, dp_ref, u_ref, k_dp, k_u, _ = reference_near_qmax(wall_name, tb, n, M, fraction)
     sol = tubefsi.solve(make_fluid(n), make_wall(wall_name), make_tube(tb), flow_rate=q_in)
-    return [("dp(q)", _rel(sol.pressure_drop, dp_ref), float(k_dp)),
-            ("u(q)", _rel(sol.inlet_displacement, u_ref), float(k_u))]
+    return [("dp(q)", rel_err(sol.pressure_drop, dp_ref), float(k_dp)),
+            ("u(q)", rel_err(sol.inlet_displacement, u_ref), float(k_u))]
 
 
 def assert_contract(errors, label):
@@ -372,8 +360,8 @@ def test_rigid(n, q, newtonian):
     fluid, wall, tube = make_fluid(n, newtonian), tubefsi.registry.walls["rigid"](), make_tube(0.3)
     sol = tubefsi.solve(fluid, wall, tube, flow_rate=q)
     sol2 = tubefsi.solve(fluid, wall, tube, pressure_drop=dp_in)
-    assert_contract([("dp(q)", _rel(sol.pressure_drop, dp_ref), n),
-                     ("q(dp)", _rel(sol2.flow_rate, q_ref), 1 / n)], f"rigid, n={n!r}, q={q}")
+    assert_contract([("dp(q)", rel_err(sol.pressure_drop, dp_ref), n),
+                     ("q(dp)", rel_err(sol2.flow_rate, q_ref), 1 / n)], f"rigid, n={n!r}, q={q}")
     assert sol.inlet_displacement == 0.0 and sol2.inlet_displacement == 0.0
 
 
@@ -405,7 +393,7 @@ def test_beyond_stretch_cap_raises(wall_name, tb):
     assert exc.quantity == "flow_rate"
     assert isinstance(exc.limit, float) and math.isfinite(exc.limit)
     assert 0 < exc.limit < q_in
-    assert _rel(exc.limit, q_cap) <= RTOL * max(1.0, 1 / n), (exc.limit, float(q_cap))
+    assert rel_err(exc.limit, q_cap) <= RTOL * max(1.0, 1 / n), (exc.limit, float(q_cap))
 
 
 # ---------------------------------------------------------------------------- the reference itself
@@ -418,6 +406,23 @@ def test_reference_derivative_is_the_tube_law_slope(wall_name):
             for lam in (mpf(1) + mpf("1e-6"), mpf("1.5"), mpf(31), mpf(201)):
                 numeric = mpmath.diff(wall.P, lam)
                 assert abs(numeric / wall.dP(lam) - 1) < mpf(10) ** (12 - DPS)
+
+
+@pytest.mark.parametrize("wall_name", [w for w in DEFORMABLE if WALLS[w][2] not in ("thin-linear", "thick-linear")])
+def test_reference_closed_forms_match_the_strain_energy(wall_name):
+    """The closed forms used here equal the same wall derived from its strain energy (the route
+    of the plugins' materials: Lamé quadrature, Leibniz's rule, mpmath.diff), and the
+    hand-written plane-strain dW is the derivative of W(1/s, s, 1)."""
+    with mp.workdps(DPS):
+        for tb in TB_VALUES:
+            wall = _ref_wall(wall_name, tb)
+            generic = RefWall(wall.kind, wall.material, wall.tb, closed_form=False)
+            assert wall.mu is not None and generic.mu is None
+            for lam in (mpf(1) + mpf("1e-6"), mpf("1.5"), mpf(31), mpf(201)):
+                assert abs(generic.P(lam) / wall.P(lam) - 1) < mpf(10) ** (12 - DPS)
+                assert abs(generic.dP(lam) / wall.dP(lam) - 1) < mpf(10) ** (12 - DPS)
+                numeric = mpmath.diff(wall.material.W_hat, lam)
+                assert abs(numeric / wall.material.dW(lam) - 1) < mpf(10) ** (12 - DPS)
 
 
 @pytest.mark.parametrize("wall_name", DEFORMABLE)

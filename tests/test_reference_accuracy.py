@@ -3,9 +3,11 @@ r"""Accuracy of the default ``tubefsi.solve`` against an independent 40-digit re
 Where the reference comes from
 ------------------------------
 Nothing in this file calls tubefsi's numerics to build the expected values. The
-reference (shared with ``test_accuracy_contract.py``, in ``tests/_reference.py``) is written in ``mpmath`` (``mp.dps = 40``, set for this module only by a
-fixture) straight from the physics in ``DESIGN.md`` §2 (the tube laws of §2.3, the
-power-law flow law of §2.2 and the separation of variables of §2.4):
+reference (shared with ``test_accuracy_contract.py``, in ``tubefsi.testing.reference``: the
+modules ``tube_laws`` and ``power_law``) is written in ``mpmath`` (``mp.dps = 40``, set for this
+module only by the ``mp_precision`` fixture of ``conftest.py``) straight from the physics in
+``docs/theory.md`` (section "Tube laws", section "The flow law of a generalized Newtonian
+fluid" and the separation of variables of section "Coupling without an ODE"):
 
 * tube laws ``P(lam)`` (``mu`` = shear modulus, ``2 (c1 + c2)`` for Mooney–Rivlin):
 
@@ -63,18 +65,12 @@ from hypothesis import strategies as st
 from mpmath import mp, mpf
 
 import tubefsi
-from _reference import (
-    WALLS,
-    RefWall,
-    ref_J,
-    ref_J_inf,
-    ref_phi,
-    ref_phi_inverse,
-    rel_err,
-    stretch_at_pressure,
-)
+from tubefsi.testing.reference import rel_err
+from tubefsi.testing.reference.power_law import ref_J, ref_J_inf, ref_phi, ref_phi_inverse
+from tubefsi.testing.reference.tube_laws import WALLS, RefWall, stretch_at_pressure
 
 DPS = 40   # working precision of the reference (set per module, restored afterwards)
+pytestmark = pytest.mark.usefixtures("mp_precision")
 
 RTOL = 1e-10
 RTOL_QMAX = 1e-9
@@ -92,15 +88,8 @@ NEAR_LIMIT = mpf("0.97")
 DEFORMABLE = tuple(WALLS)
 
 
-@pytest.fixture(autouse=True, scope="module")
-def _mp_precision():
-    """Run this module at mp.dps = 40 without leaking the setting into other test modules."""
-    with mp.workdps(DPS):
-        yield
-
-
 # ---------------------------------------------------------------------------- reference (mpmath)
-# The tube laws, Jhat by parts, phi and its inverse, J_inf live in tests/_reference.py.
+# The tube laws, Jhat by parts, phi and its inverse, J_inf live in tubefsi.testing.reference.
 def near_limit_stretch(wall):
     """lam with P(lam) = 0.97 p_max (bracketed, then polished by findroot)."""
     return stretch_at_pressure(wall, NEAR_LIMIT * wall.limit_pressure(), polish=False)

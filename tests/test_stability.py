@@ -6,8 +6,8 @@ reference-thickness walls, ``n = 1 ± 1e-9`` for thin current-thickness walls, a
 nearest 2/3 and 1), at inlet strain ``1e-8``, at ``t/a = 0.01`` and ``2``, at ``1 - 1e-6`` of the
 limit pressure, and at 99 % of the maximum flow rate. Each case is checked flow-controlled
 (``Δp(q)``, ``u(q)``) and, except near ``q_max``, pressure-controlled (``q(Δp)``, ``u(Δp)``)
-against the independent mpmath reference of ``_reference.py`` (40 digits; tube laws and
-hand-derived slopes from DESIGN.md §2.3). The bound is ``1e-12 * max(1, κ)`` with ``κ`` the
+against the independent mpmath reference of ``tubefsi.testing.reference`` (40 digits; tube laws and
+hand-derived slopes from ``docs/theory.md``, section "Tube laws"). The bound is ``1e-12 * max(1, κ)`` with ``κ`` the
 relative condition number of the output with respect to the load, evaluated on the reference
 (the same convention as ``test_accuracy_contract.py``; ``e = λ - 1``, ``k = 3n + 1``,
 ``Ĵ(λ) = ∫_1^λ P'(s) s^k ds``):
@@ -40,22 +40,19 @@ import pytest
 from mpmath import mp, mpf
 
 import tubefsi
-from _reference import WALLS, RefWall, ref_J_inf, ref_J_tail, ref_phi, ref_phi_inverse, stretch_at_pressure
 from tubefsi.couplers import ODE, Quadrature
+from tubefsi.testing.reference import rel_err
+from tubefsi.testing.reference.power_law import ref_J_inf, ref_J_tail, ref_phi, ref_phi_inverse
+from tubefsi.testing.reference.tube_laws import WALLS, RefWall, stretch_at_pressure
 
 DPS = 40
+pytestmark = pytest.mark.usefixtures("mp_precision")
 RTOL = 1e-12
 FAR = 1e-3           # "far from the truth" for a non-default method
 
 A = 2.0**-13         # m; a power of two, so thickness = tb * A and thickness / A are exact
 L = 1e-2             # m
 M = 0.01             # Pa s^n
-
-
-@pytest.fixture(autouse=True, scope="module")
-def _mp_precision():
-    with mp.workdps(DPS):
-        yield
 
 
 # ---------------------------------------------------------------------------- reference
@@ -136,11 +133,6 @@ def reference(wall_name, tb, n, how, value):
         return out
 
 
-def _rel(got, ref):
-    with mp.workdps(DPS):
-        return float(abs(mpf(float(got)) / ref - 1))
-
-
 # ---------------------------------------------------------------------------- library side
 def make_wall(wall_name):
     reg, params, _ = WALLS[wall_name]
@@ -161,13 +153,13 @@ def default_path_errors(wall_name, tb, n, how, value):
     fluid, wall, tube = power_law(n), make_wall(wall_name), make_tube(tb)
     q_in, dp_ref, u_ref, k_dp, k_u = ref["flow"]
     sol = tubefsi.solve(fluid, wall, tube, flow_rate=q_in)
-    errors = [("dp(q)", _rel(sol.pressure_drop, dp_ref), float(k_dp)),
-              ("u(q)", _rel(sol.inlet_displacement, u_ref), float(k_u))]
+    errors = [("dp(q)", rel_err(sol.pressure_drop, dp_ref), float(k_dp)),
+              ("u(q)", rel_err(sol.inlet_displacement, u_ref), float(k_u))]
     if "pressure" in ref:
         dp_in, q_ref, u_ref, k_q, k_u = ref["pressure"]
         sol = tubefsi.solve(fluid, wall, tube, pressure_drop=dp_in)
-        errors += [("q(dp)", _rel(sol.flow_rate, q_ref), float(k_q)),
-                   ("u(dp)", _rel(sol.inlet_displacement, u_ref), float(k_u))]
+        errors += [("q(dp)", rel_err(sol.flow_rate, q_ref), float(k_q)),
+                   ("u(dp)", rel_err(sol.inlet_displacement, u_ref), float(k_u))]
     return errors
 
 
@@ -244,7 +236,7 @@ def assert_never_silently_wrong(run, expected, label):
     sol, info = outcome(run)
     if sol == "raised" or info:
         return
-    errors = {name: _rel(getattr(sol, name), exact) for name, exact in expected}
+    errors = {name: rel_err(getattr(sol, name), exact) for name, exact in expected}
     far = {name: f"{err:.2g}" for name, err in errors.items() if err > FAR}
     assert not far, f"{label}: silent wrong number (relative error > {FAR:g}, no warning, no error): {far}"
 
@@ -339,8 +331,8 @@ def test_odeint_excess_work_is_a_convergence_error(strain):
         with pytest.raises(tubefsi.ConvergenceError):
             tubefsi.solve(fluid, wall, tube, flow_rate=q_in, coupler=ODE(method="odeint"))
     sol = tubefsi.solve(fluid, wall, tube, flow_rate=q_in)
-    assert_contract([("dp(q)", _rel(sol.pressure_drop, dp_ref), float(k_dp)),
-                     ("u(q)", _rel(sol.inlet_displacement, u_ref), float(k_u))], f"default at strain {strain}")
+    assert_contract([("dp(q)", rel_err(sol.pressure_drop, dp_ref), float(k_dp)),
+                     ("u(q)", rel_err(sol.inlet_displacement, u_ref), float(k_u))], f"default at strain {strain}")
 
 
 @pytest.mark.parametrize("method", ("odeint", "LSODA-default", "RK45-default", "DOP853-1e-10"))

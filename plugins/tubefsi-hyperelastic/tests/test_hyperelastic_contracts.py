@@ -1,12 +1,15 @@
-"""tubefsi's public contract suites, run on every wall this distribution registers."""
+"""tubefsi's public contract suites, run on every wall this distribution registers.
+
+tubefsi's own ``tests/test_contracts.py`` runs the suites on the built-in models only, so these
+walls go through each suite here, once.
+"""
 
 import math
 
 import pytest
 import tubefsi
 from tubefsi import registry
-from tubefsi.couplers import Quadrature
-from tubefsi.testing import CouplerContract, HyperelasticWallContract, examples
+from tubefsi.testing import CouplerContract, HyperelasticWallContract, coupler_cases, examples
 
 NAMES = ["thin-gent", "thick-gent", "thin-fung", "thick-fung", "thin-ogden", "thick-ogden", "thin-yeoh", "thick-yeoh"]
 WALLS = [wall for name in NAMES for wall in examples("walls", name)]
@@ -24,14 +27,8 @@ class TestWalls(HyperelasticWallContract):      # includes every WallContract te
         return request.param
 
 
-def _cases():
-    fluids = [examples("rheologies", "power-law")[0], examples("rheologies", "newtonian")[0]]
-    return [pytest.param((fluids[i % 2], wall, Quadrature()), id=f"{wall!r}-{type(fluids[i % 2]).__name__}")
-            for i, wall in enumerate(WALLS)]
-
-
 class TestCouplers(CouplerContract):
-    @pytest.fixture(params=_cases())
+    @pytest.fixture(params=coupler_cases(WALLS))
     def case(self, request):
         return request.param
 

@@ -1,4 +1,8 @@
-"""Each wall against an independent mpmath computation (``_mp_wall_reference.py``, 30 digits).
+"""Each wall against an independent mpmath computation (``tubefsi.testing.reference``, 30 digits).
+
+The reference walls are ``tubefsi.testing.reference.tube_laws.RefWall`` of materials written as
+their three-dimensional strain energies (``docs/theory.md``, section "Tube laws"); the flow is
+separated as in ``tubefsi.testing.reference.power_law`` (section "Coupling without an ODE").
 
 * the hand-written plane-strain derivatives of the reference against ``mpmath.diff`` of the
   three-dimensional strain energies;
@@ -15,9 +19,11 @@ import math
 import pytest
 from mpmath import mp, mpf
 
-import _mp_wall_reference as ref
 import tubefsi
 from tubefsi.registry import rheologies, walls
+from tubefsi.testing.reference import rel_err
+from tubefsi.testing.reference import tube_laws as ref
+from tubefsi.testing.reference.power_law import inlet_stretch, ref_J_direct, ref_phi, ref_phi_inverse
 
 DPS = 30
 TOL = 1e-10
@@ -27,10 +33,6 @@ TOL = 1e-10
 def _precision():
     with mp.workdps(DPS):
         yield
-
-
-def rel(a, b):
-    return abs(mpf(a) / mpf(b) - 1)
 
 
 def material(wall):
@@ -46,7 +48,9 @@ def material(wall):
 
 
 def theory(wall):
-    return getattr(wall, "thickness_convention", "thick")
+    """The reference wall's kind: "thick", "thin-reference" or "thin-current"."""
+    convention = getattr(wall, "thickness_convention", None)
+    return "thick" if convention is None else f"thin-{convention}"
 
 
 NAMES = ["thin-gent", "thick-gent", "thin-fung", "thick-fung", "thin-ogden", "thick-ogden", "thin-yeoh", "thick-yeoh"]
@@ -58,19 +62,19 @@ WALLS = [walls[n](**kw) for n in NAMES for kw in walls[n]._examples]
 def test_reference_derivatives_match_the_strain_energy(mat):
     w_hat = lambda s: mat.W(1 / s, s, mpf(1))
     for s in (mpf("1.001"), mpf("1.4"), mpf("2.1")):
-        assert rel(mat.dW(s), mp.diff(w_hat, s)) < mpf(10) ** -20
+        assert rel_err(mat.dW(s), mp.diff(w_hat, s)) < mpf(10) ** -20
 
 
 @pytest.mark.parametrize("wall", WALLS, ids=repr)
 def test_tube_law_and_slope(wall):
     mat = material(wall)
     for tb in (0.05, 0.5, 2.0):
-        law = ref.TubeLaw(mat, theory(wall), tb)
+        law = ref.RefWall(theory(wall), mat, tb)
         top = wall.max_stretch(tb)
         for e in (1e-6, 1e-2, 0.4, 1.5):
             lam = 1 + min(e, 0.9 * (top - 1))
-            assert rel(wall.pressure(lam, tb), law.pressure(lam)) < 1e-12, (tb, lam)
-            assert rel(wall.stiffness(lam, tb), law.slope(lam)) < 1e-10, (tb, lam)
+            assert rel_err(wall.pressure(lam, tb), law.P(lam)) < 1e-12, (tb, lam)
+            assert rel_err(wall.stiffness(lam, tb), law.dP(lam)) < 1e-10, (tb, lam)
 
 
 @pytest.mark.parametrize("convention", ["reference", "current", "thick"])
@@ -78,19 +82,19 @@ def test_gent_near_the_lock(convention):
     jm = 3.0
     wall = (walls["thick-gent"](shear_modulus=2e3, locking_parameter=jm) if convention == "thick" else
             walls["thin-gent"](shear_modulus=2e3, locking_parameter=jm, thickness_convention=convention))
-    law = ref.TubeLaw(ref.Gent(2e3, jm), convention, 0.4)
-    lock = law.mat.lock
+    law = ref.RefWall("thick" if convention == "thick" else f"thin-{convention}", ref.Gent(2e3, jm), 0.4)
+    lock = law.material.lock
     for gap in (1e-3, 1e-7, 1e-11):
         lam = float(lock * (1 - mpf(gap)))
-        p, p_ref = wall.pressure(lam, 0.4), law.pressure(lam)
+        p, p_ref = wall.pressure(lam, 0.4), law.P(lam)
         # condition number of P at lam: lam P'/P (the float stretch is exact; the lock is rounded)
-        cond = float(lam * law.slope(lam) / p_ref) * 1e-16 / gap
-        assert rel(p, p_ref) < 1e-12 + 4 * cond, gap
-        assert rel(wall.stretch(float(p_ref), 0.4), lam) < 1e-14 + 1e-16 / gap
+        cond = float(lam * law.dP(lam) / p_ref) * 1e-16 / gap
+        assert rel_err(p, p_ref) < 1e-12 + 4 * cond, gap
+        assert rel_err(wall.stretch(float(p_ref), 0.4), lam) < 1e-14 + 1e-16 / gap
 
 
 def _peak(law, guess):
-    return mp.findroot(law.slope, mpf(guess))
+    return mp.findroot(law.dP, mpf(guess))
 
 
 @pytest.mark.parametrize("wall", [w for w in WALLS if math.isfinite(w.limit_pressure(0.3))
@@ -99,13 +103,13 @@ def test_limit_points(wall):
     mat = material(wall)
     for tb in (0.05, 0.3, 2.0):
         top = wall.max_stretch(tb)
-        law = ref.TubeLaw(mat, theory(wall), tb)
+        law = ref.RefWall(theory(wall), mat, tb)
         if math.isfinite(top):      # a first pressure peak: P'(top) = 0, limit = P(top)
             peak = _peak(law, top)
-            assert rel(top, peak) < 1e-12
-            assert rel(wall.limit_pressure(tb), law.pressure(peak)) < 1e-12
+            assert rel_err(top, peak) < 1e-12
+            assert rel_err(wall.limit_pressure(tb), law.P(peak)) < 1e-12
         else:                       # an asymptote as lam -> inf
-            assert rel(wall.limit_pressure(tb), law.pressure(mpf(10) ** 8)) < 1e-12
+            assert rel_err(wall.limit_pressure(tb), law.P(mpf(10) ** 8)) < 1e-12
 
 
 # ---------------------------------------------------------------- solves
@@ -117,17 +121,17 @@ K = 3 * N + 1
 
 def _check_flow_controlled(wall, flow_rates, tol=TOL):
     a, L, tb = TUBE.radius, TUBE.length, TUBE.reduced_thickness
-    law = ref.TubeLaw(material(wall), theory(wall), tb)
+    law = ref.RefWall(theory(wall), material(wall), tb)
     sol = tubefsi.solve(FLUID, wall, TUBE, flow_rate=flow_rates)
     out = []
     for i, q in enumerate(flow_rates):
-        target = mpf(L) * ref.phi(q, M, N) / mpf(a) ** K
-        lam = ref.inlet_stretch(law, target, K, 1 + sol.inlet_displacement[i] / a)
-        dp = law.pressure(lam)
-        err = (rel(sol.pressure_drop[i], dp), rel(sol.inlet_displacement[i], (lam - 1) * a))
+        target = mpf(L) * ref_phi(q, N, M) / mpf(a) ** K
+        lam = inlet_stretch(law, target, K, 1 + sol.inlet_displacement[i] / a)
+        dp = law.P(lam)
+        err = (rel_err(sol.pressure_drop[i], dp), rel_err(sol.inlet_displacement[i], (lam - 1) * a))
         assert max(err) < tol, (q, err)
         back = tubefsi.solve(FLUID, wall, TUBE, pressure_drop=float(dp))
-        assert rel(back.flow_rate, q) < tol
+        assert rel_err(back.flow_rate, q) < tol
         out.append((float(lam), float(max(err))))
     return out
 
@@ -149,10 +153,10 @@ def test_power_law_in_a_thick_ogden_tube_and_its_maximum_flow_rate():
     wall = walls["thick-ogden"](moduli=(2008.5, 14.75, 49.05), exponents=(1.3, 5.0, -2.0))
     tb = TUBE.reduced_thickness
     q_max = tubefsi.max_flow_rate(FLUID, wall, TUBE)
-    law = ref.TubeLaw(material(wall), "thick", tb)
+    law = ref.RefWall("thick", material(wall), tb)
     peak = _peak(law, wall.max_stretch(tb))
-    q_ref = ref.phi_inverse(ref.J(law, peak, K) * mpf(TUBE.radius) ** K / mpf(TUBE.length), M, N)
-    assert rel(q_max, q_ref) < TOL
+    q_ref = ref_phi_inverse(ref_J_direct(law, peak, K) * mpf(TUBE.radius) ** K / mpf(TUBE.length), N, M)
+    assert rel_err(q_max, q_ref) < TOL
     _check_flow_controlled(wall, [0.01 * q_max, 0.5 * q_max])
     with pytest.raises(tubefsi.NoSteadyStateError) as info:
         tubefsi.solve(FLUID, wall, TUBE, flow_rate=1.001 * q_max)

@@ -1,4 +1,8 @@
-"""tubefsi's public contract suites, run on every model this distribution registers."""
+"""tubefsi's public contract suites, run on every model this distribution registers.
+
+tubefsi's own ``tests/test_contracts.py`` runs the suites on the built-in models only, so these
+fluids go through each suite here, once.
+"""
 
 import numpy as np
 import pytest

@@ -1,14 +1,19 @@
-r"""An independent ``mpmath`` reference for generalized Newtonian flow in a thick neo-Hookean tube.
+r"""Generalized Newtonian flow in a reference wall, in ``mpmath``.
 
-Nothing here calls tubefsi. Everything is written from the physics (``DESIGN.md`` §2) at the
-caller's ``mp.dps``, with fixed Gauss–Legendre rules (24 nodes) on geometrically graded
-sub-intervals, so that a whole solve costs well under a second.
+Nothing here calls tubefsi. Everything is written from ``docs/theory.md`` (sections "The flow law
+of a generalized Newtonian fluid" and "Coupling without an ODE") at the caller's ``mp.dps``, with
+fixed Gauss–Legendre rules (24 nodes, :mod:`.quadrature`) on geometrically graded
+sub-intervals, so that a whole solve costs well under a second. The wall is a
+:class:`~.tube_laws.RefWall` (only its ``P`` and ``dP`` enter).
 
 Fluid (Carreau–Yasuda): :math:`\tau(x) = x[\eta_\infty + (\eta_0-\eta_\infty)(1 + (\lambda x)^a)^{(n-1)/a}]`,
-:math:`\tau'(x) = \eta_\infty + (\eta_0-\eta_\infty)(1+(\lambda x)^a)^{(n-1)/a - 1}(1 + n(\lambda x)^a)`.
+:math:`\tau'(x) = \eta_\infty + (\eta_0-\eta_\infty)(1+(\lambda x)^a)^{(n-1)/a - 1}(1 + n(\lambda x)^a)`;
+or any law given by its shear rate :math:`\dot\gamma(\tau)`, zero below a yield stress
+(:class:`RateLawRef`).
 
-The tube flow is parametrized by the wall *shear rate* :math:`g`, which avoids inverting the
-constitutive law: with :math:`\tau = \tau(x)` substituted in the Rabinowitsch–Mooney integral,
+The tube flow is parametrized by the wall *shear rate* :math:`g` (by the wall stress for a rate
+law), which avoids inverting the constitutive law: with :math:`\tau = \tau(x)` substituted in the
+Rabinowitsch–Mooney integral,
 
 .. math::
 
@@ -28,56 +33,21 @@ and at fixed flow rate :math:`q` a section of wall shear rate :math:`g` has radi
 integrand at :math:`g_{in}`), the cumulative integral :math:`\int_0^g` along the sorted
 outer nodes, and :math:`\Delta p = P(\lambda_{in})`.
 
-Thick neo-Hookean tube law (Lamé, plane strain, §2.3), :math:`b = (1+\bar t)^2`,
-:math:`\lambda_o^2 = 1 + (\lambda^2-1)/b`: :math:`P(\lambda) = \int_{\lambda_o}^{\lambda}
-\frac{\hat W'(s)}{s^2-1}ds` with :math:`\hat W'(s) = \mu(s - s^{-3})`, i.e. the integrand
-:math:`\mu(s^2+1)/s^3`; by Leibniz, :math:`P'(\lambda) = h(\lambda) - h(\lambda_o)\lambda/(b\lambda_o)`.
+The tests use a thick neo-Hookean wall derived from its strain energy,
+``RefWall("thick", NeoHookean(mu), tb, closed_form=False)``: the Lamé integral
+:math:`P(\lambda) = \int_{\lambda_o}^{\lambda}\mu(s^2+1)/s^3\,ds` by ``mpmath.quad`` and, by
+Leibniz, :math:`P'(\lambda) = h(\lambda) - h(\lambda_o)\lambda/(b\lambda_o)`, :math:`b = (1+\bar t)^2`,
+:math:`\lambda_o^2 = 1 + (\lambda^2-1)/b` (``docs/theory.md``, section "Tube laws", subsection
+"Thick walls").
 """
 
 from __future__ import annotations
 
-import functools
-
 from mpmath import mp, mpf
 
-__all__ = ["CarreauYasudaRef", "RateLawRef", "ThickNeoHookeanRef", "solve_flow_controlled", "gauss_legendre",
-           "yield_pressure_drop", "velocity"]
+from .quadrature import gauss_legendre, gauss_legendre_rule, geometric_breaks
 
-
-@functools.lru_cache(maxsize=None)
-def _gl(m: int, dps: int):
-    with mp.workdps(dps + 10):
-        nodes, weights = [], []
-        for k in range(1, m + 1):
-            x = mp.cos(mp.pi * (k - mpf(1) / 4) / (m + mpf(1) / 2))
-            for _ in range(100):                     # Newton on P_m
-                p0, p1 = mpf(1), x
-                for j in range(2, m + 1):
-                    p0, p1 = p1, ((2 * j - 1) * x * p1 - (j - 1) * p0) / j
-                dp = m * (x * p1 - p0) / (x * x - 1)
-                dx = p1 / dp
-                x -= dx
-                if abs(dx) < mpf(10) ** (-(dps + 8)):
-                    break
-            nodes.append(x)
-            weights.append(2 / ((1 - x * x) * dp * dp))
-    return tuple(nodes), tuple(weights)
-
-
-def gauss_legendre(f, a, b, m=24):
-    """``∫_a^b f`` by the ``m``-point Gauss–Legendre rule (nodes at the current precision)."""
-    nodes, weights = _gl(m, mp.dps)
-    c, h = (a + b) / 2, (b - a) / 2
-    return h * mp.fsum(w * f(c + h * x) for x, w in zip(nodes, weights))
-
-
-def geometric_breaks(lo, hi, ratio=2):
-    """lo = x_0 < x_1 < ... = hi with x_{k+1} <= ratio * x_k (lo > 0)."""
-    pts = [lo]
-    while pts[-1] * ratio < hi:
-        pts.append(pts[-1] * ratio)
-    pts.append(hi)
-    return pts
+__all__ = ["CarreauYasudaRef", "RateLawRef", "solve_flow_controlled", "yield_pressure_drop", "velocity"]
 
 
 class CarreauYasudaRef:
@@ -171,25 +141,6 @@ class RateLawRef(CarreauYasudaRef):
         return (4 * self.rate(x) - 3 * gam) / (x * gam)
 
 
-class ThickNeoHookeanRef:
-    def __init__(self, shear_modulus, tb):
-        self.mu, self.tb = mpf(shear_modulus), mpf(tb)
-        self.b = (1 + self.tb) ** 2
-
-    def h(self, s):                     # dW(s) / (s^2 - 1), dW = mu (s - s^-3)
-        return self.mu * (s * s + 1) / s**3
-
-    def outer(self, lam):
-        return mp.sqrt(1 + (lam * lam - 1) / self.b)
-
-    def pressure(self, lam):
-        return mp.quad(self.h, [self.outer(lam), lam])
-
-    def slope(self, lam):
-        lo = self.outer(lam)
-        return self.h(lam) - self.h(lo) * lam / (self.b * lo)
-
-
 def solve_flow_controlled(fluid, wall, radius, length, q, stretch_guess, m=24, newton=8):
     r"""(pressure drop, inlet stretch) of the flow-controlled problem, outlet pressure 0.
 
@@ -206,11 +157,11 @@ def solve_flow_controlled(fluid, wall, radius, length, q, stretch_guess, m=24, n
         R = (4 * q / (mp.pi * gam)) ** (mpf(1) / 3)
         lam = R / a
         G = 2 * fluid.stress(x) / R
-        return lam, wall.slope(lam) * lam / 3 * fluid.dlog_apparent(x, gam) / G
+        return lam, wall.dP(lam) * lam / 3 * fluid.dlog_apparent(x, gam) / G
 
     lam0 = mpf(stretch_guess)
     x_in = fluid.at_apparent(gam_out / lam0**3, _guess(fluid, gam_out / lam0**3))
-    nodes, weights = _gl(m, mp.dps)
+    nodes, weights = gauss_legendre_rule(m)
     for _ in range(newton):
         I_in = fluid.integral(x_in)
         pieces = [fluid.lower + d for d in geometric_breaks(x_in - fluid.lower, x_out - fluid.lower)]
@@ -227,7 +178,7 @@ def solve_flow_controlled(fluid, wall, radius, length, q, stretch_guess, m=24, n
         if abs(H / L - 1) < mpf(10) ** (-mp.dps + 5):
             break
     lam_in, _ = state(x_in, fluid.integral(x_in))
-    return wall.pressure(lam_in), lam_in
+    return wall.P(lam_in), lam_in
 
 
 def _guess(fluid, gam):
@@ -242,9 +193,9 @@ def yield_pressure_drop(yield_stress, wall, radius, length):
     r"""The pressure drop as :math:`q \to 0^+`: :math:`G = 2\tau_y/R`, so
     :math:`L = \int_1^{\lambda_{in}} P'(\lambda)\,a\lambda/(2\tau_y)\,d\lambda`; returns :math:`P(\lambda_{in})`."""
     a, L, ty = mpf(radius), mpf(length), mpf(yield_stress)
-    H = lambda lam: mp.quad(lambda s: wall.slope(s) * a * s / (2 * ty), [1, lam])
+    H = lambda lam: mp.quad(lambda s: wall.dP(s) * a * s / (2 * ty), [1, lam])
     lam = mp.findroot(lambda lam: H(lam) - L, mpf(1) + mpf("1e-3"))
-    return wall.pressure(lam)
+    return wall.P(lam)
 
 
 def velocity(rate, radius, gradient, r, yield_stress=0):
