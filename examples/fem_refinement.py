@@ -14,9 +14,12 @@ Then it prints the relative error of every registered thick hyperelastic wall (i
 ``_dW`` as the felupe material) on the default test mesh.
 
 Run: ``MPLBACKEND=Agg python examples/fem_refinement.py [OUT_DIR]`` (default
-``docs/chapter``; writes ``fem_refinement.png``). About a minute.
+``docs/chapter``; writes ``fem_refinement.png``). About a minute. ``--quick`` keeps the two
+coarsest meshes of each element and the neo-Hookean wall only (a few seconds; a smoke test,
+not the published study).
 """
 
+import argparse
 import math
 import sys
 import time
@@ -39,13 +42,14 @@ STUDY = {  # order -> meshes (elements through the wall, elements around the qua
 }
 
 
-def refinement():
+def refinement(levels_per_order=None):
+    """The study of ``STUDY``; ``levels_per_order`` keeps only the coarsest meshes of each element."""
     wall = tubefsi.registry.walls["thick-neo-hookean"](shear_modulus=1.0)
     exact = wall.pressure(np.array(STRETCHES), TB)
     rows = []
     for order, levels in STUDY.items():
         previous = None
-        for nr, nh in levels:
+        for nr, nh in levels[:levels_per_order]:
             t0 = time.perf_counter()
             p = fe.ring_pressure(fe.fem.NeoHooke(mu=1.0), TB, STRETCHES, n_radial=nr, n_hoop=nh, order=order)
             err = float(np.max(np.abs(p / exact - 1.0)))
@@ -56,10 +60,13 @@ def refinement():
     return rows
 
 
-def all_walls():
+def all_walls(names=None):
+    """Every registered thick hyperelastic wall (or those of ``names``) on the default test mesh."""
     rows = []
     for case in fe.THICK_CASES:
         name, params = case.values
+        if names is not None and name not in names:
+            continue
         wall = tubefsi.registry.walls[name](**params)
         lam = fe.test_stretches(wall, TB)
         mu = float(wall._d2W(np.asarray(1.0))) / 4.0
@@ -72,9 +79,15 @@ def all_walls():
     return rows
 
 
-def main(out_dir=ROOT / "docs" / "chapter"):
-    rows = refinement()
-    out = Path(out_dir)
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("out_dir", nargs="?", default=ROOT / "docs" / "chapter",
+                        help="where to write fem_refinement.png (default: the repository's docs/chapter)")
+    parser.add_argument("--quick", action="store_true",
+                        help="two meshes per element, the neo-Hookean wall only (a smoke test)")
+    args = parser.parse_args(sys.argv[1:] if argv is None else argv)
+    rows = refinement(2 if args.quick else None)
+    out = Path(args.out_dir)
     out.mkdir(parents=True, exist_ok=True)
     print(f"thick neo-Hookean ring, t/a = {TB}, stretches {STRETCHES}: max relative error in pressure")
     print(f"{'element':>8} {'mesh':>8} {'error':>10} {'rate':>6} {'time/s':>7}")
@@ -82,7 +95,7 @@ def main(out_dir=ROOT / "docs" / "chapter"):
         print(f"{'Q' + str(r['order']):>8} {r['n_radial']:>3}x{r['n_hoop']:<4} {r['error']:10.3e} "
               f"{r['rate']:6.2f} {r['seconds']:7.2f}")
     print("\nevery registered thick hyperelastic wall, FEM of its own dW vs its tube law (default mesh):")
-    for ident, top, err in all_walls():
+    for ident, top, err in all_walls(("thick-neo-hookean",) if args.quick else None):
         print(f"  {ident:<22} stretches up to {top:5.3f}: max relative error {err:.2e}")
 
     import matplotlib.pyplot as plt
@@ -111,8 +124,10 @@ def main(out_dir=ROOT / "docs" / "chapter"):
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=10)
     fig.savefig(out / "fem_refinement.png", dpi=110)
+    plt.close(fig)
     print(f"\nwrote {out / 'fem_refinement.png'}")
+    return 0
 
 
 if __name__ == "__main__":
-    main(*sys.argv[1:2])
+    sys.exit(main())

@@ -62,5 +62,11 @@ def run(outdir=None):
     return result
 
 
+def main(argv=None):
+    argv = sys.argv[1:] if argv is None else argv
+    run(argv[0] if argv else "out/fit")
+    return 0
+
+
 if __name__ == "__main__":
-    run(sys.argv[1] if len(sys.argv) > 1 else "out/fit")
+    sys.exit(main())

@@ -12,34 +12,41 @@ hyperelastic (solid) against linear (dashed). This script draws each figure twic
     gamma = 3 beta (E = 3 mu: the hyperelastic and the linear wall of one colour have the
     same small-strain stiffness). Thin walls use the chapter's reference-thickness law.
 
-Parameter values (the chapter prints none; :data:`tubefsi.dimensionless.CHAPTER_PARAMETERS`):
+Parameter values (the chapter prints none; :data:`tubefsi.chapter.CHAPTER_PARAMETERS`):
 qbar in [0, 1] (201 points), beta in {0.5, 1, 2}, n in {1, 0.7}, thick t/a = 0.3, nu = 1/2.
-Where a consistent shear-thinning thick tube has a maximum flow rate (DESIGN.md §2.5), its
-curve ends there (marked x).
+Where a consistent shear-thinning thick tube has a maximum flow rate (``docs/theory.md``,
+section "Limits"), its curve ends there (marked x).
 
 Run: ``MPLBACKEND=Agg python examples/reproduce_chapter.py [OUT_DIR]`` (default
 ``out/chapter``); ``--docs`` writes only the PNGs, into ``docs/chapter`` (the figures of
-``docs/verification.md``). The code is :func:`tubefsi.dimensionless.reproduce_chapter`.
+``docs/verification.md``); ``--points N`` draws each curve with N points instead of 201 (a
+quick check). The code is :func:`tubefsi.chapter.reproduce_chapter`.
 """
 
+import argparse
 import sys
 import time
 from pathlib import Path
 
-from tubefsi.dimensionless import reproduce_chapter
+from tubefsi.chapter import reproduce_chapter
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def main(argv=None):
-    args = list(sys.argv[1:] if argv is None else argv)
-    if "--docs" in args:
-        args.remove("--docs")
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("out", nargs="?", default=ROOT / "out" / "chapter", type=Path,
+                        help="output directory (default: the repository's out/chapter)")
+    parser.add_argument("--docs", action="store_true", help="write only the PNGs, into docs/chapter")
+    parser.add_argument("--points", type=int, default=None, metavar="N",
+                        help="points per curve (default 201, the published figures)")
+    args = parser.parse_args(sys.argv[1:] if argv is None else argv)
+    if args.docs:
         out, formats = ROOT / "docs" / "chapter", ("png",)
     else:
-        out, formats = (Path(args[0]) if args else ROOT / "out" / "chapter"), ("png", "csv")
+        out, formats = args.out, ("png", "csv")
     t0 = time.perf_counter()
-    reproduce_chapter(out, formats=formats, file=sys.stdout)
+    reproduce_chapter(out, points=args.points, formats=formats, file=sys.stdout)
     print(f"done in {time.perf_counter() - t0:.1f} s")
     return 0
 

@@ -2,9 +2,12 @@ r"""Stability map: where each tubefsi method fails or loses accuracy, and how it
 
 Run ``python examples/stability_map.py [OUTDIR]`` (default: the repository's ``docs/``); it writes
 ``OUTDIR/stability_map.png`` and prints what every panel found. Headless; about a minute.
+``--quick`` samples each panel at three points only (a smoke test, not the published map).
+The map is discussed in ``docs/stability.md``.
 
-Every number is compared with an independent ``mpmath`` reference (DESIGN.md §2, the same
-code as ``examples/work_precision.py``: tube laws, hand-derived slopes checked against
+Every number is compared with an independent ``mpmath`` reference (the formulas of
+``docs/theory.md``, sections "Tube laws" and "Coupling without an ODE"; the same code as
+``examples/work_precision.py``: tube laws, hand-derived slopes checked against
 ``mpmath.diff``, ``J(λ) = ∫_1^λ P'(s) s^k ds`` by ``mpmath.quad``), at the exact double the
 method receives. Markers: filled = a number and no warning; hollow = a number *and* a warning
 (``tubefsi.AccuracyWarning`` or a SciPy integrator warning); ``×`` on the "raised" line = a
@@ -156,9 +159,9 @@ def odes():
 
 
 # ------------------------------------------------------------------------- (a) singular closed forms
-def panel_singular(ax, log):
+def panel_singular(ax, log, points=31):
     lam_float = 1.5
-    deltas = np.geomspace(1e-16, 1e-1, 31)
+    deltas = np.geomspace(1e-16, 1e-1, points)
     cases = [("thin reference, n → 2/3", "thin-reference", mpf(2) / 3, "tab:blue",
               lambda n, lam: (lam ** (3 * n + 2) - 1) / (3 * n + 2) + 3 * (lam ** (3 * n - 2) - 1) / (3 * n - 2)),
              ("thin current, n → 1", "thin-current", mpf(1), "tab:green",
@@ -221,12 +224,12 @@ def limit_scene():
     return tube, rw, wall, n
 
 
-def panel_max_flow(ax, log):
+def panel_max_flow(ax, log, points=13):
     tube, rw, wall, n = limit_scene()
     fluid = power_law(n)
     k = 3 * mpf(n) + 1
     q_max = ref.power_law_q_max(rw, n, M)
-    lams = np.geomspace(2.0, 1e6, 13)
+    lams = np.geomspace(2.0, 1e6, points)
     q, dps, us = ref.power_law_reference(rw, n, M, lams)
     x = [float(1 - mpf(qi) / q_max) for qi in q]
     floor = []
@@ -260,12 +263,12 @@ def panel_max_flow(ax, log):
     ax.invert_xaxis()
 
 
-def panel_limit_pressure(ax, log):
+def panel_limit_pressure(ax, log, points=12):
     tube, rw, wall, n = limit_scene()
     fluid = power_law(n)
     k = 3 * mpf(n) + 1
     p_lim = rw.limit_pressure()
-    eps_grid = np.geomspace(0.3, 1e-12, 12)
+    eps_grid = np.geomspace(0.3, 1e-12, points)
     x, floor, cases = [], [], []
     with mp.workdps(45):
         for e in eps_grid:
@@ -307,10 +310,10 @@ def panel_limit_pressure(ax, log):
 
 
 # ------------------------------------------------------------------------- (d) strain sweep
-def panel_strain(ax, log):
+def panel_strain(ax, log, points=18):
     tube, rw, wall, n = limit_scene()
     fluid = power_law(n)
-    strains = np.geomspace(1e-15, 1e2, 18)
+    strains = np.geomspace(1e-15, 1e2, points)
     q, dps, us = ref.power_law_reference(rw, n, M, [1 + mpf(float(s)) for s in strains])
     methods = {"tubefsi default": ("auto", "k", "*")} | odes()
     for label, (coupler, color, marker) in methods.items():
@@ -341,9 +344,9 @@ def panel_strain(ax, log):
 
 
 # ------------------------------------------------------------------------- (e, f) heat maps
-def panel_heat(ax, fig, kind, log):
-    ns = np.geomspace(0.1, 3.0, 12)
-    tbs = np.geomspace(1e-3, 1e2, 11)
+def panel_heat(ax, fig, kind, log, n_points=12, tb_points=11):
+    ns = np.geomspace(0.1, 3.0, n_points)
+    tbs = np.geomspace(1e-3, 1e2, tb_points)
     c1, c2 = 1.5e3, -0.5e3
     if kind == "thick":
         wall = walls["thick-mooney-rivlin"](c1=c1, c2=c2)
@@ -398,9 +401,13 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("outdir", nargs="?", default=pathlib.Path(__file__).resolve().parents[1] / "docs",
                         help="where to write stability_map.png")
+    parser.add_argument("--quick", action="store_true",
+                        help="three points per panel, 3 x 3 heat maps (a smoke test, seconds)")
     args = parser.parse_args(argv)
     outdir = pathlib.Path(args.outdir)
     outdir.mkdir(parents=True, exist_ok=True)
+    line = dict(points=3) if args.quick else {}                      # the line panels (a)-(d)
+    heat = dict(n_points=3, tb_points=3) if args.quick else {}       # the heat maps (e, f)
     mp.dps = 30
     t0 = time.perf_counter()
     fig, axes = plt.subplots(2, 3, figsize=(19, 12.5), constrained_layout=True)
@@ -409,11 +416,11 @@ def main(argv=None) -> int:
               (panel_strain, axes[1, 0])]
     for fn, ax in panels:
         t = time.perf_counter()
-        fn(ax, log)
+        fn(ax, log, **line)
         log.append(f"   [{fn.__name__}: {time.perf_counter() - t:.1f} s]")
     for kind, ax in (("thick", axes[1, 1]), ("thin-current", axes[1, 2])):
         t = time.perf_counter()
-        panel_heat(ax, fig, kind, log)
+        panel_heat(ax, fig, kind, log, **heat)
         log.append(f"   [heat map {kind}: {time.perf_counter() - t:.1f} s]")
     fig.legend(handles=status_marks(), loc="outside lower center", ncol=6, fontsize=10, frameon=False)
     fig.suptitle("tubefsi stability map: errors against an independent mpmath reference", fontsize=12)

@@ -2,7 +2,9 @@ r"""Work–precision chart: relative error against time per point for every tube
 
 Run ``python examples/work_precision.py [OUTDIR]`` (default: the repository's ``docs/``); it writes
 ``OUTDIR/work_precision.png`` and prints a table (error, time per point, speed ratio against
-the chapter's method). Headless (matplotlib Agg); about 70 s on two cores.
+the chapter's method). Headless (matplotlib Agg); about 70 s on two cores. ``--quick`` runs
+every step at small sizes (3 reference points, 2 quadrature orders, one ODE method at one
+tolerance, a tiny time budget: seconds; a smoke test, not the published chart).
 
 Scenes (tube: a = 100 µm, t = 30 µm, L = 1 cm; power-law fluid m = 0.017 Pa s^n, n = 0.7)
 --------------------------------------------------------------------------------------------
@@ -28,15 +30,18 @@ ratios are against ``ODE(method="odeint")``.
 
 Reference values (independent of tubefsi's numerics)
 -----------------------------------------------------
-All references are computed with ``mpmath`` at ``mp.dps = 30`` straight from DESIGN.md §2:
+All references are computed with ``mpmath`` at ``mp.dps = 30`` straight from the formulas of
+``docs/theory.md``:
 
-* tube laws (§2.3): thin reference ``P = μ t̄ (λ − λ⁻³)``; thick (Lamé)
+* tube laws (section "Tube laws"): thin reference ``P = μ t̄ (λ − λ⁻³)``; thick (Lamé)
   ``P = (μ/2)[f(x_o) − f(x_i)]``, ``f(x) = x + ln x``, ``x_o = b/(b − 1 + λ²)``, ``x_i = λ⁻²``,
   ``b = (1 + t̄)²``, ``μ = 2(c1 + c2)``; hand-derived slopes ``P' = μ t̄ (1 + 3 s⁻⁴)`` and
   ``P' = μ d ((d+2) s² + d) / (s³ (s² + d)²)``, ``d = b − 1`` (checked against ``mpmath.diff``
   of ``P`` when the script starts);
-* power law (§2.2): ``G(q, R) = φ(q) R^−k``, ``k = 3n + 1``, ``φ(q) = 2m[(3n+1)q/(πn)]^n``;
-  separation (§2.4) with the outlet at zero pressure: ``L φ(q) = a^k ∫_1^λin P'(s) s^k ds``
+* power law (section "The flow law of a generalized Newtonian fluid"):
+  ``G(q, R) = φ(q) R^−k``, ``k = 3n + 1``, ``φ(q) = 2m[(3n+1)q/(πn)]^n``;
+  separation (section "Coupling without an ODE") with the outlet at zero pressure:
+  ``L φ(q) = a^k ∫_1^λin P'(s) s^k ds``
   (a positive integrand, ``mpmath.quad`` on geometrically split intervals — no cancellation,
   also at λ = 2000). Each scene picks exact inlet stretches λ, gets ``q``, rounds it to the
   double that the methods receive, and moves λ by one Newton step so that the reference is the
@@ -84,12 +89,12 @@ import matplotlib.pyplot as plt  # noqa: E402
 import mpmath  # noqa: E402
 import numpy as np  # noqa: E402
 from mpmath import mp, mpf  # noqa: E402
-from scipy.integrate import odeint  # noqa: E402
 
 import tubefsi  # noqa: E402
 from tubefsi.couplers import ODE, ClosedForm, Quadrature  # noqa: E402
 from tubefsi.registry import rheologies, walls  # noqa: E402
 from tubefsi.rheology import Rheology  # noqa: E402
+from tubefsi.testing.reference.chapter_baseline import chapter_thick, chapter_thin  # noqa: E402
 
 mp.dps = 30
 
@@ -106,9 +111,28 @@ ODE_METHODS = ("DOP853", "LSODA", "Radau")
 ERROR_FLOOR = 1e-16
 
 
+@attrs.frozen
+class Sizes:
+    """How much the chart measures: the published chart by default, :data:`QUICK` for a smoke test."""
+
+    n_ref: int = N_REF                  # reference points of scenes 1-3
+    n_vector: int = N_VECTOR            # flow rates per timed call of a vectorized method, scenes 1-3
+    carreau_ref: int = 10               # the same two for scene 4
+    carreau_vector: int = 400
+    budget: float = BUDGET
+    quad_orders: tuple = QUAD_ORDERS
+    rtols: tuple = RTOLS
+    ode_methods: tuple = ODE_METHODS
+
+
+#: ``--quick``: every scene and every kind of method once, at small sizes (seconds)
+QUICK = Sizes(n_ref=3, n_vector=20, carreau_ref=2, carreau_vector=10, budget=0.01, quad_orders=(8, 24),
+              rtols=(1e-6,), ode_methods=("LSODA",))
+
+
 # ============================================================================ reference (mpmath)
 class RefWall:
-    """Tube law P(λ) and its hand-derived slope P'(λ) in mpmath (DESIGN.md §2.3).
+    """Tube law P(λ) and its hand-derived slope P'(λ) in mpmath (``docs/theory.md``, "Tube laws").
 
     ``kind``: "thin-reference" (μ t̄ (λ − λ⁻³)), "thin-current" (μ t̄ (1 − λ⁻⁴), P' = 4 μ t̄ λ⁻⁵)
     or "thick" (Lamé); ``mu`` is the shear modulus, 2 (c1 + c2) for Mooney–Rivlin.
@@ -317,35 +341,9 @@ def carreau_reference(fluid, wall, qs, a=A, length=LEN):
 
 
 # ============================================================================ the chapter's method
-# copied from benchmarks/speed.py (a lean scalar odeint per point, default tolerances), returning
-# the inlet displacement as well
-def chapter_thick(q, n, m, mu, tube):
-    a, L, tb = tube.radius, tube.length, tube.reduced_thickness
-    d = tb * (2 + tb)
-    phi = 2 * m * ((3 * n + 1) * q / (math.pi * n)) ** n
-    k = 3 * n + 1
-
-    def rhs(lam, z):
-        lam2 = lam * lam
-        slope = mu * lam * d * (lam2 * (d + 2) + d) / (lam2 * lam2 * (lam2 + d) ** 2)
-        return -phi * (a * lam) ** -k / slope
-
-    lam_in = odeint(rhs, 1.0, [L, 0.0])[-1, 0]
-    x = lam_in**2 - 1
-    b = (1 + tb) ** 2
-    return 0.5 * mu * (math.log1p(x * d / (b + x)) + x * d / ((1 + x) * (b + x))), a * (lam_in - 1)
-
-
-def chapter_thin(q, n, m, mu, tube):
-    a, L, tb = tube.radius, tube.length, tube.reduced_thickness
-    phi = 2 * m * ((3 * n + 1) * q / (math.pi * n)) ** n
-    k = 3 * n + 1
-
-    def rhs(lam, z):
-        return -phi * (a * lam) ** -k / (mu * tb * (1 + 3 * lam**-4))
-
-    lam_in = odeint(rhs, 1.0, [L, 0.0])[-1, 0]
-    return mu * tb * (lam_in - lam_in**-3), a * (lam_in - 1)
+# chapter_thick, chapter_thin (imported above) come from tubefsi.testing.reference.chapter_baseline,
+# shared with benchmarks/speed.py: a lean scalar odeint per point at default tolerances, returning
+# (pressure drop, inlet displacement).
 
 
 # ============================================================================ scenes
@@ -364,7 +362,7 @@ class Scene:
     note: str = ""
 
 
-def build_scenes():
+def build_scenes(sizes=Sizes()):
     tb = TUBE.reduced_thickness
     fluid = rheologies["power-law"](consistency=M_FLUID, index=N_FLUID)
     scenes = []
@@ -372,10 +370,11 @@ def build_scenes():
     mu = 2e3
     thin = RefWall("thin-reference", mu, tb)
     thin.check_slope()
-    q, dp, u = power_law_reference(thin, N_FLUID, M_FLUID, 1 + np.geomspace(0.01, 3, N_REF))
+    q, dp, u = power_law_reference(thin, N_FLUID, M_FLUID, 1 + np.geomspace(0.01, 3, sizes.n_ref))
     scenes.append(Scene("thin", "1. thin neo-Hookean (ref. thickness), power law n = 0.7: closed form",
                         fluid, walls["thin-neo-hookean"](shear_modulus=mu, thickness_convention="reference"),
-                        q, dp, u, baseline=lambda qi: chapter_thin(qi, N_FLUID, M_FLUID, mu, TUBE)))
+                        q, dp, u, baseline=lambda qi: chapter_thin(qi, N_FLUID, M_FLUID, mu, TUBE),
+                        n_vector=sizes.n_vector))
 
     c1, c2 = 1.5e3, -0.5e3
     mu = 2 * (c1 + c2)
@@ -383,23 +382,26 @@ def build_scenes():
     thick.check_slope()
     mr = walls["thick-mooney-rivlin"](c1=c1, c2=c2)
     q_max = power_law_q_max(thick, N_FLUID, M_FLUID)
-    q, dp, u = power_law_reference(thick, N_FLUID, M_FLUID, 1 + np.geomspace(0.02, 1.5, N_REF))
+    q, dp, u = power_law_reference(thick, N_FLUID, M_FLUID, 1 + np.geomspace(0.02, 1.5, sizes.n_ref))
     scenes.append(Scene("moderate", "2. thick Mooney–Rivlin, power law n = 0.7: moderate load",
                         fluid, mr, q, dp, u, baseline=lambda qi: chapter_thick(qi, N_FLUID, M_FLUID, mu, TUBE),
-                        note=f"q/q_max {q.min() / float(q_max):.3g}–{q.max() / float(q_max):.3g}"))
-    q, dp, u = power_law_reference(thick, N_FLUID, M_FLUID, np.geomspace(10, 2000, N_REF))
+                        note=f"q/q_max {q.min() / float(q_max):.3g}–{q.max() / float(q_max):.3g}",
+                        n_vector=sizes.n_vector))
+    q, dp, u = power_law_reference(thick, N_FLUID, M_FLUID, np.geomspace(10, 2000, sizes.n_ref))
     p_lim = thick.mu * mpmath.log(1 + thick.tb)
     scenes.append(Scene("limit", "3. thick Mooney–Rivlin, power law n = 0.7: near the maximum flow rate",
                         fluid, mr, q, dp, u, baseline=lambda qi: chapter_thick(qi, N_FLUID, M_FLUID, mu, TUBE),
                         note=f"q/q_max {q.min() / float(q_max):.4f}–{q.max() / float(q_max):.4f}, "
-                             f"1 - dp/p_lim down to {float(1 - max(dp) / p_lim):.1e}"))
+                             f"1 - dp/p_lim down to {float(1 - max(dp) / p_lim):.1e}",
+                        n_vector=sizes.n_vector))
 
     carreau = Carreau()
     nh = RefWall("thick", 2e3, tb)
-    q, dp, u = carreau_reference(carreau, nh, np.geomspace(2e-11, 1.2e-9, 10))
+    q, dp, u = carreau_reference(carreau, nh, np.geomspace(2e-11, 1.2e-9, sizes.carreau_ref))
     scenes.append(Scene("carreau", "4. Carreau fluid (non-separable), thick neo-Hookean",
                         carreau, walls["thick-neo-hookean"](shear_modulus=2e3), q, dp, u,
-                        n_vector=400, n_per_point=10, note="ratios against ODE(method='odeint')"))
+                        n_vector=sizes.carreau_vector, n_per_point=sizes.carreau_ref,
+                        note="ratios against ODE(method='odeint')"))
     return scenes
 
 
@@ -430,17 +432,17 @@ def ode(method, rtol=None):
         return ODE(method=method, **kw)
 
 
-def methods_for(scene):
+def methods_for(scene, sizes=Sizes()):
     """(family, label, coupler or callable, per_point)."""
     out = [("auto", "auto (default)", "auto", False)]
     if scene.key == "thin":
         out.append(("closed form", "ClosedForm()", ClosedForm(), False))
-    for k in QUAD_ORDERS:
+    for k in sizes.quad_orders:
         out.append(("quadrature", f"Quadrature(order={k})", Quadrature(order=k, check_error=False), False))
     # the generic (non-separable) flow law makes each right-hand side evaluation a root find:
     # fewer tolerances there keep the script within a few minutes
-    rtols = RTOLS[::2] if scene.key == "carreau" else RTOLS
-    for method in ODE_METHODS:
+    rtols = sizes.rtols[::2] if scene.key == "carreau" else sizes.rtols
+    for method in sizes.ode_methods:
         for rtol in rtols:
             if method == "Radau" and rtol < 1e-10:
                 continue           # minutes per point near the limit; adds nothing to the chart
@@ -451,20 +453,21 @@ def methods_for(scene):
     return out
 
 
-def repeats(pilot, count):
+def repeats(pilot, count, budget=BUDGET):
     """Best of 3 for per-point methods when that fits the time budget, else a single pass."""
-    return 3 if 3 * pilot * count < BUDGET else 1
+    return 3 if 3 * pilot * count < budget else 1
 
 
-def run_method(scene, coupler, per_point):
+def run_method(scene, coupler, per_point, budget=BUDGET):
     """Return (time per point, error, n points timed, note)."""
     q_ref = scene.q_ref
     if callable(coupler) and not isinstance(coupler, tubefsi.couplers.Coupler):
         pilot = best_of(lambda: coupler(q_ref[-1]), 1)
-        count = int(min(scene.n_per_point, max(5, BUDGET / max(pilot, 1e-9))))
+        count = int(min(scene.n_per_point, max(5, budget / max(pilot, 1e-9))))
         idx = np.unique(np.linspace(0, q_ref.size - 1, count).round().astype(int))
         res = []
-        elapsed = best_of(lambda: res.append([coupler(qi) for qi in q_ref[idx]]), repeats(pilot, idx.size))
+        elapsed = best_of(lambda: res.append([coupler(qi) for qi in q_ref[idx]]),
+                          repeats(pilot, idx.size, budget))
         dp, u = zip(*res[-1])
         return elapsed / idx.size, max_error(dp, u, [scene.dp_ref[i] for i in idx],
                                              [scene.u_ref[i] for i in idx]), idx.size, ""
@@ -477,10 +480,10 @@ def run_method(scene, coupler, per_point):
         try:
             if per_point:
                 pilot = best_of(lambda: solve(q_ref[-1:]), 1)
-                count = int(min(scene.n_per_point, max(3, BUDGET / max(pilot, 1e-9))))
+                count = int(min(scene.n_per_point, max(3, budget / max(pilot, 1e-9))))
                 idx = np.unique(np.linspace(0, q_ref.size - 1, count).round().astype(int))
                 sols = []
-                per = best_of(lambda: sols.append(solve(q_ref[idx])), repeats(pilot, idx.size)) / idx.size
+                per = best_of(lambda: sols.append(solve(q_ref[idx])), repeats(pilot, idx.size, budget)) / idx.size
                 sol = sols[-1]
             else:
                 idx = np.arange(q_ref.size)
@@ -567,18 +570,20 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("outdir", nargs="?", default=pathlib.Path(__file__).resolve().parents[1] / "docs",
                         help="where to write work_precision.png")
+    parser.add_argument("--quick", action="store_true", help="every step at small sizes (a smoke test, seconds)")
     args = parser.parse_args(argv)
     outdir = pathlib.Path(args.outdir)
     outdir.mkdir(parents=True, exist_ok=True)
+    sizes = QUICK if args.quick else Sizes()
 
     t_start = time.perf_counter()
-    scenes = build_scenes()
+    scenes = build_scenes(sizes)
     print(f"references: {time.perf_counter() - t_start:.1f} s (mpmath, dps {mp.dps})")
     results = {}
     for scene in scenes:
         rows = []
-        for fam, label, coupler, per_point in methods_for(scene):
-            per, err, count, note = run_method(scene, coupler, per_point)
+        for fam, label, coupler, per_point in methods_for(scene, sizes):
+            per, err, count, note = run_method(scene, coupler, per_point, sizes.budget)
             rows.append((fam, label, per, err, count, note))
         base_fam = "chapter" if scene.baseline is not None else "odeint"
         base = next(per for fam, _, per, *_ in rows if fam == base_fam)
