@@ -1,9 +1,9 @@
 """The chapter's printed inconsistencies and what they change (docs/verification.md).
 
 Each test backs one claim of the verification page, and would fail if the claim were false.
-"As printed" means the chapter's own equations (tubefsi.dimensionless.printed_*); "consistent"
+"As printed" means the chapter's own equations (tubefsi.chapter.printed_*); "consistent"
 means tubefsi.solve of the physical scene (tubefsi.dimensionless.scene), whose formulas are
-derived from the tube law and the flow law (DESIGN.md §2) and checked against an independent
+derived from the tube law and the flow law (docs/theory.md) and checked against an independent
 high-precision reference and, for the tube laws, against finite elements (test_fem_tube_laws).
 """
 
@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 import tubefsi
+from tubefsi import chapter
 from tubefsi import dimensionless as nd
 from tubefsi.registry import walls
 from tubefsi.walls.hyperelastic import HyperelasticWall
@@ -103,32 +104,35 @@ def test_printed_closed_form_integrates_an_ode_without_the_factor_3(n, lam):
 @pytest.mark.parametrize("gamma", [0.2, 1.0, 3.0])
 def test_corrected_thin_closed_form_agrees_with_tubefsi(n, gamma):
     q = QBAR[::20]
-    np.testing.assert_allclose(nd.thin_reference_pressure_drop(n, gamma, q), consistent(n, q, gamma=gamma),
+    np.testing.assert_allclose(chapter.thin_reference_pressure_drop(n, gamma, q), consistent(n, q, gamma=gamma),
                                rtol=1e-12)
 
 
 def test_printed_thin_closed_form_overestimates_the_pressure_drop():
     """By 43 % at n = 1, gamma = 1, qbar = 0.1; 36 % at n = 0.7; 3 % at n = 1, gamma = 3, qbar = 1."""
     for n, g, q, excess in [(1.0, 1.0, 0.1, 0.435), (0.7, 1.0, 0.1, 0.365), (1.0, 3.0, 1.0, 0.031)]:
-        assert nd.printed_thin_pressure_drop(n, g, q) / consistent(n, q, gamma=g) - 1 == pytest.approx(excess, abs=1e-3)
+        assert chapter.printed_thin_pressure_drop(n, g, q) / consistent(n, q, gamma=g) - 1 == pytest.approx(excess, abs=1e-3)
     for n in INDICES:
         for g in (1 / 6, 1 / 3, 2 / 3, 1.5, 3.0, 6.0):
-            assert np.all(nd.printed_thin_pressure_drop(n, g, QBAR) > consistent(n, QBAR, gamma=g))
+            assert np.all(chapter.printed_thin_pressure_drop(n, g, QBAR) > consistent(n, QBAR, gamma=g))
 
 
 @pytest.mark.parametrize("n", INDICES)
 def test_printed_thin_closed_form_misses_hagen_poiseuille_by_2(n):
     """As qbar -> 0 the tube is rigid: dpbar -> 2X. The printed closed form gives 4X."""
     q = 1e-12
-    assert nd.printed_thin_pressure_drop(n, 1.0, q) / (2 * flow_factor(n, q)) == pytest.approx(2.0, rel=1e-5)
+    assert chapter.printed_thin_pressure_drop(n, 1.0, q) / (2 * flow_factor(n, q)) == pytest.approx(2.0, rel=1e-5)
     assert consistent(n, q, gamma=1.0) / (2 * flow_factor(n, q)) == pytest.approx(1.0, rel=1e-5)
 
 
 # =============================================================================== 3. factor 4 (thick)
 def test_printed_thick_ode_numbers():
-    """n = 0.7, gamma = 1, qbar = 0.5, t/a = 0.3: printed ODE 0.558, consistent 0.870 (DESIGN.md §2.6)."""
-    printed = nd.printed_thick_pressure_drop(0.7, 1.0, 0.5, TB)
-    fixed = nd.printed_thick_pressure_drop(0.7, 1.0, 0.5, TB, factor=4.0)
+    """n = 0.7, gamma = 1, qbar = 0.5, t/a = 0.3: printed ODE 0.558, consistent 0.870.
+
+    docs/verification.md, section "The chapter's printed inconsistencies", item 3.
+    """
+    printed = chapter.printed_thick_pressure_drop(0.7, 1.0, 0.5, TB)
+    fixed = chapter.printed_thick_pressure_drop(0.7, 1.0, 0.5, TB, factor=4.0)
     assert round(printed, 3) == 0.558
     assert round(consistent(0.7, 0.5, tb=TB, gamma=1.0), 3) == 0.870
     assert fixed == pytest.approx(consistent(0.7, 0.5, tb=TB, gamma=1.0), rel=1e-10)
@@ -139,7 +143,7 @@ def test_printed_thick_ode_numbers():
 def test_thick_ode_with_factor_4_agrees_with_tubefsi(n, gamma, tb):
     sc = nd.scene(index=n, reduced_thickness=tb, qbar=0.1, gamma=gamma)
     q = QBAR[::10][QBAR[::10] < sc.max_qbar()]
-    np.testing.assert_allclose(nd.printed_thick_pressure_drop(n, gamma, q, tb, factor=4.0),
+    np.testing.assert_allclose(chapter.printed_thick_pressure_drop(n, gamma, q, tb, factor=4.0),
                                consistent(n, q, tb=tb, gamma=gamma), rtol=1e-9)
 
 
@@ -147,7 +151,7 @@ def test_printed_thick_brace_is_the_tube_law_slope():
     """The printed left side is right: the brace is -P'(lam)/(c1+c2); only the right side's factor is off."""
     wall = walls["thick-mooney-rivlin"](c1=0.7, c2=-0.2)
     u = np.linspace(0.0, 4.0, 41)
-    np.testing.assert_allclose(nd._thick_brace(u, TB), -wall.stiffness(1 + u, TB) / (wall.c1 + wall.c2),
+    np.testing.assert_allclose(chapter._thick_brace(u, TB), -wall.stiffness(1 + u, TB) / (wall.c1 + wall.c2),
                                rtol=1e-12, atol=1e-14)
 
 
@@ -161,7 +165,7 @@ def test_tubefsi_profiles_satisfy_the_thick_ode_with_factor_4(n, gamma, qbar):
     h = 1e-4 * L
     u = sol.displacement(z) / a
     dudz = (sol.displacement(z + h) - sol.displacement(z - h)) / (2 * h) * L / a     # d ubar / d zbar
-    ratio = nd._thick_brace(u, TB) * dudz / (TB * gamma * flow_factor(n, qbar) * (1 + u) ** -(1 + 3 * n))
+    ratio = chapter._thick_brace(u, TB) * dudz / (TB * gamma * flow_factor(n, qbar) * (1 + u) ** -(1 + 3 * n))
     np.testing.assert_allclose(ratio, 4.0, rtol=1e-6)
 
 
@@ -177,7 +181,7 @@ def test_printed_thick_pressure_gradient_relation_lacks_2_tb(n, gamma, qbar):
     u = sol.displacement(z) / a
     dudz = (sol.displacement(z + h) - sol.displacement(z - h)) / (2 * h) * L / a
     dpdz = (sol.pressure(z + h) - sol.pressure(z - h)) / (2 * h) * L / pc
-    np.testing.assert_allclose(-nd._thick_brace(u, TB) * dudz / (gamma * dpdz), 2 * TB, rtol=1e-6)
+    np.testing.assert_allclose(-chapter._thick_brace(u, TB) * dudz / (gamma * dpdz), 2 * TB, rtol=1e-6)
 
 
 @pytest.mark.parametrize("n", INDICES)
@@ -185,7 +189,7 @@ def test_printed_thick_pressure_gradient_relation_lacks_2_tb(n, gamma, qbar):
 def test_printed_thick_ode_misses_hagen_poiseuille_by_4(n, tb):
     """As qbar -> 0: dpbar -> 2X consistently, X/2 from the printed ODE (any gamma, t/a)."""
     q = 1e-12
-    assert nd.printed_thick_pressure_drop(n, 0.7, q, tb) / (2 * flow_factor(n, q)) == pytest.approx(0.25, rel=1e-5)
+    assert chapter.printed_thick_pressure_drop(n, 0.7, q, tb) / (2 * flow_factor(n, q)) == pytest.approx(0.25, rel=1e-5)
     assert consistent(n, q, tb=tb, gamma=0.7) / (2 * flow_factor(n, q)) == pytest.approx(1.0, rel=1e-5)
 
 
@@ -327,8 +331,8 @@ def test_thin_conclusion_reverses(n, beta):
     """Chapter: at the same FSI parameter the (stiffer) hyperelastic tube needs the higher pressure
     drop. True only as printed; at equal E it needs a lower one, at every qbar."""
     lin = linear(n, QBAR, beta)
-    assert np.all(nd.printed_thin_pressure_drop(n, beta / 3, QBAR) > lin)                    # as printed
-    assert np.all(nd.thin_reference_pressure_drop(n, beta / 3, QBAR) > lin)    # factor 3 fixed, gamma = beta/3
+    assert np.all(chapter.printed_thin_pressure_drop(n, beta / 3, QBAR) > lin)                    # as printed
+    assert np.all(chapter.thin_reference_pressure_drop(n, beta / 3, QBAR) > lin)    # factor 3 fixed, gamma = beta/3
     assert np.all(consistent(n, QBAR, gamma=3 * beta) < lin)                                   # consistent
 
 
@@ -339,14 +343,14 @@ def test_thick_crossing_is_an_artifact(n):
     the hyperelastic tube needs the lower pressure drop at every qbar and beta. The crossing
     needs both errors: with the factor 4 alone restored the (9x stiffer) hyperelastic curve lies
     above the linear one everywhere, with the labelling alone fixed below it everywhere."""
-    printed_hyper = nd.printed_thick_pressure_drop(n, 2.0 / 3, QBAR, TB)
+    printed_hyper = chapter.printed_thick_pressure_drop(n, 2.0 / 3, QBAR, TB)
     lin = linear(n, QBAR, 2.0, tb=TB)
     assert np.any(printed_hyper < lin) and np.any(printed_hyper > lin)
     assert printed_hyper[0] < lin[0] and printed_hyper[-1] > lin[-1]
     for beta in BETAS:
         lin = linear(n, QBAR, beta, tb=TB)
-        assert np.all(nd.printed_thick_pressure_drop(n, beta / 3, QBAR, TB, factor=4.0) > lin)
-        label_only = nd.printed_thick_pressure_drop(n, 3 * beta, QBAR, TB)
+        assert np.all(chapter.printed_thick_pressure_drop(n, beta / 3, QBAR, TB, factor=4.0) > lin)
+        label_only = chapter.printed_thick_pressure_drop(n, 3 * beta, QBAR, TB)
         ok = np.isfinite(label_only)
         assert ok.sum() > 50 and np.all(label_only[ok] < lin[ok])
         sc = nd.scene(index=n, reduced_thickness=TB, qbar=0.1, gamma=3 * beta)
@@ -372,7 +376,7 @@ def test_shear_thinning_thick_tubes_have_a_maximum_flow_rate_within_the_figure()
         assert nd.scene(index=0.7, reduced_thickness=TB, qbar=0.1, gamma=3 * beta).max_qbar() == pytest.approx(
             expected, abs=1e-3)
         for n in INDICES:
-            printed = nd.printed_thick_pressure_drop(n, beta / 3, QBAR, TB)
+            printed = chapter.printed_thick_pressure_drop(n, beta / 3, QBAR, TB)
             assert np.all(np.isfinite(printed)) and np.all(np.diff(printed) > 0)
 
 
@@ -399,8 +403,8 @@ def test_pressure_drop_falls_with_beta_unchanged(theory):
     """Chapter: dpbar decreases as beta grows. Holds both as printed and consistently."""
     tb = TB if theory == "thick" else None
     q = np.array([0.02, 0.05])
-    printed = [nd.printed_thin_pressure_drop(1.0, b / 3, q) if tb is None
-               else nd.printed_thick_pressure_drop(1.0, b / 3, q, tb) for b in BETAS]
+    printed = [chapter.printed_thin_pressure_drop(1.0, b / 3, q) if tb is None
+               else chapter.printed_thick_pressure_drop(1.0, b / 3, q, tb) for b in BETAS]
     fixed = [consistent(1.0, q, tb=tb, gamma=3 * b) for b in BETAS]
     lin = [linear(1.0, q, b, tb=tb) for b in BETAS]
     for curves in (printed, fixed, lin):
@@ -418,7 +422,7 @@ def test_thickness_effect_holds_at_fixed_gamma_and_reverses_at_fixed_modulus():
 
 # =============================================================================== the reproduction
 def test_reproduction_writes_both_figures_both_ways(tmp_path):
-    paths = nd.reproduce_chapter(tmp_path, points=21)
+    paths = chapter.reproduce_chapter(tmp_path, points=21)
     names = sorted(p.name for p in paths)
     assert names == sorted(f"{f}_{v}.{e}" for f in ("thin", "thick") for v in ("printed", "consistent")
                            for e in ("png", "csv"))
@@ -429,13 +433,13 @@ def test_reproduction_writes_both_figures_both_ways(tmp_path):
 
 
 def test_chapter_curves_match_the_functions_they_plot():
-    (hyper, lin, *_), = [nd.chapter_curves("thick", "printed", points=11)]
+    (hyper, lin, *_), = [chapter.chapter_curves("thick", "printed", points=11)]
     assert hyper["gamma"] == pytest.approx(BETAS[0] / 3) and lin["wall"] == "linear"
-    np.testing.assert_allclose(hyper["dpbar"], nd.printed_thick_pressure_drop(1.0, BETAS[0] / 3, hyper["qbar"], TB))
-    hyper, lin, *_ = nd.chapter_curves("thin", "consistent", points=11)
+    np.testing.assert_allclose(hyper["dpbar"], chapter.printed_thick_pressure_drop(1.0, BETAS[0] / 3, hyper["qbar"], TB))
+    hyper, lin, *_ = chapter.chapter_curves("thin", "consistent", points=11)
     assert hyper["gamma"] == pytest.approx(3 * BETAS[0])
     np.testing.assert_allclose(hyper["dpbar"], consistent(1.0, hyper["qbar"], gamma=3 * BETAS[0]), rtol=1e-14)
-    np.testing.assert_allclose(lin["dpbar"], nd.linear_pressure_drop(1.0, BETAS[0], lin["qbar"]), rtol=1e-12)
+    np.testing.assert_allclose(lin["dpbar"], chapter.linear_pressure_drop(1.0, BETAS[0], lin["qbar"]), rtol=1e-12)
 
 
 @pytest.mark.parametrize("n", INDICES + (2 / 3,))
@@ -443,5 +447,5 @@ def test_chapter_curves_match_the_functions_they_plot():
 def test_chapter_linear_closed_forms_agree_with_tubefsi(n, tb):
     """Its linear formulas (eq. q-dp-linear-elastic, q-dp-linear-elastic-thick) are right."""
     for beta in BETAS:
-        np.testing.assert_allclose(nd.linear_pressure_drop(n, beta, QBAR, reduced_thickness=tb),
+        np.testing.assert_allclose(chapter.linear_pressure_drop(n, beta, QBAR, reduced_thickness=tb),
                                    linear(n, QBAR, beta, tb=tb), rtol=1e-12)

@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 
 import tubefsi
 from tubefsi import dimensionless as nd
-from tubefsi._validation import real
+from tubefsi.fields import real
 from tubefsi.registry import rheologies, walls
 from tubefsi.rheology.base import Rheology
 from tubefsi.walls.hyperelastic import HyperelasticWall, ThickWall

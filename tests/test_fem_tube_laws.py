@@ -1,7 +1,7 @@
 r"""An independent check of the tube laws: finite-element inflation of a plane-strain ring.
 
-The tube laws of DESIGN.md §2.3 are derived (the thick one from the Lamé problem, the thin
-ones from membrane theory). Here felupe — a maintained hyperelastic finite-element library
+The tube laws of ``docs/theory.md``, section "Tube laws", are derived (the thick one from the
+Lamé problem, the thin ones from membrane theory). Here felupe — a maintained hyperelastic finite-element library
 (the ``verify`` extra) — solves the same boundary-value problem from the 3-D strain energy,
 with none of tubefsi's reductions: a quarter ring :math:`a \le r \le a(1+\bar t)` in plane
 strain, symmetry on both cut faces, the inner surface moved radially to the stretch
@@ -320,7 +320,8 @@ def test_thin_current_thickness_law_matches_fem_of_a_thin_ring(name, params, thi
 @pytest.mark.parametrize(("name", "params"), BUILTIN_THIN)
 def test_thin_reference_thickness_law_is_off_by_the_stretch(name, params, thin_ring_cache):
     """The chapter's thin law (undeformed thickness) overestimates the exact ring by the
-    factor lambda: 1 % at stretch 1.01, 200 % at stretch 3 (DESIGN.md §2.6, item 4)."""
+    factor lambda: 1 % at stretch 1.01, 200 % at stretch 3 (``docs/verification.md``, section
+    "The chapter's printed inconsistencies", item 4)."""
     wall = walls[name](**params, thickness_convention="reference")
     lam = np.array(STRETCHES)
     p_fem = _thin_fem(thin_ring_cache, name, params)

@@ -1,4 +1,6 @@
-"""Limiting cases of DESIGN §2.5 through the whole solver, and agreement of the ODE path.
+"""Limiting cases through the whole solver, and agreement of the ODE path.
+
+The limits are derived in ``docs/theory.md``, section "Limits".
 
 Every reference here is independent of the code path under test: Hagen–Poiseuille in
 closed form, the Newtonian class against the power law, the linear wall against the

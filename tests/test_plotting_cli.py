@@ -349,7 +349,7 @@ def test_parse_model_spec():
     assert cli.parse_model_spec("a:x=1,y=2.5e3,z=current") == ("a", {"x": 1, "y": 2500.0, "z": "current"})
 
 
-# ---------------------------------------------------------------------------- console script, demo
+# ---------------------------------------------------------------------------- console script
 def _console_script():
     exe = Path(sys.executable).with_name("tubefsi")
     return exe if exe.exists() else shutil.which("tubefsi")
@@ -366,16 +366,3 @@ def test_console_script():
     good = subprocess.run([exe, "solve", *SCENE_ARGS, "--flow-rate", "1e-9", "--json"], capture_output=True,
                           text=True, check=True)
     assert json.loads(good.stdout)["pressure_drop"] == tubefsi.solve(FLUID, SOFT, TUBE, flow_rate=1e-9).pressure_drop
-
-
-def test_cli_demo_writes_figures(tmp_path, capsys):
-    out = tmp_path / "demo"
-    assert cli.main(["demo", "--out", str(out)]) == 0
-    text = capsys.readouterr().out
-    for name in ("rigid", "thin-linear", "thick-linear", "thin-neo-hookean", "thick-neo-hookean",
-                 "maximum steady flow rate"):
-        assert name in text
-    pngs = sorted(p.name for p in out.glob("*.png"))
-    assert pngs == ["deformed_tube.png", "flow_curves.png", "profiles.png", "tube_laws.png"]
-    for p in out.glob("*.png"):
-        assert p.stat().st_size > 10_000

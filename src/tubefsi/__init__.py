@@ -8,18 +8,24 @@ Quick start::
     wall = tubefsi.registry.walls["thick-neo-hookean"](shear_modulus=2e3)
     sol = tubefsi.solve(fluid, wall, tube, flow_rate=1e-9)
     sol.pressure_drop, sol.inlet_displacement
+
+The package is layered, lowest first (``docs/architecture.md``):
+``errors``, ``fields`` and ``registry``; the models (``geometry``, ``rheology``, ``walls``);
+``scene``; ``couplers``; ``solution``; ``solve``; then ``advise``, ``fit``, ``dimensionless``,
+``chapter``, ``plotting``, ``cli`` and ``testing``. A module imports only from its own layer
+or below (``tests/test_architecture.py``).
 """
 
-from . import dimensionless, registry
+from . import dimensionless, fields, registry
 from .advise import Advice, Diagnostics, ModelValidityWarning, advise
-from .fit import FitResult, fit
 from .errors import AccuracyWarning, ConvergenceError, InvalidParameterError, NoSteadyStateError, TubefsiError
+from .fit import FitResult, fit
 from .geometry import Tube
 from .solution import Solution
 from .solve import max_flow_rate, select_coupler, solve
 
 __all__ = [
-    "dimensionless", "Tube", "solve", "max_flow_rate", "select_coupler", "Solution", "registry",
+    "dimensionless", "fields", "Tube", "solve", "max_flow_rate", "select_coupler", "Solution", "registry",
     "advise", "Advice", "Diagnostics", "ModelValidityWarning", "fit", "FitResult",
     "TubefsiError", "InvalidParameterError", "NoSteadyStateError", "ConvergenceError", "AccuracyWarning",
 ]

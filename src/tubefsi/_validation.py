@@ -1,75 +1,16 @@
-"""attrs field factories and array checks that raise InvalidParameterError."""
+"""Input checks of the public functions: arrays and scalars that raise InvalidParameterError.
+
+Model parameters are declared with :mod:`tubefsi.fields`; these check the loads and the
+other arguments of the entry points.
+"""
 
 from __future__ import annotations
 
 import math
 
-import attrs
 import numpy as np
 
 from .errors import InvalidParameterError
-
-
-def _convert_float(value, field):
-    if isinstance(value, (bool, str)):
-        raise InvalidParameterError(field.name, "the real numbers", value)
-    try:
-        return float(value)
-    except (TypeError, ValueError):
-        raise InvalidParameterError(field.name, "the real numbers", value) from None
-
-
-_float_converter = attrs.Converter(_convert_float, takes_field=True)
-
-
-def _interval_validator(low, high, low_open, high_open, admissible):
-    def check(instance, attribute, value):
-        ok = math.isfinite(value) or (value == math.inf and high == math.inf and not high_open)
-        ok = ok and (value > low if low_open else value >= low)
-        ok = ok and (value < high if high_open else value <= high)
-        if not ok:
-            raise InvalidParameterError(attribute.name, admissible, value)
-
-    return check
-
-
-def real(*, low=-math.inf, high=math.inf, low_open=True, high_open=True, unit="", doc="",
-         default=attrs.NOTHING):
-    """A float field validated to lie in an interval; NaN and infinities are rejected."""
-    lo = "(" if low_open else "["
-    hi = ")" if high_open else "]"
-    admissible = f"{lo}{_fmt(low)}, {_fmt(high)}{hi}"
-    return attrs.field(
-        converter=_float_converter,
-        validator=_interval_validator(low, high, low_open, high_open, admissible),
-        metadata={"unit": unit, "doc": doc, "admissible": admissible},
-        default=default,
-    )
-
-
-def positive(*, unit="", doc="", default=attrs.NOTHING):
-    """A finite float field that must be > 0."""
-    return real(low=0.0, unit=unit, doc=doc, default=default)
-
-
-def choice(options, *, doc="", default=attrs.NOTHING):
-    """A string field restricted to ``options``."""
-    admissible = "{" + ", ".join(repr(o) for o in options) + "}"
-
-    def check(instance, attribute, value):
-        if value not in options:
-            raise InvalidParameterError(attribute.name, admissible, value)
-
-    return attrs.field(validator=check, default=default,
-                       metadata={"unit": "", "doc": doc, "admissible": admissible})
-
-
-def _fmt(x):
-    if x == math.inf:
-        return "inf"
-    if x == -math.inf:
-        return "-inf"
-    return f"{x:g}"
 
 
 def as_load(name, value, *, allow_zero=True):
@@ -98,4 +39,27 @@ def as_array(name, value, admissible, predicate):
     if not np.all(ok):
         bad = a[~ok].flat[0] if a.ndim else a.item()
         raise InvalidParameterError(name, admissible, bad)
+    return a
+
+
+def positive_scalar(name, value) -> float:
+    """A finite float ``> 0``."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InvalidParameterError(name, "(0, inf)", value) from None
+    if not (math.isfinite(v) and v > 0):
+        raise InvalidParameterError(name, "(0, inf)", v)
+    return v
+
+
+def nonnegative_array(name, value):
+    """A float array of finite entries ``>= 0``."""
+    try:
+        a = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidParameterError(name, "[0, inf)", value) from None
+    if not np.all(np.isfinite(a) & (a >= 0)):
+        raise InvalidParameterError(name, "[0, inf)", a[~(np.isfinite(a) & (a >= 0))].flat[0]
+                                    if a.ndim else a.item())
     return a

@@ -23,8 +23,11 @@ from typing import Any
 import attrs
 import numpy as np
 
-from .errors import NoSteadyStateError, TubefsiError
+from . import registry
+from .errors import InvalidParameterError, NoSteadyStateError, TubefsiError
 from .rheology.power_law import _PowerLawForms
+from .scene import make_scene
+from .solve import solve
 from .walls.hyperelastic import HyperelasticWall, ThickWall, ThinWall
 from .walls.linear import ThickLinear, ThinLinear
 from .walls.rigid import Rigid
@@ -80,8 +83,6 @@ def _material(wall):
 
 def _thin_counterpart(wall):
     """The registered thin (current-thickness) wall of the same material, if any."""
-    from . import registry
-
     material = _material(wall)
     if material is None:
         return None
@@ -105,8 +106,6 @@ def _linear_equivalent(wall, tb):
 
 def _candidates(rheology, wall, tube, load):
     """(rank, label, rheology, wall) of the requested model and its simpler relatives."""
-    from . import registry
-
     tb = tube.reduced_thickness
     name = registry.walls.name_of(wall) or type(wall).__name__
     fluid_name = registry.rheologies.name_of(rheology) or type(rheology).__name__
@@ -160,17 +159,11 @@ def advise(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, toleranc
         ``recommended`` is the simplest candidate within ``tolerance``; ``str(advice)``
         prints the comparison table.
     """
-    from .solve import _scene, solve
-
-    scene = _scene(rheology, wall, tube, outlet_pressure)
+    scene = make_scene(rheology, wall, tube, outlet_pressure=outlet_pressure)
     rheology, wall = scene.rheology, scene.wall
     if (flow_rate is None) == (pressure_drop is None):
-        from .errors import InvalidParameterError
-
         raise InvalidParameterError("flow_rate / pressure_drop", "exactly one of the two", None)
     if not (isinstance(tolerance, (int, float)) and math.isfinite(tolerance) and tolerance >= 0):
-        from .errors import InvalidParameterError
-
         raise InvalidParameterError("tolerance", "[0, inf)", tolerance)
     if flow_rate is None:
         flow_rate = solve(rheology, wall, tube, pressure_drop=pressure_drop,
@@ -222,8 +215,6 @@ class Diagnostics:
 
 def diagnostics(solution, *, density=None, warn=True) -> Diagnostics:
     """Check a :class:`~tubefsi.Solution`'s assumptions (see :meth:`tubefsi.Solution.diagnostics`)."""
-    from .solve import max_flow_rate
-
     tube, wall = solution.tube, solution.wall
     tb = tube.reduced_thickness
     messages = []
@@ -235,12 +226,12 @@ def diagnostics(solution, *, density=None, warn=True) -> Diagnostics:
         messages.append(f"hoop strain {strain:.3g} > 0.05 with a linear wall: use a hyperelastic wall")
     if isinstance(wall, ThinWall) and tb > 0.1:
         messages.append(f"thin-wall theory with t/a = {tb:.3g} > 0.1: use the thick wall")
-    limit = wall.limit_pressure(tb) if not wall.is_rigid else math.inf
+    limit = wall.limit_pressure(tb)
     p_frac = float(np.max(solution.outlet_pressure + solution.state.pressure_drop)) / limit
     if p_frac > 0.9:
         messages.append(f"inlet pressure at {100 * p_frac:.1f} % of the limit pressure {limit:.4g} Pa: "
                         "the tube is close to unbounded inflation")
-    q_max = max_flow_rate(solution.rheology, wall, tube, outlet_pressure=solution.outlet_pressure)
+    q_max = solution.max_flow_rate
     q_frac = float(np.max(solution.state.flow_rate)) / q_max
     if q_frac > 0.9:
         messages.append(f"flow rate at {100 * q_frac:.1f} % of the maximum flow rate {q_max:.4g} m^3/s")

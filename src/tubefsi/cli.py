@@ -1,4 +1,4 @@
-r"""The ``tubefsi`` command: list the registered models, solve one scene, run the demo.
+r"""The ``tubefsi`` command: list the registered models, solve a scene, sweep a curve, advise.
 
 ::
 
@@ -6,7 +6,9 @@ r"""The ``tubefsi`` command: list the registered models, solve one scene, run th
     tubefsi solve --rheology power-law:consistency=0.017,index=0.7 \
                   --wall thick-neo-hookean:shear_modulus=2e3 \
                   --tube radius=1e-4,thickness=3e-5,length=1e-2 --flow-rate 1e-9 [--json]
-    tubefsi demo --out tubefsi-demo
+    tubefsi curve  ... --flow-rate 0:1e-8:200 [--log] [--format csv|json] [--plot FILE]
+    tubefsi advise ... --flow-rate 5e-9 [--density 1060]
+    tubefsi reproduce [OUTDIR]
 
 A model is ``NAME`` or ``NAME:key=value,key=value`` with the parameter names of
 ``tubefsi list`` (SI units); a coupler may take options the same way
@@ -14,22 +16,27 @@ A model is ``NAME`` or ``NAME:key=value,key=value`` with the parameter names of
 one value or a comma-separated list. Any bad argument — an unknown model or
 parameter, a value outside its admissible range, a load beyond the maximum flow
 rate — ends with a one-line ``tubefsi: error: ...`` on stderr and exit status 2.
-
-The demo (:func:`run_demo`, also ``examples/demo.py``) compares the built-in walls
-for a blood-like shear-thinning fluid in a soft microfluidic tube and writes figures.
 """
 
 from __future__ import annotations
 
 import argparse
+import inspect
 import json
-import math
 import sys
-from pathlib import Path
 
 import numpy as np
 
-__all__ = ["main", "run_demo", "parse_model_spec"]
+from . import __version__, registry
+from .advise import advise
+from .chapter import reproduce_chapter
+from .errors import TubefsiError
+from .fields import parameters
+from .geometry import Tube
+from .plotting import plot_flow_curve
+from .solve import solve
+
+__all__ = ["main", "parse_model_spec"]
 
 PROG = "tubefsi"
 
@@ -81,37 +88,28 @@ def _parse_pairs(text: str, spec: str) -> dict:
     return params
 
 
-def _fields(cls):
-    import attrs
-
-    return attrs.fields(cls) if attrs.has(cls) else ()
-
-
-def _build(kind: str, registry, spec: str):
+def _build(kind: str, models, spec: str):
     """An instance of the registered model ``NAME`` with the parameters of ``spec``."""
-    import attrs
-
     name, params = parse_model_spec(spec)
-    if name not in registry:
-        raise UsageError(f"unknown {kind} {name!r}; known: {', '.join(registry)}")
-    cls = registry[name]
-    fields = {f.name: f for f in _fields(cls) if f.init}
+    if name not in models:
+        raise UsageError(f"unknown {kind} {name!r}; known: {', '.join(models)}")
+    cls = models[name]
+    fields = {p.name: p for p in parameters(cls)}
     unknown = [k for k in params if k not in fields]
     if unknown:
         known = ", ".join(fields) or "none"
         raise UsageError(f"{kind} {name!r} has no parameter {unknown[0]!r}; its parameters: {known}")
-    missing = [f for f in fields.values() if f.default is attrs.NOTHING and f.name not in params]
+    missing = [p for p in fields.values() if p.required and p.name not in params]
     if missing:
-        raise UsageError(f"{kind} {name!r} needs " + ", ".join(_describe_field(f) for f in missing)
+        raise UsageError(f"{kind} {name!r} needs " + ", ".join(_describe(p) for p in missing)
                          + f" (e.g. {name}:{missing[0].name}=...)")
     return cls(**params)
 
 
-def _describe_field(field) -> str:
-    meta = field.metadata
-    unit = f" ({meta['unit']})" if meta.get("unit") else ""
-    adm = f" in {meta['admissible']}" if meta.get("admissible") else ""
-    return f"{field.name}{unit}{adm}"
+def _describe(parameter) -> str:
+    unit = f" ({parameter.unit})" if parameter.unit else ""
+    adm = f" in {parameter.admissible}" if parameter.admissible else ""
+    return f"{parameter.name}{unit}{adm}"
 
 
 def _load_values(option: str, text: str):
@@ -130,8 +128,6 @@ def _load_values(option: str, text: str):
 # ---------------------------------------------------------------------------- list
 def _summary(cls) -> str:
     """First phrase of a class docstring, without reST math."""
-    import inspect
-
     doc = " ".join((inspect.getdoc(cls) or "").split())
     depth, cut = 0, len(doc)
     for i, ch in enumerate(doc):
@@ -149,8 +145,6 @@ def _summary(cls) -> str:
 
 
 def _cmd_list(args, out) -> int:
-    from . import registry
-
     groups = [("rheologies", registry.rheologies), ("walls", registry.walls), ("couplers", registry.couplers)]
     for title, reg in groups:
         print(f"{title}:", file=out)
@@ -159,24 +153,14 @@ def _cmd_list(args, out) -> int:
             dist = reg.distribution(name)
             origin = "" if dist == "tubefsi" else f"  [{dist}]"
             print(f"  {name:<22}{_summary(cls)}{origin}", file=out)
-            fields = [f for f in _fields(cls) if f.init]
+            fields = parameters(cls)
             if not fields:
                 print(f"      {'(no parameters)' if title != 'couplers' else '(no options)'}", file=out)
-            for f in fields:
-                meta = f.metadata
-                unit = meta.get("unit") or "-"
-                adm = meta.get("admissible") or ""
-                default = "" if f.default is _nothing() else f"  default {f.default!r}"
-                doc = meta.get("doc") or ""
-                line = f"      {f.name:<22}{unit:<9}{adm:<26}{doc}{default}"
+            for p in fields:
+                default = "" if p.required else f"  default {p.default!r}"
+                line = f"      {p.name:<22}{p.unit or '-':<9}{p.admissible:<26}{p.doc}{default}"
                 print(line.rstrip(), file=out)
     return 0
-
-
-def _nothing():
-    import attrs
-
-    return attrs.NOTHING
 
 
 # ---------------------------------------------------------------------------- solve
@@ -191,9 +175,6 @@ _OUTPUT_UNITS = {
 
 def _scene_from_args(args):
     """(fluid, wall, tube, coupler) from the shared scene options."""
-    import tubefsi
-    from . import registry
-
     fluid = _build("rheology", registry.rheologies, args.rheology)
     wall = _build("wall", registry.walls, args.wall)
     tube_params = _parse_pairs(args.tube, args.tube)
@@ -205,7 +186,7 @@ def _scene_from_args(args):
     if missing:
         raise UsageError(f"--tube needs {', '.join(missing)} (m), e.g. --tube radius=1e-4,thickness=3e-5,"
                          "length=1e-2")
-    tube = tubefsi.Tube(**tube_params)
+    tube = Tube(**tube_params)
     coupler = args.coupler
     if coupler != "auto":
         coupler = _build("coupler", registry.couplers, coupler)
@@ -213,15 +194,13 @@ def _scene_from_args(args):
 
 
 def _cmd_solve(args, out) -> int:
-    import tubefsi
-
     fluid, wall, tube, coupler = _scene_from_args(args)
     load = {}
     if args.flow_rate is not None:
         load["flow_rate"] = _load_values("--flow-rate", args.flow_rate)
     else:
         load["pressure_drop"] = _load_values("--pressure-drop", args.pressure_drop)
-    sol = tubefsi.solve(fluid, wall, tube, coupler=coupler, outlet_pressure=args.outlet_pressure, **load)
+    sol = solve(fluid, wall, tube, coupler=coupler, outlet_pressure=args.outlet_pressure, **load)
 
     result = {}
     for key in _OUTPUT_UNITS:
@@ -240,163 +219,14 @@ def _cmd_solve(args, out) -> int:
     return 0
 
 
-# ---------------------------------------------------------------------------- demo
-#: The demo's scene: a blood-like shear-thinning fluid in a soft microfluidic tube.
-DEMO_TUBE = dict(radius=100e-6, thickness=30e-6, length=10e-3)                  # m
-DEMO_FLUID = ("power-law", dict(consistency=0.017, index=0.7))                   # Pa s^n, -
-DEMO_SHEAR_MODULUS = 2e3                                                         # Pa (soft gel)
-DEMO_FLOW_RATES = (1e-10, 1e-9, 5e-9, 1e-8)                                      # m^3/s
-
-
-def demo_walls(shear_modulus: float = DEMO_SHEAR_MODULUS) -> dict:
-    """The demo's walls, all of one material: linear ones at its small-strain limit, E = 3 mu."""
-    from . import registry
-
-    W = registry.walls
-    E = 3.0 * shear_modulus
-    return {
-        "rigid": W["rigid"](),
-        "thin-linear": W["thin-linear"](youngs_modulus=E, poisson_ratio=0.5),
-        "thick-linear": W["thick-linear"](youngs_modulus=E, poisson_ratio=0.5),
-        "thin-neo-hookean": W["thin-neo-hookean"](shear_modulus=shear_modulus),
-        "thick-neo-hookean": W["thick-neo-hookean"](shear_modulus=shear_modulus),
-    }
-
-
-def run_demo(out_dir="tubefsi-demo", *, file=None) -> list[Path]:
-    """Compare the walls on the demo scene, print a table, write PNG figures to ``out_dir``.
-
-    Returns the paths of the figures written.
-    """
-    import matplotlib.pyplot as plt
-
-    import tubefsi
-    from . import plotting
-
-    out = sys.stdout if file is None else file
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-
-    tube = tubefsi.Tube(**DEMO_TUBE)
-    fluid = tubefsi.registry.rheologies[DEMO_FLUID[0]](**DEMO_FLUID[1])
-    walls = demo_walls()
-    mu = DEMO_SHEAR_MODULUS
-    qs = np.array(DEMO_FLOW_RATES)
-
-    print(f"tubefsi {tubefsi.__version__} demo: power-law fluid (m = {fluid.consistency:g} Pa s^n, "
-          f"n = {fluid.index:g}) in a soft tube", file=out)
-    print(f"  tube a = {tube.radius * 1e6:g} um, t = {tube.thickness * 1e6:g} um, L = {tube.length * 1e3:g} mm "
-          f"(t/a = {tube.reduced_thickness:g}); wall shear modulus mu = {mu:g} Pa, linear walls E = 3 mu, "
-          f"nu = 0.5", file=out)
-    print("", file=out)
-
-    # ---- the table: pressure drop and inlet displacement per wall and flow rate
-    limits, rows = {}, {}
-    for name, wall in walls.items():
-        limits[name] = tubefsi.max_flow_rate(fluid, wall, tube)
-        ok = qs < limits[name]                      # beyond q_max there is no steady state
-        dp = np.full(qs.shape, np.nan)
-        u = np.full(qs.shape, np.nan)
-        coupler = "-"
-        if np.any(ok):
-            sol = tubefsi.solve(fluid, wall, tube, flow_rate=qs[ok])
-            dp[ok], u[ok], coupler = sol.pressure_drop, 1e6 * sol.inlet_displacement, sol.coupler_name
-        rows[name] = (coupler, dp, u)
-
-    def table(title, column, fmt):
-        print(title, file=out)
-        print(f"  {'wall':<19}{'coupler':<13}" + "".join(f"{q:>10.0e}" for q in qs), file=out)
-        for name, row in rows.items():
-            cells = "".join(f"{format(v, fmt):>10}" if np.isfinite(v) else f"{'none':>10}" for v in row[column])
-            print(f"  {name:<19}{row[0]:<13}{cells}", file=out)
-        print("", file=out)
-
-    table("pressure drop (Pa) at flow rate q (m^3/s):", 1, ".1f")
-    table("inlet wall displacement R(0) - a (um) at flow rate q (m^3/s):", 2, ".2f")
-    print("maximum steady flow rate (m^3/s):", file=out)
-    for name, q_max in limits.items():
-        if math.isfinite(q_max):
-            note = f"  (the wall's limit pressure is {walls[name].limit_pressure(tube.reduced_thickness):.1f} Pa)"
-        else:
-            note = "  (every flow rate has a steady state)"
-        print(f"  {name:<19}{q_max:.6g}{note}", file=out)
-    print("", file=out)
-
-    # ---- figures
-    written: list[Path] = []
-
-    def save(fig, stem):
-        path = out_dir / f"{stem}.png"
-        fig.savefig(path, dpi=130)
-        plt.close(fig)
-        written.append(path)
-
-    soft = walls["thick-neo-hookean"]
-    q_max = limits["thick-neo-hookean"]
-    q_curve = np.linspace(0.0, 0.9 * q_max, 200) if math.isfinite(q_max) else np.linspace(0.0, qs[-1], 200)
-
-    colors = dict(zip(walls, ("0.15", "C0", "C2", "C1", "C3")))
-    q_log = np.geomspace(1e-4 * q_curve[-1], q_curve[-1], 200)
-    fig, (ax_lin, ax_log) = plt.subplots(1, 2, figsize=(11.5, 4.4), layout="constrained")
-    for name, wall in walls.items():
-        for ax, q_range in ((ax_lin, q_curve), (ax_log, q_log)):
-            plotting.plot_flow_curve(fluid, wall, tube, flow_rates=q_range, ax=ax, rigid=False, label=name,
-                                     color=colors[name])
-    ax_log.set_xscale("log")
-    ax_log.set_yscale("log")
-    ax_log.autoscale_view()
-    ax_lin.set_title("Flow curves: one material, five wall models")
-    ax_log.set_title("the same, log–log: all agree at small loads")
-    ax_log.get_legend().remove()
-    save(fig, "flow_curves")
-
-    sol_curve = tubefsi.solve(fluid, soft, tube, flow_rate=q_curve)
-    save(plotting.plot_profiles(sol_curve), "profiles")
-
-    sol = tubefsi.solve(fluid, soft, tube, flow_rate=DEMO_FLOW_RATES[2])
-    fig, (ax_t, ax_v) = plt.subplots(1, 2, figsize=(12.5, 4.2), layout="constrained",
-                                     gridspec_kw=dict(width_ratios=[1.8, 1.0]))
-    plotting.plot_deformed_tube(sol, ax=ax_t)
-    plotting.plot_velocity_profiles(sol, ax=ax_v)
-    save(fig, "deformed_tube")
-
-    tb = tube.reduced_thickness
-    fig, (ax_n, ax_pa) = plt.subplots(1, 2, figsize=(11.5, 4.4), layout="constrained")
-    for name, wall in walls.items():
-        if "linear" not in name:       # normalized, a linear wall is the small-strain tangent itself
-            plotting.plot_tube_law(wall, tb, ax=ax_n, max_stretch=3.0, color=colors[name])
-        plotting.plot_tube_law(wall, tb, ax=ax_pa, max_stretch=3.0, normalize=False, color=colors[name])
-    ax_n.set_title(f"Normalized by the small-strain modulus $k_0$ (t/a = {tb:.3g});\n"
-                   "the linear walls are the tangent", fontsize=10)
-    ax_pa.set_title(f"Tube laws of one material, $\\mu$ = {mu:g} Pa, E = 3$\\mu$", fontsize=10)
-    ax_pa.legend(frameon=False, loc="upper left")
-    save(fig, "tube_laws")
-
-    for path in written:
-        print(f"wrote {path}", file=out)
-    return written
-
-
-def _cmd_demo(args, out) -> int:
-    run_demo(args.out, file=out)
-    return 0
-
-
 # ---------------------------------------------------------------------------- main
 def _parser() -> argparse.ArgumentParser:
-    from . import __version__
-
     parser = _Parser(prog=PROG, description="Steady fluid–structure interaction in soft tubes.")
     parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
 
     p = sub.add_parser("list", help="list the registered rheologies, walls and couplers with their parameters")
     p.set_defaults(run=_cmd_list)
-
-    p = sub.add_parser("demo", help="run the demo and write its figures")
-    p.add_argument("--out", default="tubefsi-demo", metavar="DIR",
-                   help="directory for the PNG figures (default: ./tubefsi-demo)")
-    p.set_defaults(run=_cmd_demo)
 
     p = sub.add_parser("solve", help="solve one scene (or a list of loads)",
                        description="Solve steady flow through a soft tube. " + _SCENE_HELP)
@@ -472,15 +302,13 @@ def _range(option, text, log):
 
 
 def _cmd_curve(args, out) -> int:
-    import tubefsi
-
     fluid, wall, tube, coupler = _scene_from_args(args)
     if args.flow_rate is not None:
-        sol = tubefsi.solve(fluid, wall, tube, coupler=coupler, outlet_pressure=args.outlet_pressure,
-                            flow_rate=_range("--flow-rate", args.flow_rate, args.log))
+        sol = solve(fluid, wall, tube, coupler=coupler, outlet_pressure=args.outlet_pressure,
+                    flow_rate=_range("--flow-rate", args.flow_rate, args.log))
     else:
-        sol = tubefsi.solve(fluid, wall, tube, coupler=coupler, outlet_pressure=args.outlet_pressure,
-                            pressure_drop=_range("--pressure-drop", args.pressure_drop, args.log))
+        sol = solve(fluid, wall, tube, coupler=coupler, outlet_pressure=args.outlet_pressure,
+                    pressure_drop=_range("--pressure-drop", args.pressure_drop, args.log))
     columns = list(_OUTPUT_UNITS)
     data = {k: np.atleast_1d(getattr(sol, k)).tolist() for k in columns}
     stream = open(args.output, "w", encoding="utf-8") if args.output else out
@@ -496,30 +324,24 @@ def _cmd_curve(args, out) -> int:
         if args.output:
             stream.close()
     if args.plot:
-        from .plotting import plot_flow_curve
-
         ax = plot_flow_curve(fluid, wall, tube, flow_rates=np.atleast_1d(sol.flow_rate))
         ax.figure.savefig(args.plot, dpi=130)
     return 0
 
 
 def _cmd_reproduce(args, out) -> int:
-    from .dimensionless import reproduce_chapter
-
     reproduce_chapter(args.out, formats=("png",) if args.png_only else ("png", "csv"), file=out)
     return 0
 
 
 def _cmd_advise(args, out) -> int:
-    import tubefsi
-
     fluid, wall, tube, _ = _scene_from_args(args)
     load = {"flow_rate": args.flow_rate} if args.flow_rate is not None else {"pressure_drop": args.pressure_drop}
-    advice = tubefsi.advise(fluid, wall, tube, tolerance=args.tolerance, outlet_pressure=args.outlet_pressure,
+    advice = advise(fluid, wall, tube, tolerance=args.tolerance, outlet_pressure=args.outlet_pressure,
                             **load)
     print(advice, file=out)
     print(f"\nrecommended: {advice.recommended.label}", file=out)
-    sol = tubefsi.solve(fluid, wall, tube, outlet_pressure=args.outlet_pressure, **load)
+    sol = solve(fluid, wall, tube, outlet_pressure=args.outlet_pressure, **load)
     print("\ndiagnostics of the requested model:", file=out)
     print(sol.diagnostics(density=args.density, warn=False), file=out)
     return 0
@@ -533,8 +355,6 @@ def _error(message) -> int:
 
 def main(argv=None) -> int:
     """Run the ``tubefsi`` command with ``argv`` (default ``sys.argv[1:]``); return the exit status."""
-    from .errors import TubefsiError
-
     parser = _parser()
     try:
         args = parser.parse_args(argv)
@@ -543,7 +363,7 @@ def main(argv=None) -> int:
     except SystemExit as exc:  # --help, --version
         return exc.code if isinstance(exc.code, int) else 0
     if args.command is None:
-        return _error("a command is required: list, solve, curve, advise, demo or reproduce (see 'tubefsi --help')")
+        return _error("a command is required: list, solve, curve, advise or reproduce (see 'tubefsi --help')")
     try:
         return args.run(args, sys.stdout)
     except (UsageError, ValueError, TubefsiError) as exc:

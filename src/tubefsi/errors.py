@@ -6,12 +6,19 @@ exception from deep inside SciPy.
 
 from __future__ import annotations
 
+import os
+import sys
+import warnings
+
+import numpy as np
+
 __all__ = [
     "TubefsiError",
     "InvalidParameterError",
     "NoSteadyStateError",
     "ConvergenceError",
     "AccuracyWarning",
+    "warn_user",
 ]
 
 
@@ -66,8 +73,6 @@ class ConvergenceError(TubefsiError, ArithmeticError):
 
 
 def _short(value) -> str:
-    import numpy as np
-
     a = np.asarray(value)
     if a.ndim == 0:
         return f"{a.item()!r}"
@@ -76,3 +81,14 @@ def _short(value) -> str:
 
 class AccuracyWarning(UserWarning):
     """A non-default method's result is less accurate than its tolerance promises."""
+
+
+_PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__))
+
+
+def warn_user(message: str, category: type[Warning]) -> None:
+    """Issue a warning attributed to the first caller outside tubefsi (the user's line)."""
+    frame, level = sys._getframe(0), 1
+    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(_PACKAGE_DIR):
+        frame, level = frame.f_back, level + 1
+    warnings.warn(message, category, stacklevel=level)

@@ -17,6 +17,8 @@ import numpy as np
 from scipy import optimize
 
 from .errors import InvalidParameterError, TubefsiError
+from .scene import make_scene
+from .solve import max_flow_rate, solve
 
 __all__ = ["fit", "FitResult"]
 
@@ -68,9 +70,7 @@ def fit(flow_rate, pressure_drop, rheology, wall, tube, *, parameters, outlet_pr
     -------
     FitResult
     """
-    from .solve import _scene, max_flow_rate, solve
-
-    scene = _scene(rheology, wall, tube, outlet_pressure)
+    scene = make_scene(rheology, wall, tube, outlet_pressure=outlet_pressure)
     models = {"rheology": scene.rheology, "wall": scene.wall}
     q = np.asarray(flow_rate, dtype=float)
     dp = np.asarray(pressure_drop, dtype=float)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import attrs
 
-from ._validation import positive
+from .fields import positive
 
 __all__ = ["Tube"]
 

@@ -36,9 +36,13 @@ from __future__ import annotations
 
 import math
 
+import attrs
 import numpy as np
 
+from . import registry
 from .errors import InvalidParameterError, NoSteadyStateError
+from .solve import max_flow_rate, solve
+from .walls.hyperelastic import HyperelasticWall
 
 __all__ = [
     "plot_tube_law",
@@ -68,8 +72,6 @@ def _new_axes(ax, figsize):
 
 
 def _model_name(model, kind) -> str:
-    from . import registry
-
     reg = {"wall": registry.walls, "rheology": registry.rheologies}[kind]
     try:
         name = reg.name_of(model)
@@ -101,8 +103,6 @@ def _fmt(x, unit="") -> str:
 
 def _incompressible(wall) -> bool:
     """Whether the wall conserves its cross-sectional area (so its outer radius is known)."""
-    from .walls.hyperelastic import HyperelasticWall
-
     if wall.is_rigid or isinstance(wall, HyperelasticWall):
         return True
     return getattr(wall, "poisson_ratio", None) == 0.5
@@ -135,8 +135,6 @@ def _subset(solution, max_loads):
     Profiles of the subset cost ``max_loads`` root solves per position instead of one
     per load. Returns the subset and the selected flow rates (1-d).
     """
-    import attrs
-
     state = solution.state
     q = np.ravel(np.asarray(state.flow_rate, dtype=float))
     order = np.argsort(q, kind="stable")
@@ -254,10 +252,8 @@ def _default_flow_rates(scene_sol, tube, n, outlet_pressure):
     small-strain modulus (the pressure that would double the radius by the linear
     law), capped at 90 % of the limit pressure; 1 kPa for a rigid wall.
     """
-    from .solve import max_flow_rate
-
     fluid, wall = scene_sol.rheology, scene_sol.wall
-    q_max = math.inf if wall.is_rigid else max_flow_rate(fluid, wall, tube, outlet_pressure=outlet_pressure)
+    q_max = max_flow_rate(fluid, wall, tube, outlet_pressure=outlet_pressure)
     if math.isfinite(q_max):
         return np.linspace(0.0, 0.9 * q_max, n), q_max
     tb = tube.reduced_thickness
@@ -311,15 +307,13 @@ def plot_flow_curve(rheology, wall, tube, *, flow_rates=None, ax=None, n=200, la
     -------
     matplotlib.axes.Axes
     """
-    from .solve import max_flow_rate, solve
-
     probe = solve(rheology, wall, tube, flow_rate=0.0, outlet_pressure=outlet_pressure, coupler=coupler)
     fluid, wall = probe.rheology, probe.wall
     if flow_rates is None:
         q, q_max = _default_flow_rates(probe, tube, _check_count("n", n), outlet_pressure)
     else:
         q = np.ravel(np.asarray(flow_rates, dtype=float))
-        q_max = math.inf if wall.is_rigid else max_flow_rate(fluid, wall, tube, outlet_pressure=outlet_pressure)
+        q_max = max_flow_rate(fluid, wall, tube, outlet_pressure=outlet_pressure)
     try:
         sol = solve(fluid, wall, tube, flow_rate=q, outlet_pressure=outlet_pressure, coupler=coupler)
     except NoSteadyStateError as exc:
@@ -349,7 +343,7 @@ def plot_flow_curve(rheology, wall, tube, *, flow_rates=None, ax=None, n=200, la
         ax.annotate(f"$q_{{max}}$ = {_fmt(q_max, 'm³/s')}", xy=(0.0, q_max), xycoords=("axes fraction", "data"),
                     xytext=(4, -3), textcoords="offset points", ha="left", va="top", color=color, fontsize=8)
     lim = wall.limit_pressure(tube.reduced_thickness)
-    if not wall.is_rigid and math.isfinite(lim):
+    if math.isfinite(lim):
         ax.axvline(lim - outlet_pressure, color=color, lw=1.0, ls=":", label="_nolegend_")
         ax.annotate(f"limit {_fmt(lim - outlet_pressure, 'Pa')}", xy=(lim - outlet_pressure, 0.4),
                     xycoords=("data", "axes fraction"), xytext=(3, 0), textcoords="offset points",
@@ -427,7 +421,7 @@ def plot_profiles(solution, *, axes=None, n=200, max_loads=8):
         ax_r.plot(zz, r[:, j] / a, color=c, lw=1.8)
     ax_r.axhline(1.0, color="0.5", lw=0.9, ls=":", label="undeformed")
     lim = solution.wall.limit_pressure(tube.reduced_thickness)
-    if not solution.wall.is_rigid and math.isfinite(lim):
+    if math.isfinite(lim):
         ax_p.axhline(lim, color="0.35", lw=1.0, ls="--", label="limit pressure")
         ax_p.legend(frameon=False, loc="lower left")
 

@@ -1,4 +1,10 @@
-"""The result of :func:`tubefsi.solve`: loads, inlet state and lazy profiles."""
+"""The result of :func:`tubefsi.solve`: loads, inlet state and lazy profiles.
+
+A :class:`Solution` talks only to its coupler: the profiles and the maximum flow rate are
+the coupler's (:meth:`~tubefsi.couplers.Coupler.profile`,
+:meth:`~tubefsi.couplers.Coupler.max_flow_rate`). ``diagnostics`` and ``plot`` are accessors
+that reach :mod:`tubefsi.advise` and :mod:`tubefsi.plotting` on purpose, at call time.
+"""
 
 from __future__ import annotations
 
@@ -7,8 +13,9 @@ import numpy as np
 
 from ._numerics import as_output
 from ._validation import as_array
-from .couplers.base import Scene, State
+from .couplers.base import Coupler
 from .errors import InvalidParameterError
+from .scene import Scene, State
 
 __all__ = ["Solution"]
 
@@ -23,9 +30,11 @@ class Solution:
     """
 
     scene: Scene
-    coupler: object
+    coupler: Coupler
     state: State
     scalar: bool = True
+    #: The registered name of the coupler (its class name if it is not registered).
+    coupler_name: str = ""
 
     # ------------------------------------------------------------------ loads
     @property
@@ -71,75 +80,59 @@ class Solution:
         return as_output(self.tube.radius * (1.0 + self.state.inlet_strain), self.scalar)
 
     @property
-    def coupler_name(self) -> str:
-        from .registry import couplers
-
-        return couplers.name_of(self.coupler) or type(self.coupler).__name__
+    def max_flow_rate(self) -> float:
+        """The largest flow rate with a steady state in this scene (m^3/s; ``inf`` if none)."""
+        return float(self.coupler.max_flow_rate(self.scene))
 
     # ------------------------------------------------------------------ profiles
-    def _log_stretch(self, z):
-        """Log-stretch v(z) solving L - z = H(v; q), broadcast against the load shape."""
+    def _profile(self, z):
+        """``(strain, pressure_rise, flow_rate)`` at ``z`` from the coupler, broadcast with the loads."""
         L = self.tube.length
         z = as_array("z", z, f"[0, {L:g}] (m)", lambda a: (a >= 0) & (a <= L))
-        scene, st = self.scene, self.state
-        z, q, v_in = np.broadcast_arrays(z, st.flow_rate, st.log_stretch)
-        if self.wall.is_rigid:
-            return z, q, np.zeros_like(z)
-        frac = (L - z) / L
-        engine = self.coupler
-        if not engine.separates_variables:
-            from .couplers.quadrature import Quadrature
+        strain, rise = self.coupler.profile(self.scene, self.state, z)
+        return strain, rise, np.broadcast_to(self.state.flow_rate, np.shape(strain))
 
-            engine = Quadrature()
-        v, _ = engine.solve_log_stretch(scene, np.where(q == 0, 0.0, frac * scene.target(q)), q,
-                                        upper=v_in * (1 + 1e-12) + 1e-300)
-        return z, q, np.where(frac == 1.0, v_in, v)
+    def _out(self, value, *arguments):
+        return as_output(value, self.scalar and all(np.ndim(a) == 0 for a in arguments))
 
     def pressure(self, z):
         """Pressure p(z) (Pa) at axial position ``z`` in [0, L] (m)."""
-        z_, q, v = self._log_stretch(z)
-        if self.wall.is_rigid:
-            g = self.rheology._pressure_gradient(q, self.tube.radius)
-            p = self.outlet_pressure + (self.tube.length - z_) * np.where(q == 0, 0.0, g)
-        else:
-            p = self.outlet_pressure + self.scene.pressure_rise(v)
-        return as_output(p, self.scalar and np.ndim(z) == 0)
+        _, rise, _ = self._profile(z)
+        return self._out(self.outlet_pressure + rise, z)
 
     def radius(self, z):
         """Deformed inner radius R(z) (m)."""
-        _, _, v = self._log_stretch(z)
-        return as_output(self.tube.radius * (1.0 + self.scene.strain_at(v)), self.scalar and np.ndim(z) == 0)
+        strain, _, _ = self._profile(z)
+        return self._out(self.tube.radius * (1.0 + strain), z)
 
     def displacement(self, z):
         """Radial wall displacement R(z) - a (m), without cancellation."""
-        _, _, v = self._log_stretch(z)
-        return as_output(self.tube.radius * self.scene.strain_at(v), self.scalar and np.ndim(z) == 0)
+        strain, _, _ = self._profile(z)
+        return self._out(self.tube.radius * strain, z)
 
     def pressure_gradient(self, z):
         """Local pressure gradient G = -dp/dz (Pa/m)."""
-        _, q, v = self._log_stretch(z)
-        big_r = self.tube.radius * (1.0 + self.scene.strain_at(v))
-        return as_output(self.rheology.pressure_gradient(q, big_r), self.scalar and np.ndim(z) == 0)
+        strain, _, q = self._profile(z)
+        return self._out(self.rheology.pressure_gradient(q, self.tube.radius * (1.0 + strain)), z)
 
     def wall_shear_stress(self, z):
         """Wall shear stress tau_w = G R / 2 (Pa)."""
-        _, q, v = self._log_stretch(z)
-        big_r = self.tube.radius * (1.0 + self.scene.strain_at(v))
-        g = self.rheology.pressure_gradient(q, big_r)
-        return as_output(0.5 * g * big_r, self.scalar and np.ndim(z) == 0)
+        strain, _, q = self._profile(z)
+        big_r = self.tube.radius * (1.0 + strain)
+        return self._out(0.5 * self.rheology.pressure_gradient(q, big_r) * big_r, z)
 
     def velocity(self, r, z):
         """Axial velocity v(r, z) (m/s) at radial position ``r`` in [0, R(z)] (m)."""
         r_arr = np.asarray(r, dtype=float)
-        _, q, v = self._log_stretch(z)
-        big_r = self.tube.radius * (1.0 + self.scene.strain_at(v))
+        strain, _, q = self._profile(z)
+        big_r = self.tube.radius * (1.0 + strain)
         g = self.rheology.pressure_gradient(q, big_r)
         r_arr, big_r, g = np.broadcast_arrays(r_arr, big_r, g)
         if np.any(r_arr > big_r * (1 + 1e-12)) or np.any(r_arr < 0):
             raise InvalidParameterError("r", "[0, R(z)] (m)", r_arr[(r_arr > big_r) | (r_arr < 0)].flat[0])
-        out = self.rheology.velocity(np.minimum(r_arr, big_r), big_r, g)
-        return as_output(out, self.scalar and np.ndim(z) == 0 and np.ndim(r) == 0)
+        return self._out(self.rheology.velocity(np.minimum(r_arr, big_r), big_r, g), z, r)
 
+    # ------------------------------------------------------------------ accessors (upper layers)
     def diagnostics(self, *, density=None, warn=True):
         """Validity of the model's assumptions for this solution.
 

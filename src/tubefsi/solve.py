@@ -1,4 +1,10 @@
-"""The entry points: :func:`solve` and :func:`max_flow_rate`."""
+"""The entry points: :func:`solve`, :func:`max_flow_rate` and :func:`select_coupler`.
+
+``solve`` builds the :class:`~tubefsi.scene.Scene` (:func:`~tubefsi.scene.make_scene`), picks
+the coupler, validates the load, runs the coupler (wrapped in
+:class:`~tubefsi.couplers.Checked` when it checks itself) on chunks of at most ``CHUNK``
+loads and returns a :class:`~tubefsi.Solution`.
+"""
 
 from __future__ import annotations
 
@@ -7,38 +13,19 @@ import math
 import attrs
 import numpy as np
 
+from . import registry
 from ._validation import as_load
-from .couplers.base import Coupler, Scene, State
+from .couplers.base import Coupler
+from .couplers.checked import checked
 from .errors import InvalidParameterError, NoSteadyStateError
-from .geometry import Tube
-from .rheology.base import Rheology
+from .scene import State, _resolve, make_scene
 from .solution import Solution
-from .walls.base import WallModel
 
 __all__ = ["solve", "max_flow_rate", "select_coupler"]
 
 
-def _resolve(kind, value, base, registry):
-    if isinstance(value, str):
-        try:
-            value = registry[value]
-        except KeyError as exc:
-            raise InvalidParameterError(kind, "{" + ", ".join(registry) + "}", value) from exc
-    if isinstance(value, type) and issubclass(value, base):
-        try:
-            value = value()
-        except TypeError as exc:
-            raise InvalidParameterError(kind, f"an instance of {base.__name__}", value,
-                                        f"{value.__name__} needs parameters: {exc}") from None
-    if not isinstance(value, base):
-        raise InvalidParameterError(kind, f"an instance of {base.__name__} or a registered name", value)
-    return value
-
-
 def select_coupler(rheology, wall, coupler="auto") -> Coupler:
     """The coupler ``solve`` would use: a name, an instance, or ``"auto"`` (cheapest accurate)."""
-    from . import registry
-
     if isinstance(coupler, str) and coupler == "auto":
         candidates = []
         for name in registry.couplers:
@@ -57,25 +44,6 @@ def select_coupler(rheology, wall, coupler="auto") -> Coupler:
                                     f"{type(inst).__name__} does not support {type(rheology).__name__} "
                                     f"with {type(wall).__name__}")
     return inst
-
-
-def _scene(rheology, wall, tube, outlet_pressure):
-    from . import registry
-
-    rheology = _resolve("rheology", rheology, Rheology, registry.rheologies)
-    wall = _resolve("wall", wall, WallModel, registry.walls)
-    if not isinstance(tube, Tube):
-        raise InvalidParameterError("tube", "a tubefsi.Tube", tube)
-    try:
-        p_out = float(outlet_pressure)
-    except (TypeError, ValueError):
-        raise InvalidParameterError("outlet_pressure", "[0, inf)", outlet_pressure) from None
-    if not (math.isfinite(p_out) and p_out >= 0):
-        raise InvalidParameterError("outlet_pressure", "[0, inf)", p_out)
-    lim = wall.limit_pressure(tube.reduced_thickness)
-    if not wall.is_rigid and p_out >= lim:
-        raise NoSteadyStateError("pressure", lim, p_out, "the outlet pressure already exceeds it")
-    return Scene(rheology=rheology, wall=wall, tube=tube, outlet_pressure=p_out)
 
 
 def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="auto",
@@ -110,11 +78,12 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
     NoSteadyStateError
         Beyond the wall's limit pressure or the maximum flow rate.
     """
-    scene = _scene(rheology, wall, tube, outlet_pressure)
+    scene = make_scene(rheology, wall, tube, outlet_pressure=outlet_pressure)
     if (flow_rate is None) == (pressure_drop is None):
         raise InvalidParameterError("flow_rate / pressure_drop", "exactly one of the two",
                                     None, "give flow_rate= or pressure_drop=, not both or neither")
     chosen = select_coupler(scene.rheology, scene.wall, coupler)
+    runner = checked(chosen)            # a self-checking coupler is re-solved finer (AccuracyWarning)
     if flow_rate is not None:
         q = as_load("flow_rate", flow_rate)
         q_max = _finite_max_flow(chosen, scene, q)
@@ -122,13 +91,14 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
         if beyond is not None and np.any(beyond):
             raise NoSteadyStateError("flow_rate", q_max, q[beyond].flat[0],
                                      "the tube inflates without bound")
-        state = _chunked(chosen.flow_controlled, scene, q)
+        state = _chunked(runner.flow_controlled, scene, q)
         scalar = np.ndim(flow_rate) == 0
     else:
         dp = as_load("pressure_drop", pressure_drop)
-        state = _chunked(chosen.pressure_controlled, scene, dp)
+        state = _chunked(runner.pressure_controlled, scene, dp)
         scalar = np.ndim(pressure_drop) == 0
-    return Solution(scene=scene, coupler=chosen, state=state, scalar=scalar)
+    return Solution(scene=scene, coupler=chosen, state=state, scalar=scalar,
+                    coupler_name=registry.couplers.name_of(chosen) or type(chosen).__name__)
 
 
 #: Loads per coupler call: bounds the working memory (a few tens of MB) of any sweep.
@@ -147,7 +117,7 @@ def _chunked(method, scene, load):
 
 
 def _finite_max_flow(coupler, scene, q):
-    if scene.wall.is_rigid or not math.isfinite(scene.wall.limit_pressure(scene.tb)):
+    if not math.isfinite(scene.wall.limit_pressure(scene.tb)):     # the rigid wall's included
         return None
     q_max = coupler.max_flow_rate(scene)
     return q_max if math.isfinite(q_max) else None
@@ -161,5 +131,5 @@ def max_flow_rate(rheology, wall, tube, *, outlet_pressure=0.0, coupler="auto") 
     enough in :math:`R`: for a power law, exactly when :math:`n < 1`. Then
     :math:`L\,\phi(q_{max}) = \int_0^\infty s P'(s)/\psi(as)\,du`.
     """
-    scene = _scene(rheology, wall, tube, outlet_pressure)
+    scene = make_scene(rheology, wall, tube, outlet_pressure=outlet_pressure)
     return float(select_coupler(scene.rheology, scene.wall, coupler).max_flow_rate(scene))

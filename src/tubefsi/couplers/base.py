@@ -1,377 +1,92 @@
-r"""The coupler contract, and the separated-variables machinery couplers share.
+r"""The coupler interface: how a solution strategy meets :func:`tubefsi.solve`.
 
-Lubrication theory gives :math:`dp/dz = -G(q, R(p))` with :math:`p(L) = p_{out}`.
-Writing the tube law :math:`p = P(\lambda)` and the log-stretch
-:math:`u = \ln(\lambda/\lambda_{out})` separates the variables:
+A coupler solves the lubrication problem :math:`dp/dz = -G(q, R(p))`, :math:`p(L) = p_{out}`
+(``docs/theory.md``, section "Lubrication") for one :class:`~tubefsi.scene.Scene` and an array
+of loads. It is a small immutable (``attrs`` frozen) object whose fields are its options,
+and it is either abstract or final. Hooks a concrete coupler implements:
 
-.. math::
+=============================================  ===================================================
+hook                                           returns
+=============================================  ===================================================
+``supports(rheology, wall)``                   whether it can solve the pair
+``flow_controlled(scene, flow_rate)``          a :class:`~tubefsi.scene.State` per flow rate
+``pressure_controlled(scene, pressure_drop)``  a :class:`~tubefsi.scene.State` per pressure drop
+``max_flow_rate(scene)``                       the largest flow rate with a steady state (or inf)
+``profile(scene, state, z)``                   the hoop strain and pressure rise at positions z
+=============================================  ===================================================
 
-    L - z = \int_0^{v(z)} \frac{s\,P'(s)}{G(q, a s)}\,du, \qquad s = \lambda_{out} e^u,
+and the class attributes ``cost_rank`` (lower is cheaper; ``coupler="auto"`` takes the
+cheapest that supports the pair) and ``meets_accuracy_contract`` (whether ``auto`` may pick
+it). A coupler that can estimate its own error by solving again at a finer setting returns
+that finer version from :meth:`Coupler.refined`; :class:`~tubefsi.couplers.Checked` then
+compares the two and warns (``AccuracyWarning``) — one wrapper for every such coupler.
 
-so the inlet log-stretch :math:`v` solves :math:`H(v; q) = L` and the pressure drop is
-:math:`\int_0^v s P'(s)\,du`. For a separable rheology, :math:`G = \phi(q)\psi(R)`, this is
-:math:`J(v) = L\,\phi(q)` with :math:`J` independent of :math:`q`, so one function serves a
-whole flow curve. Couplers differ only in how they evaluate :math:`J` (closed form or
-Gauss–Legendre quadrature) or in integrating the ODE instead.
-
-A wall with a maximum stretch :math:`\lambda_{max}` (a locking material such as Gent, the
-first pressure peak of a non-monotone tube law, the representable end of a Fung law) bounds
-:math:`v` by :math:`v_{max} = \ln(\lambda_{max}/\lambda_{out})`. :meth:`Scene.integrate`
-grades its panels geometrically toward :math:`v_{max}` where the pressure is unbounded there
-(:math:`P'` singular: a lock), and narrows them where the integrand grows fast.
+The separated-variables couplers (``closed-form``, ``quadrature``) share an engine,
+:class:`~tubefsi.couplers.separated.SeparatedVariables`; a coupler from a plugin may use it
+or implement the interface from scratch.
 """
 
 from __future__ import annotations
 
 import abc
-import functools
-import math
 from typing import ClassVar
 
-import attrs
-import numpy as np
-from scipy import interpolate
-from scipy import optimize
-from scipy.optimize import elementwise
-
-from .._numerics import EPS, integrate_graded, solve_increasing
-from ..errors import NoSteadyStateError
-from ..rheology.base import yield_stress_of
-
-__all__ = ["Coupler", "Scene", "State"]
-
-#: Largest inlet stretch (relative to the outlet) a solve may reach: ln(1e15).
-MAX_LOG_STRETCH = math.log(1e15)
-_PROBE_LOG_STRETCH = math.log(1e8)
-
-
-@attrs.frozen
-class State:
-    """What a coupler returns: arrays of one shape."""
-
-    flow_rate: np.ndarray
-    pressure_drop: np.ndarray
-    inlet_strain: np.ndarray
-    log_stretch: np.ndarray          # v = ln(lambda_in / lambda_out)
-
-
-@attrs.frozen(kw_only=True)
-class Scene:
-    """A rheology, a wall, a tube and an outlet pressure: everything but the load."""
-
-    rheology: object
-    wall: object
-    tube: object
-    outlet_pressure: float = 0.0
-
-    @property
-    def tb(self) -> float:
-        return self.tube.reduced_thickness
-
-    outlet_strain: float = attrs.field(init=False)
-    outlet_stretch: float = attrs.field(init=False)
-    #: :math:`\ln(\lambda_{max}/\lambda_{out})`: the largest log-stretch (``inf`` for most walls)
-    log_stretch_max: float = attrs.field(init=False)
-
-    def __attrs_post_init__(self):
-        # the hoop strain at the outlet, once: every J evaluation needs it
-        strain = 0.0 if self.outlet_pressure == 0 else float(
-            self.wall._strain(np.asarray(self.outlet_pressure), self.tb))
-        object.__setattr__(self, "outlet_strain", strain)
-        object.__setattr__(self, "outlet_stretch", 1.0 + strain)
-        lam_max = math.inf if self.wall.is_rigid else float(self.wall._max_stretch(self.tb))
-        object.__setattr__(self, "log_stretch_max", math.log(lam_max / (1.0 + strain)))
-        # a maximum stretch with an unbounded pressure (a locking wall) is a singularity of P'
-        singular = math.isfinite(lam_max) and not math.isfinite(self.wall._limit_pressure(self.tb))
-        object.__setattr__(self, "_pole", self.log_stretch_max if singular else math.inf)
-
-    _pole: float = attrs.field(init=False, repr=False)
-
-    def integrate(self, f, upper, *, order=16, panel_width=2.0):
-        """``∫_0^upper f(u, idx) du`` over log-stretch: composite Gauss–Legendre, panels narrowed
-        where ``f`` grows fast and graded toward a locking stretch (see :func:`integrate_graded`)."""
-        return integrate_graded(f, upper, self._pole, order=order, panel_width=panel_width)
-
-    # -- tube law along u
-    def stretch_at(self, u):
-        return self.outlet_stretch * np.exp(u)
-
-    def strain_at(self, u):
-        """Hoop strain at log-stretch ``u``, without cancellation."""
-        return self.outlet_strain + self.outlet_stretch * np.expm1(u)
-
-    def pressure_rise(self, v):
-        r""":math:`P(\lambda_{out}e^v) - p_{out}`, computed without cancellation."""
-        v = np.asarray(v, dtype=float)
-        if self.outlet_pressure == 0.0:
-            return self.wall._pressure_at_strain(np.expm1(v), self.tb)
-        return self.integrate(lambda u, idx: self._slope(u), v)
-
-    def _slope(self, u):
-        s = self.stretch_at(u)
-        return s * self.wall._stiffness(s, self.tb)
-
-    # -- the separated integrand
-    def integrand(self, u, q=None):
-        r""":math:`s P'(s)/\psi(a s)` (separable) or :math:`s P'(s)/G(q, a s)`."""
-        s = self.stretch_at(u)
-        a = self.tube.radius
-        slope = s * self.wall._stiffness(s, self.tb)
-        if self.rheology.separable:
-            return slope / self.rheology._radius_factor(a * s)
-        qq = np.broadcast_to(q, np.shape(u))
-        return slope / self.rheology._pressure_gradient(qq, a * s)
-
-    def target(self, q):
-        """Right-hand side of the separated identity for flow rate ``q``."""
-        if self.rheology.separable:
-            return self.tube.length * self.rheology._flow_factor(q)
-        return np.full(np.shape(q), self.tube.length)
+__all__ = ["Coupler"]
 
 
 class Coupler(abc.ABC):
-    """Abstract solution strategy. Subclasses are attrs frozen classes of options."""
+    """Abstract solution strategy (see the module docstring for the hooks).
+
+    Loads arrive as float arrays (entries >= 0, already validated); the returned
+    :class:`~tubefsi.scene.State` has their shape. Points beyond a limit raise
+    :class:`~tubefsi.NoSteadyStateError`; a numerical failure raises
+    :class:`~tubefsi.ConvergenceError`.
+    """
 
     __slots__ = ()
 
     #: Lower is cheaper; ``coupler="auto"`` takes the cheapest that supports the pair.
     cost_rank: ClassVar[int] = 100
-    #: Whether ``auto`` may pick it (it meets the 1e-12 accuracy contract).
+    #: Whether ``auto`` may pick it (it meets the 1e-12 accuracy contract,
+    #: ``docs/verification.md``, section "Contracts").
     meets_accuracy_contract: ClassVar[bool] = True
-    #: Whether ``_J`` (the separated integral) is available for profiles.
-    separates_variables: ClassVar[bool] = True
 
     @abc.abstractmethod
     def supports(self, rheology, wall) -> bool:
         """Whether this coupler can solve ``rheology`` flowing in ``wall``."""
 
-    # --------------------------------------------------------------- J hooks
     @abc.abstractmethod
-    def _J(self, scene: Scene, v, q):
-        r""":math:`\int_0^v` of the separated integrand (``q`` only if non-separable)."""
+    def flow_controlled(self, scene, flow_rate):
+        """Solve for the pressure drop at each flow rate (float array, m^3/s); a ``State``."""
 
-    def _J_infinity(self, scene: Scene, q=None) -> float:
-        r""":math:`J(\infty)`: finite only for a wall with a limit pressure and a fast
-        enough decay of :math:`s P'(s)/\psi(as)`; used for the maximum flow rate."""
-        tb = scene.tb
-        if not math.isfinite(scene.wall._limit_pressure(tb)):
-            return math.inf
-        qq = None if q is None else np.asarray(q, dtype=float)
-        if math.isfinite(scene.log_stretch_max):
-            # the tube law ends at its pressure peak: J stays finite up to it
-            return float(self._J(scene, np.asarray(scene.log_stretch_max * (1 - 8 * EPS)), qq))
-        rheo = scene.rheology
-        mu = getattr(rheo, "radius_exponent", None)
-        if mu is None:
-            # local exponent of G in R far out, where the probe of J(inf) ends
-            r = scene.tube.radius * np.exp(_PROBE_LOG_STRETCH) * np.array([1.0, 10.0])
-            g = rheo._radius_factor(r) if rheo.separable else rheo._pressure_gradient(np.full(2, q), r)
-            mu = float(-np.log(g[1] / g[0]) / np.log(10.0))
-        alpha = scene.wall._stiffness_decay_exponent(tb) - 1.0 - mu
-        if not alpha > 1e-12:
-            return math.inf
-        v1 = np.asarray(_PROBE_LOG_STRETCH)
-        head = self._J(scene, v1, qq)
-        tail = scene.integrand(v1, qq) / alpha
-        return float(head + tail)
+    @abc.abstractmethod
+    def pressure_controlled(self, scene, pressure_drop):
+        """Solve for the flow rate at each pressure drop (float array, Pa); a ``State``."""
 
-    # --------------------------------------------------------------- problems
-    def flow_controlled(self, scene: Scene, flow_rate) -> State:
-        """Solve for the pressure drop at each flow rate (array)."""
-        q = np.asarray(flow_rate, dtype=float)
-        if scene.wall.is_rigid:
-            dp = scene.tube.length * scene.rheology._pressure_gradient(q, scene.tube.radius)
-            dp = np.where(q == 0, 0.0, dp)
-            zero = np.zeros_like(q)
-            return State(q, dp, zero + scene.outlet_strain, zero)
-        v, ok = self.solve_log_stretch(scene, np.where(q == 0, 0.0, scene.target(q)), q)
-        if not np.all(ok):
-            self._raise_runaway(scene, q, ok)
-        dp = scene.pressure_rise(v)
-        return State(q, dp, scene.strain_at(v), v)
+    @abc.abstractmethod
+    def max_flow_rate(self, scene) -> float:
+        """The largest flow rate with a steady state (m^3/s); ``inf`` where every one has one."""
 
-    def solve_log_stretch(self, scene: Scene, target, q=None, upper=None):
-        r"""Log-stretch :math:`v` with :math:`J(v; q) = ` ``target``, elementwise; returns ``(v, ok)``.
+    @abc.abstractmethod
+    def profile(self, scene, state, z):
+        r"""``(strain, pressure_rise)`` at positions ``z`` (m), broadcast against the state's shape.
 
-        Safeguarded Newton on :math:`\ln J`. For a separable rheology a whole curve
-        shares :math:`J`, so a coarse solve on a few quantiles of the targets gives
-        every point a starting value within a few Newton steps of its root.
+        ``strain`` is the hoop strain :math:`\lambda(z) - 1` (never formed by subtraction) and
+        ``pressure_rise`` is :math:`p(z) - p_{out}`.
         """
-        sep = scene.rheology.separable
-        target = np.asarray(target, dtype=float)
-        qflat = None if sep else np.broadcast_to(q, target.shape).ravel()
 
-        def F(v, i):
-            return self._J(scene, v, None if sep else qflat[i])
+    def refined(self) -> Coupler | None:
+        """A finer version of this coupler for an a-posteriori error check, or None (no check).
 
-        def dF(v, i):
-            return scene.integrand(v, None if sep else qflat[i])
-
-        positive = target[target > 0]
-        if sep and positive.size > 256:
-            anchors = np.geomspace(positive.min(), positive.max(), 129)
-            v_anchor, ok = self.solve_log_stretch(scene, anchors)
-            keep = ok & (v_anchor < MAX_LOG_STRETCH)
-            if np.count_nonzero(keep) >= 2:
-                shape = interpolate.PchipInterpolator(np.log(anchors[keep]), v_anchor[keep], extrapolate=True)
-                guess = np.maximum(shape(np.log(np.where(target > 0, target, anchors[0]))), 0.0)
-            else:
-                guess = np.ones(target.shape)
-        else:
-            with np.errstate(divide="ignore", invalid="ignore"):   # G(0, R) = 0: only where target = 0
-                slope0 = scene.integrand(np.zeros(target.shape), None if sep else np.broadcast_to(q, target.shape))
-                guess = np.where(target > 0, np.minimum(target / slope0, 1.0), 0.0)
-        if upper is not None:
-            guess = np.minimum(guess, upper)
-        cap = self._log_stretch_cap(scene)
-        if math.isfinite(scene.log_stretch_max):
-            upper = cap if upper is None else np.minimum(upper, cap)
-            guess = np.minimum(guess, 0.5 * cap)
-        v, ok = solve_increasing(F, dF, target, guess=guess, upper=upper, xmax=MAX_LOG_STRETCH, max_step=2.0,
-                                 log=True)
-        if math.isfinite(scene.log_stretch_max):
-            # converged onto the maximum stretch without reaching the target: out of reach
-            at_cap = np.flatnonzero((v.ravel() >= cap * (1 - 1e-12)) & (target.ravel() > 0))
-            if at_cap.size:
-                short = F(v.ravel()[at_cap], at_cap) < target.ravel()[at_cap] * (1 - 1e-9)
-                ok = ok.copy()
-                ok.ravel()[at_cap[short]] = False
-        return v, ok
-
-    @staticmethod
-    def _log_stretch_cap(scene):
-        """The largest log-stretch a solve may reach: below a maximum stretch, and ln(1e15)."""
-        v_max = scene.log_stretch_max
-        return min(MAX_LOG_STRETCH, v_max * (1 - 8 * EPS)) if math.isfinite(v_max) else MAX_LOG_STRETCH
-
-    def pressure_controlled(self, scene: Scene, pressure_drop) -> State:
-        """Solve for the flow rate at each pressure drop (array)."""
-        dp = np.asarray(pressure_drop, dtype=float)
-        tb, wall, a, L = scene.tb, scene.wall, scene.tube.radius, scene.tube.length
-        rheo = scene.rheology
-        if wall.is_rigid:
-            q = np.where(dp == 0, 0.0, rheo._flow_rate(np.full_like(dp, a), np.where(dp == 0, 1.0, dp) / L))
-            zero = np.zeros_like(dp)
-            return State(q, dp, zero + scene.outlet_strain, zero)
-        wall._check_pressure(scene.outlet_pressure + dp, tb)
-        e_in = wall._strain(scene.outlet_pressure + dp, tb)
-        v = np.log1p((e_in - scene.outlet_strain) / scene.outlet_stretch)
-        if rheo.separable:
-            q = rheo._flow_factor_inverse(self._J(scene, v, None) / L)
-        else:
-            q = self._solve_flow_rate(scene, v, dp)
-        q = np.where(dp == 0, 0.0, q)
-        return State(q, dp, e_in, v)
-
-    def _solve_flow_rate(self, scene, v, dp):
-        r"""Non-separable rheology: find q with H(v; q) = L (H decreases with q).
-
-        Rigid tubes of the outlet and inlet radii under the mean gradient dp/L bracket q.
-        A yield-stress fluid has a finite :math:`H(v; 0^+)`, with :math:`G = 2\tau_y/R`:
-        where it does not exceed L the pressure drop cannot yield the fluid all along
-        the tube, and q = 0.
+        :class:`~tubefsi.couplers.Checked` solves with both and warns when they differ by
+        more than :meth:`error_threshold`.
         """
-        a, L, rheo = scene.tube.radius, scene.tube.length, scene.rheology
-        shape = np.shape(v)
-        v = np.asarray(v, dtype=float).ravel()
-        dp = np.broadcast_to(np.asarray(dp, dtype=float), shape).ravel()
-        g = np.where(dp == 0, 1.0, dp) / L
-        q_lo = rheo._flow_rate(np.full_like(g, a * scene.outlet_stretch), g)
-        q_hi = rheo._flow_rate(a * scene.stretch_at(v), g)
-        flowing = (q_hi > 0) & (dp > 0)
-        if yield_stress_of(rheo) > 0 and np.any(flowing):
-            flowing[flowing] = self._J(scene, v[flowing], np.zeros(np.count_nonzero(flowing))) > L
-        q = np.zeros(v.shape)
-        if not np.any(flowing):
-            return q.reshape(shape)
-        v, q_lo, q_hi = v[flowing], q_lo[flowing], q_hi[flowing]
+        return None
 
-        def f(log_q, v):
-            return np.log(self._J(scene, v, np.exp(log_q))) - math.log(L)
+    def error_threshold(self) -> float:
+        """Largest relative difference from :meth:`refined` accepted without a warning."""
+        return 1e-8
 
-        hi = np.log(q_hi) * (1 + 1e-15) + 1e-15
-        with np.errstate(divide="ignore"):
-            lo = np.log(q_lo)
-        lo = lo - 1e-12 * np.abs(lo)
-        found = np.ones(v.shape, dtype=bool)
-        unyielded = q_lo <= 0          # the outlet section alone would not yield: search down
-        if np.any(unyielded):
-            top = hi[unyielded]
-            br = elementwise.bracket_root(f, top - 2.0, top, xmin=top - 700.0, xmax=top, args=(v[unyielded],))
-            lo[unyielded] = br.bracket[0]
-            hi[unyielded] = np.where(br.success, br.bracket[1], hi[unyielded])
-            found[unyielded] = br.success   # else q < 1e-304 q_hi: zero in double precision
-        res = elementwise.find_root(f, (lo, hi), args=(v,),
-                                    tolerances=dict(xrtol=4 * np.finfo(float).eps, xatol=1e-300))
-        q[flowing] = np.where(found, np.exp(res.x), 0.0)
-        return q.reshape(shape)
-
-    def max_flow_rate(self, scene: Scene) -> float:
-        """Largest flow rate with a steady state (``inf`` if none)."""
-        if scene.wall.is_rigid or not math.isfinite(scene.wall._limit_pressure(scene.tb)):
-            return math.inf
-        if not scene.rheology.separable:
-            return self._max_flow_rate_general(scene)
-        j_inf = self._J_infinity(scene)
-        if not math.isfinite(j_inf):
-            return math.inf
-        try:
-            with np.errstate(over="ignore"):
-                return float(scene.rheology._flow_factor_inverse(j_inf / scene.tube.length))
-        except OverflowError:  # beyond double precision (e.g. the representable end of a Fung wall)
-            return math.inf
-
-    def _max_flow_rate_general(self, scene: Scene) -> float:
-        """Non-separable rheology: the q with H(inf; q) = L (H decreases with q), by Brent's method;
-        cached per (coupler, scene), since every flow-controlled solve asks for it."""
-        try:
-            return _cached_max_flow_rate(self, scene)
-        except TypeError:  # an unhashable model
-            return self._max_flow_rate_search(scene)
-
-    def _max_flow_rate_search(self, scene: Scene) -> float:
-        L = scene.tube.length
-        tau_y = yield_stress_of(scene.rheology)
-        if tau_y > 0 and not self._J_infinity(scene, 0.0) > L:
-            return 0.0  # even the limit pressure cannot yield the fluid all along the tube
-
-        def excess(log_q):
-            return math.log(self._J_infinity(scene, math.exp(log_q))) - math.log(L)
-
-        a = scene.tube.radius
-        g0 = max(scene.wall._limit_pressure(scene.tb) / L, 4.0 * tau_y / a)
-        log_q = math.log(float(scene.rheology._flow_rate(np.asarray([a]), np.asarray([g0]))[0]))
-        if not math.isfinite(excess(log_q)):
-            return math.inf  # G(q, R) falls off too fast in R: every flow rate has a steady state
-        lo, hi = log_q, log_q
-        while excess(lo) < 0:
-            lo -= 2.0
-        while excess(hi) > 0:
-            hi += 2.0
-            if hi - log_q > 200:
-                return math.inf
-        return math.exp(optimize.brentq(excess, lo, hi, xtol=1e-15, rtol=4 * np.finfo(float).eps))
-
-    def _raise_runaway(self, scene, q, ok):
-        q_max = self.max_flow_rate(scene)
-        bad = q[~ok].flat[0]
-        if math.isfinite(q_max) and bad >= q_max:
-            raise NoSteadyStateError("flow_rate", q_max, bad, "the tube inflates without bound")
-        cap = self._log_stretch_cap(scene)
-        v = np.asarray(cap)
-        sep = scene.rheology.separable
-        if sep:
-            reach = float(scene.rheology._flow_factor_inverse(self._J(scene, v, None) / scene.tube.length))
-        else:
-            v1 = np.array([cap])
-            reach = float(self._solve_flow_rate(scene, v1, scene.pressure_rise(v1))[0])
-        if cap < MAX_LOG_STRETCH:
-            raise NoSteadyStateError("flow_rate", reach, bad,
-                                     "the inlet stretch would reach the wall's maximum stretch")
-        raise NoSteadyStateError("flow_rate", reach, bad,
-                                 "the inlet stretch would exceed 1e15 (the tube inflates without practical bound)")
-
-
-@functools.lru_cache(maxsize=256)
-def _cached_max_flow_rate(coupler, scene) -> float:
-    return coupler._max_flow_rate_search(scene)
+    def describe(self) -> str:
+        """A short description for messages (default: the class name)."""
+        return type(self).__name__

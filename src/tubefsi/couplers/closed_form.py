@@ -15,29 +15,26 @@ evaluated as ``expm1(c v)/c``, exact through the removable singularities at
 
 from __future__ import annotations
 
-from typing import ClassVar
+from typing import ClassVar, final
 
 import attrs
 import numpy as np
 
-from .base import MAX_LOG_STRETCH, Coupler, State
+from ..scene import State
+from .separated import MAX_LOG_STRETCH, SeparatedVariables
 
 __all__ = ["ClosedForm"]
 
 
+@final
 @attrs.frozen(kw_only=True)
-class ClosedForm(Coupler):
+class ClosedForm(SeparatedVariables):
     """Closed-form separated integral (power-law fluid; rigid, linear or thin hyperelastic wall)."""
 
     cost_rank: ClassVar[int] = 0
 
     def supports(self, rheology, wall) -> bool:
-        if getattr(rheology, "radius_exponent", None) is None or not rheology.separable:
-            return False
-        if wall.is_rigid:
-            return True
-        probe = wall._power_law_integral(np.asarray(0.5), 1.0, 4.0, 0.1)
-        return probe is not None
+        return rheology.separable and rheology.radius_exponent is not None and wall.closed_form_integral
 
     def _J(self, scene, v, q):
         k = scene.rheology.radius_exponent
@@ -54,11 +51,11 @@ class ClosedForm(Coupler):
         if scene.wall.is_rigid:
             return super().flow_controlled(scene, q)
         k = scene.rheology.radius_exponent
-        target = scene.target(q) / scene.tube.radius**k
+        target = self.target(scene, q) / scene.tube.radius**k
         v = scene.wall._power_law_integral_inverse(target, scene.outlet_stretch, k, scene.tb)
         if v is None:
             return super().flow_controlled(scene, q)
         v = np.where(q == 0, 0.0, v)
         if not np.all(v <= MAX_LOG_STRETCH):
             self._raise_runaway(scene, q, v <= MAX_LOG_STRETCH)
-        return State(q, scene.pressure_rise(v), scene.strain_at(v), v)
+        return State(q, self.pressure_rise(scene, v), self.strain_at(scene, v), v)

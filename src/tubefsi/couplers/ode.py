@@ -14,21 +14,27 @@ each divided by its rigid-tube scale (:math:`\Delta p_0 = L\,G(q, a)` and
 rtol = 1e-8, atol = 1e-10), or ``"odeint"`` for :func:`scipy.integrate.odeint` (LSODA)
 with its own defaults — the chapter's method, kept as the speed baseline. Pressure-controlled problems are solved by
 shooting on the flow rate (Brent's method inside the rigid-tube bracket). One ODE
-runs per point; this coupler is a reference, not a default.
+runs per point; this coupler is a reference, not a default. With ``check_error`` (the
+default) :func:`tubefsi.solve` re-integrates at 1/100 of the tolerances
+(:meth:`ODE.refined`, through :class:`~tubefsi.couplers.Checked`) and warns where the two
+results differ by more than ten times the tolerance. The maximum flow rate, the profiles
+and the rigid tube come from the separated-variables engine (``quadrature``): they are
+properties of the problem, not of the integrator.
 """
 
 from __future__ import annotations
 
 import math
-import warnings
-from typing import ClassVar
+from typing import ClassVar, final
 
 import attrs
 import numpy as np
 from scipy import integrate, optimize
 
-from ..errors import AccuracyWarning, ConvergenceError, NoSteadyStateError
-from .base import Coupler, State
+from ..errors import ConvergenceError, InvalidParameterError, NoSteadyStateError
+from ..scene import State
+from .base import Coupler
+from .quadrature import Quadrature
 
 __all__ = ["ODE"]
 
@@ -38,13 +44,16 @@ _MAX_EVALUATIONS = 20_000
 _METHODS = ("odeint", "RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 
 
+#: The engine behind the maximum flow rate, the profiles and the rigid tube.
+_ENGINE = Quadrature()
+
+
 def _check_method(instance, attribute, value):
     if value not in _METHODS:
-        from ..errors import InvalidParameterError
-
         raise InvalidParameterError("method", "{" + ", ".join(_METHODS) + "}", value)
 
 
+@final
 @attrs.frozen(kw_only=True)
 class ODE(Coupler):
     """Integrate dp/dz = -G(q, R(p)) with SciPy (reference path, one ODE per point)."""
@@ -59,18 +68,28 @@ class ODE(Coupler):
 
     cost_rank: ClassVar[int] = 1000
     meets_accuracy_contract: ClassVar[bool] = False
-    separates_variables: ClassVar[bool] = False
 
     def supports(self, rheology, wall) -> bool:
         return True
 
-    def _J(self, scene, v, q):  # pragma: no cover - the ODE path does not separate variables
-        raise NotImplementedError
-
     def max_flow_rate(self, scene):
-        from .quadrature import Quadrature
+        return _ENGINE.max_flow_rate(scene)
 
-        return Quadrature().max_flow_rate(scene)
+    def profile(self, scene, state, z):
+        return _ENGINE.profile(scene, state, z)
+
+    def refined(self):
+        """The same integrator at 1/100 of the tolerances (when ``check_error``)."""
+        if not self.check_error:
+            return None
+        rtol, atol = self._tolerances()
+        return attrs.evolve(self, rtol=0.01 * rtol, atol=0.01 * atol, check_error=False)
+
+    def error_threshold(self) -> float:
+        return min(10 * self._tolerances()[0], 1e-3)
+
+    def describe(self) -> str:
+        return f"ODE({self.method}, rtol={self._tolerances()[0]:g})"
 
     def _tolerances(self):
         """The tolerances in force: odeint's own defaults, or 1e-8 / 1e-10 for solve_ivp."""
@@ -78,8 +97,8 @@ class ODE(Coupler):
             return (self.rtol or 1.49012e-8), (self.atol or 1.49012e-8)
         return (self.rtol or 1e-8), (self.atol or 1e-10)
 
-    def _integrate(self, scene, q, scale=1.0):
-        """Return (inlet strain, pressure rise) for one flow rate; tolerances times ``scale``."""
+    def _integrate(self, scene, q):
+        """Return (inlet strain, pressure rise) for one flow rate."""
         tb, a, L = scene.tb, scene.tube.radius, scene.tube.length
         wall, rheo = scene.wall, scene.rheology
         lam_max = wall._max_stretch(tb)
@@ -107,13 +126,12 @@ class ODE(Coupler):
         try:
             if self.method == "odeint":
                 y, info = integrate.odeint(rhs, y0, [L, 0.0], tfirst=True, full_output=True,
-                                           rtol=rtol * scale, atol=atol * scale)
+                                           rtol=rtol, atol=atol)
                 if info["message"] != "Integration successful.":
                     raise ConvergenceError(f"odeint failed at q = {q!r}: {info['message']}")
                 strain, rise = y[-1]
             else:
-                sol = integrate.solve_ivp(rhs, (L, 0.0), y0, method=self.method, rtol=rtol * scale,
-                                          atol=atol * scale)
+                sol = integrate.solve_ivp(rhs, (L, 0.0), y0, method=self.method, rtol=rtol, atol=atol)
                 if not sol.success:
                     raise ConvergenceError(f"solve_ivp({self.method}) failed at q = {q!r}: {sol.message}")
                 strain, rise = sol.y[:, -1]
@@ -126,27 +144,13 @@ class ODE(Coupler):
             raise ConvergenceError(f"the ODE solution is not finite at q = {q!r}")
         return strain, rise
 
-    def _integrate_checked(self, scene, q, errors):
-        strain, rise = self._integrate(scene, q)
-        if self.check_error:
-            strain_fine, rise_fine = self._integrate(scene, q, scale=0.01)
-            errors.append(max(abs(rise / rise_fine - 1.0),
-                              abs((strain - strain_fine) / max(strain_fine, 1e-300))))
-        return strain, rise
-
-    def _warn_accuracy(self, errors):
-        rtol = self._tolerances()[0]
-        if errors and max(errors) > min(10 * rtol, 1e-3):
-            warnings.warn(f"ODE({self.method}, rtol={rtol:g}): estimated relative error {max(errors):.2g} "
-                          f"exceeds ten times the tolerance; tighten rtol/atol or use coupler='auto'",
-                          AccuracyWarning, stacklevel=5)
-
-    def _shoot(self, scene, drop, lo, hi, scale):
+    def _shoot(self, scene, drop, lo, hi):
         """The flow rate whose integrated pressure rise is ``drop``, by Brent's method in [lo, hi]."""
 
         def miss(qq):
-            return self._integrate(scene, qq, scale)[1] - drop
+            return self._integrate(scene, qq)[1] - drop
 
+        q_max = self.max_flow_rate(scene)
         f_lo, f_hi = miss(lo), miss(hi)
         for _ in range(20):  # integration error may shift the root just outside the exact bracket
             if f_lo <= 0 <= f_hi:
@@ -155,7 +159,7 @@ class ODE(Coupler):
                 lo *= 0.999
                 f_lo = miss(lo)
             if f_hi < 0:
-                hi = hi * 1.001 if not math.isfinite(self.max_flow_rate(scene)) else 0.5 * (hi + self.max_flow_rate(scene))
+                hi = hi * 1.001 if not math.isfinite(q_max) else 0.5 * (hi + q_max)
                 f_hi = miss(hi)
         else:
             raise ConvergenceError(f"{self.method}: shooting could not bracket the flow rate for Δp = {drop!r}")
@@ -164,17 +168,14 @@ class ODE(Coupler):
     def flow_controlled(self, scene, flow_rate) -> State:
         q = np.asarray(flow_rate, dtype=float)
         if scene.wall.is_rigid:
-            return super().flow_controlled(scene, q)
+            return _ENGINE.flow_controlled(scene, q)
         q_max = self.max_flow_rate(scene)
         if np.any(q >= q_max):
             raise NoSteadyStateError("flow_rate", q_max, q[q >= q_max].flat[0])
         strain = np.empty(q.size)
         rise = np.empty(q.size)
-        errors = []
         for i, qi in enumerate(q.ravel()):
-            strain[i], rise[i] = ((scene.outlet_strain, 0.0) if qi == 0
-                                  else self._integrate_checked(scene, qi, errors))
-        self._warn_accuracy(errors)
+            strain[i], rise[i] = (scene.outlet_strain, 0.0) if qi == 0 else self._integrate(scene, qi)
         strain, rise = strain.reshape(q.shape), rise.reshape(q.shape)
         v = np.log1p((strain - scene.outlet_strain) / scene.outlet_stretch)
         return State(q, rise, strain, v)
@@ -182,12 +183,11 @@ class ODE(Coupler):
     def pressure_controlled(self, scene, pressure_drop) -> State:
         dp = np.asarray(pressure_drop, dtype=float)
         if scene.wall.is_rigid:
-            return super().pressure_controlled(scene, dp)
+            return _ENGINE.pressure_controlled(scene, dp)
         tb, a, L, rheo = scene.tb, scene.tube.radius, scene.tube.length, scene.rheology
         scene.wall._check_pressure(scene.outlet_pressure + dp, tb)
         e_in = scene.wall._strain(scene.outlet_pressure + dp, tb)
         q = np.zeros(dp.size)
-        errors = []
         q_max = self.max_flow_rate(scene)
         for i, (d, e) in enumerate(zip(dp.ravel(), np.ravel(e_in))):
             if d == 0:
@@ -199,10 +199,7 @@ class ODE(Coupler):
             if hi <= lo * (1 + 1e-14):
                 q[i] = lo
                 continue
-            q[i] = self._shoot(scene, d, lo, hi, 1.0)
-            if self.check_error:
-                errors.append(abs(q[i] / self._shoot(scene, d, lo, hi, 0.01) - 1.0))
-        self._warn_accuracy(errors)
+            q[i] = self._shoot(scene, d, lo, hi)
         q = q.reshape(dp.shape)
         v = np.log1p((e_in - scene.outlet_strain) / scene.outlet_stretch)
         return State(q, dp, e_in, v)

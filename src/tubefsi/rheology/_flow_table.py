@@ -71,7 +71,7 @@ class FlowTable:
 
     def __init__(self, rheology):
         self.rheology = rheology
-        self.yield_stress = float(getattr(rheology, "yield_stress", 0.0))
+        self.yield_stress = float(rheology.yield_stress)
         self.panels: dict[int, np.ndarray] = {}   # panel index -> Chebyshev coefficients
         self._slopes: dict[int, np.ndarray] = {}  # panel index -> coefficients of the derivative
 

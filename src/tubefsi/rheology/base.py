@@ -29,12 +29,15 @@ from __future__ import annotations
 
 import abc
 import math
+from typing import ClassVar
 
 import numpy as np
 from scipy.optimize import elementwise
 
 from .._numerics import as_output
 from .._validation import as_array
+from ..errors import InvalidParameterError
+from ._flow_table import _T, _W, flow_table
 
 __all__ = ["Rheology"]
 
@@ -45,18 +48,45 @@ def _overrides(obj, name) -> bool:
     return getattr(type(obj), name) is not getattr(Rheology, name)
 
 
-def yield_stress_of(rheology) -> float:
-    """The yield stress of ``rheology`` (Pa): its ``yield_stress`` field, else 0."""
-    return float(getattr(rheology, "yield_stress", 0.0))
-
-
 class Rheology(abc.ABC):
-    """Abstract base of every rheology (see the module docstring for the contract)."""
+    r"""Abstract base of every rheology (see the module docstring for the contract).
+
+    Hooks (arrays of positive arguments; implement one of the first two, override the
+    others for speed or accuracy):
+
+    ===============================  ======================================================================
+    hook (arguments)                 default
+    ===============================  ======================================================================
+    ``_stress(shear_rate)``          natural hook, or the inverse of ``_shear_rate`` (a root solve)
+    ``_shear_rate(stress)``          natural hook, or the inverse of ``_stress``
+    ``_apparent_shear_rate``         ``(wall_stress, excess=None)``: :math:`\Gamma = 4q/(\pi R^3)` by the
+                                     Rabinowitsch–Mooney integral (a fixed rule graded toward zero stress)
+    ``_flow_rate``                   ``(radius, pressure_gradient)``: :math:`\pi R^3\Gamma(GR/2)/4`
+    ``_pressure_gradient``           ``(flow_rate, radius)``: the inverse, from a cached Chebyshev table of
+                                     :math:`\ln\Gamma`
+    ``_velocity``                    ``(r, radius, pressure_gradient)``:
+                                     :math:`\int_r^R \dot\gamma(G\rho/2)\,d\rho` by quadrature
+    ``_flow_factor``                 separable rheologies only: :math:`\phi(q)` in :math:`G = \phi(q)\psi(R)`,
+    ``_flow_factor_inverse``         its inverse,
+    ``_radius_factor``               and :math:`\psi(R)`
+    ===============================  ======================================================================
+
+    Class attributes: ``separable``, ``radius_exponent`` (:math:`k` with
+    :math:`\psi(R) = R^{-k}`, for power-law-like fluids: enables the ``closed-form``
+    coupler; None otherwise), ``yield_stress`` (0 unless the fluid declares a
+    ``yield_stress`` field) and ``_examples`` (parameter sets for the contract suites).
+    """
 
     __slots__ = ()
 
     #: True when ``pressure_gradient(q, R) = phi(q) * psi(R)``.
-    separable = False
+    separable: ClassVar[bool] = False
+    #: :math:`k` with :math:`G(q, R) = \phi(q) R^{-k}` (power law: :math:`3n+1`); None if not of that form.
+    radius_exponent = None
+    #: The yield stress (Pa); a yield-stress fluid declares it as a field.
+    yield_stress = 0.0
+    #: Example parameter sets (keyword dicts) run through the contract suites of :mod:`tubefsi.testing`.
+    _examples: ClassVar[tuple] = ()
 
     # ------------------------------------------------------------------ public API
     def stress(self, shear_rate):
@@ -125,7 +155,7 @@ class Rheology(abc.ABC):
         if not _overrides(self, "_stress"):
             raise TypeError(f"{type(self).__name__} must implement _stress or _shear_rate")
         t = np.asarray(stress, dtype=float)
-        tau_y = yield_stress_of(self)
+        tau_y = float(self.yield_stress)
         flowing = t > tau_y
         tt = np.where(flowing, t, tau_y + 1.0)
 
@@ -159,10 +189,8 @@ class Rheology(abc.ABC):
         :math:`\tau_y/\tau_w < t < 1` only (0 when :math:`\tau_w \le \tau_y`). Closed forms
         (Buckingham–Reiner for Bingham, ...) may override it.
         """
-        from ._flow_table import _T, _W
-
         tau_w = np.asarray(wall_stress, dtype=float)
-        tau_y = yield_stress_of(self)
+        tau_y = float(self.yield_stress)
         if _overrides(self, "_shear_rate"):
             if tau_y == 0.0:
                 return 4.0 * (self._shear_rate(tau_w[..., None] * _T) * _T * _T) @ _W
@@ -180,8 +208,6 @@ class Rheology(abc.ABC):
         :math:`2\tau_y/R` of a yield-stress fluid (non-separable rheologies)."""
         if self.separable:
             return self._flow_factor(flow_rate) * self._radius_factor(radius)
-        from ._flow_table import flow_table
-
         return 2.0 * flow_table(self).wall_stress(4.0 * flow_rate / (math.pi * radius**3)) / radius
 
     def _velocity(self, r, radius, pressure_gradient):
@@ -190,11 +216,9 @@ class Rheology(abc.ABC):
     def _velocity_generic(self, r, radius, pressure_gradient):
         r""":math:`v(r) = \int_r^R \dot\gamma(G\rho/2)\,d\rho` by the same graded rule; for a
         stress-natural law, by parts: :math:`\frac{2}{G}\big([\tau\dot\gamma] - \int \tau\,d\dot\gamma\big)`."""
-        from ._flow_table import _T, _W
-
         r, radius, g = (np.asarray(x, dtype=float) for x in (r, radius, pressure_gradient))
         if _overrides(self, "_shear_rate"):
-            tau_y = yield_stress_of(self)
+            tau_y = float(self.yield_stress)
             if tau_y > 0.0:  # integrate over the yielded annulus only: the plug moves rigidly
                 r = np.maximum(r, np.minimum(radius, 2.0 * tau_y / g))
             rho = r[..., None] + (radius - r)[..., None] * _T
@@ -218,6 +242,4 @@ class Rheology(abc.ABC):
 
 
 def _invalid(name, admissible, value):
-    from ..errors import InvalidParameterError
-
     return InvalidParameterError(name, admissible, value)

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import attrs
 
-from .._validation import positive
+from ..fields import positive
 from .power_law import _PowerLawForms
 
 __all__ = ["Newtonian"]

@@ -12,7 +12,7 @@ import math
 import attrs
 import numpy as np
 
-from .._validation import positive
+from ..fields import positive
 from .base import Rheology
 
 __all__ = ["PowerLaw"]

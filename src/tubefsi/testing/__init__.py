@@ -13,13 +13,30 @@ run on each. A plugin's tests subclass the suites and provide fixtures::
             return request.param
 
 Suites: :class:`WallContract`, :class:`HyperelasticWallContract`,
-:class:`RheologyContract`, :class:`CouplerContract`.
+:class:`RheologyContract`, :class:`CouplerContract` (whose ``case`` fixture
+:func:`coupler_cases` fills: every registered coupler that supports each pair).
+
+Independent references live in the subpackage :mod:`tubefsi.testing.reference`, which this
+module does not import (its mpmath modules need ``mpmath``, from the ``test`` extra); import its
+modules directly:
+
+* ``tubefsi.testing.reference.tube_laws`` — the tube laws in mpmath: one reference wall for the
+  closed-form built-in laws and for any material given by its strain energy;
+* ``tubefsi.testing.reference.power_law`` — power-law flow, separated (the integral ``Jhat``, its
+  tail, the maximum flow rate);
+* ``tubefsi.testing.reference.rheology`` — generalized Newtonian flow (Carreau–Yasuda, laws
+  given by their shear rate, yield stress included) through the Rabinowitsch–Mooney integral;
+* ``tubefsi.testing.reference.chapter_baseline`` — the chapter's method (``odeint`` at its
+  default tolerances, one ODE per point), the baseline of the speed benchmarks;
+* ``tubefsi.testing.reference.rel_err`` — the relative error of a result against a reference.
+
+Nothing there calls tubefsi's numerics.
 """
 
 from .contracts import CouplerContract, HyperelasticWallContract, RheologyContract, WallContract
-from .strategies import examples, flow_rates, reduced_thicknesses, strains
+from .strategies import coupler_cases, examples, flow_rates, reduced_thicknesses, strains
 
 __all__ = [
     "WallContract", "HyperelasticWallContract", "RheologyContract", "CouplerContract",
-    "examples", "strains", "reduced_thicknesses", "flow_rates",
+    "examples", "coupler_cases", "strains", "reduced_thicknesses", "flow_rates",
 ]

@@ -16,10 +16,11 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from scipy import differentiate
 
+from ..couplers.quadrature import Quadrature
 from ..errors import InvalidParameterError, NoSteadyStateError
 from ..geometry import Tube
 from ..rheology._flow_table import tanh_sinh
-from ..rheology.base import yield_stress_of
+from ..solve import max_flow_rate, solve
 from ..walls.hyperelastic import HyperelasticWall, ThickWall, ThinWall
 from ..walls.linear import ThickLinear, ThinLinear
 from .strategies import flow_rates, reduced_thicknesses, strains
@@ -212,7 +213,7 @@ class RheologyContract:
     @given(radius=st.floats(-6, -2).map(lambda x: 10.0**x), gradient=st.floats(0, 8).map(lambda x: 10.0**x))
     def test_flow_function_inverts_and_matches_rabinowitsch_mooney(self, rheology, radius, gradient):
         q = rheology.flow_rate(radius, gradient)
-        tau_w, tau_y = 0.5 * gradient * radius, yield_stress_of(rheology)
+        tau_w, tau_y = 0.5 * gradient * radius, float(rheology.yield_stress)
         if tau_w <= tau_y:
             assert q == 0.0
             return
@@ -224,12 +225,12 @@ class RheologyContract:
 
     def test_velocity_profile_carries_the_flow_rate(self, rheology):
         radius = 1e-4
-        gradient = max(1e5, 8.0 * yield_stress_of(rheology) / radius)   # wall stress >= 4 tau_y
+        gradient = max(1e5, 8.0 * float(rheology.yield_stress) / radius)   # wall stress >= 4 tau_y
         q = rheology.flow_rate(radius, gradient)
         # flux by the tanh-sinh rule (endpoint singularities such as r^(1 + 1/n) cost nothing),
         # split at the plug radius of a yield-stress fluid; one vectorized velocity call
         t, w = tanh_sinh(7)
-        r_plug = min(radius, 2.0 * yield_stress_of(rheology) / gradient)
+        r_plug = min(radius, 2.0 * float(rheology.yield_stress) / gradient)
         r = np.concatenate([r_plug * t, r_plug + (radius - r_plug) * t])
         weights = np.concatenate([r_plug * w, (radius - r_plug) * w])
         flux = float(np.sum(weights * 2 * math.pi * r * rheology.velocity(r, radius, gradient)))
@@ -243,7 +244,7 @@ class RheologyContract:
 
     def test_yield_stress(self, rheology):
         """No flow below the yield gradient 2 tau_y / R, G(q -> 0+) -> 2 tau_y / R, a rigid plug."""
-        tau_y = yield_stress_of(rheology)
+        tau_y = float(rheology.yield_stress)
         if not tau_y > 0:
             pytest.skip("no yield stress")
         radius = 1e-3
@@ -287,14 +288,10 @@ class CouplerContract:
         raise NotImplementedError
 
     def _reference(self):
-        from ..couplers.quadrature import Quadrature
-
         return Quadrature()
 
     def _load_scale(self, rheology, wall):
         """A flow rate that strains the tube by O(1) but stays below any maximum flow rate."""
-        from ..solve import max_flow_rate
-
         tb, a, L = self.tube.reduced_thickness, self.tube.radius, self.tube.length
         dp = 0.5 * (1.0 if wall.is_rigid else wall.small_strain_modulus(tb))
         if wall.is_rigid:
@@ -303,16 +300,12 @@ class CouplerContract:
         return min(q, 0.9 * max_flow_rate(rheology, wall, self.tube))
 
     def _solve(self, case, **kw):
-        from ..solve import solve
-
         rheology, wall, coupler = case
         return solve(rheology, wall, self.tube, coupler=coupler, **kw)
 
     @settings(deadline=None, max_examples=10, suppress_health_check=[HealthCheck.function_scoped_fixture])
     @given(fraction=flow_rates(1e-3, 1.0))
     def test_agrees_with_reference_and_inverts(self, case, fraction):
-        from ..solve import solve
-
         rheology, wall, coupler = case
         q = fraction * self._load_scale(rheology, wall)
         sol = self._solve(case, flow_rate=q)

@@ -2,14 +2,12 @@ r"""The wall contract: a tube law between transmural pressure and hoop stretch.
 
 A wall law maps the hoop stretch :math:`\lambda = R/a` of the inner surface and the
 reduced thickness :math:`\bar t = t/a` to the transmural pressure
-:math:`p = P(\lambda; \bar t)`. Like :class:`scipy.stats.rv_continuous`, a subclass
-implements the one natural method, ``_pressure(stretch, reduced_thickness)`` *or*
-``_stretch(pressure, reduced_thickness)``, and the base class derives the rest:
-the inverse by vectorized bracketed root finding, the stiffness
-:math:`dP/d\lambda` by numerical differentiation. A subclass may override any
-derived hook (``_strain``, ``_pressure_at_strain``, ``_stiffness``,
-``_limit_pressure``, ``_max_stretch``) with a closed form for speed or accuracy;
-the contract suite :mod:`tubefsi.testing` checks that every path agrees.
+:math:`p = P(\lambda; \bar t)` (``docs/theory.md``, section "Tube laws"). Like
+:class:`scipy.stats.rv_continuous`, a subclass implements the one natural method,
+``_pressure(stretch, reduced_thickness)`` *or* ``_stretch(pressure, reduced_thickness)``,
+and the base class derives the rest: the inverse by a safeguarded Newton iteration with a
+bracketing fallback, the stiffness :math:`dP/d\lambda` by numerical differentiation. The
+contract suite :mod:`tubefsi.testing` checks that every path agrees.
 
 tubefsi models inflation: stretches :math:`\lambda \ge 1`, pressures :math:`p \ge 0`.
 """
@@ -18,6 +16,7 @@ from __future__ import annotations
 
 import abc
 import math
+from typing import ClassVar
 
 import numpy as np
 from scipy import differentiate
@@ -38,12 +37,45 @@ def _overrides(obj, name) -> bool:
 
 
 class WallModel(abc.ABC):
-    """Abstract base of every wall law (see the module docstring for the contract)."""
+    r"""Abstract base of every wall law (see the module docstring for the contract).
+
+    Hooks (all take arrays and the reduced thickness ``tb``; implement one of the first two,
+    override the others for speed or accuracy):
+
+    ======================================================  ==============================================
+    hook                                                    default
+    ======================================================  ==============================================
+    ``_pressure(stretch, tb)``                              natural hook, or from ``_strain`` by a root solve
+    ``_stretch(pressure, tb)``                              natural hook, or ``1 + _strain``
+    ``_pressure_at_strain(strain, tb)``                     ``_pressure(1 + strain)``; override to keep
+                                                            full accuracy at tiny strain
+    ``_strain(pressure, tb)``                               ``_stretch - 1``, or the inverse of
+                                                            ``_pressure_at_strain`` (Newton, then bracketing)
+    ``_stiffness(stretch, tb)``                             :math:`dP/d\lambda` by ``scipy.differentiate``
+    ``_limit_pressure(tb)``                                 ``inf`` (no limit pressure)
+    ``_max_stretch(tb)``                                    ``inf`` (no locking stretch, no peak)
+    ``_stiffness_decay_exponent(tb)``                       :math:`\kappa` in :math:`P' \sim \lambda^{-\kappa}`,
+                                                            estimated (only used with a limit pressure)
+    ``_power_law_integral(log_ratio, stretch, k, tb)``      None; a closed form of the separated integral
+                                                            of a power-law fluid (with
+                                                            ``closed_form_integral = True``)
+    ``_power_law_integral_inverse(integral, ...)``          None; its explicit inverse, where there is one
+    ======================================================  ==============================================
+
+    Class attributes: ``is_rigid`` (True only for :class:`~tubefsi.walls.Rigid`) and
+    ``closed_form_integral`` (True where ``_power_law_integral`` is implemented, which makes
+    the ``closed-form`` coupler available for power-law fluids).
+    """
 
     __slots__ = ()
 
     #: True only for the rigid wall, whose tube law is the vertical line ``stretch = 1``.
-    is_rigid = False
+    is_rigid: ClassVar[bool] = False
+    #: Example parameter sets (keyword dicts) run through the contract suites of :mod:`tubefsi.testing`.
+    _examples: ClassVar[tuple] = ()
+    #: True where ``_power_law_integral`` gives the separated integral of a power-law fluid in
+    #: closed form (``docs/theory.md``, section "Closed forms and removable singularities").
+    closed_form_integral: ClassVar[bool] = False
 
     # ------------------------------------------------------------------ public API
     def pressure(self, stretch, reduced_thickness):
@@ -157,8 +189,8 @@ class WallModel(abc.ABC):
     def _power_law_integral(self, log_ratio, outlet_stretch, exponent, tb):
         r"""Closed form of :math:`\int_0^v s^{k+1} P'(s)\,du`, :math:`s = \lambda_{out} e^u`, or None.
 
-        Walls that return an array here get the ``closed-form`` coupler for
-        power-law fluids (:math:`k = 3n+1`).
+        A wall that implements it sets ``closed_form_integral = True`` and gets the
+        ``closed-form`` coupler for power-law fluids (:math:`k = 3n+1`).
         """
         return None
 
@@ -174,7 +206,8 @@ class WallModel(abc.ABC):
         """Hoop strain at ``pressure``: safeguarded Newton iteration with the stiffness (vectorized,
         bracketed below a maximum stretch), else bracketed root finding on ``_pressure_at_strain``."""
         p = np.asarray(pressure, dtype=float)
-        emax = self._max_stretch(tb) - 1.0
+        lam_max = self._max_stretch(tb)
+        emax = lam_max - 1.0
         scale = max(self._stiffness(np.asarray(1.0), tb), 1e-300)
         fast = self._newton_strain(p, tb, emax, scale)
         if fast is not None:
@@ -184,7 +217,9 @@ class WallModel(abc.ABC):
             return self._pressure_at_strain(e, tb) - p
 
         guess = np.minimum(np.maximum(p / scale, 1e-300), 0.5 * emax if math.isfinite(emax) else np.inf)
-        xmax = emax if math.isfinite(emax) else 1e15
+        # never evaluate the law at a locking stretch (where it is singular): the largest strain
+        # searched is that of the last double below the lock (lam - 1 is exact for lam < 2^53)
+        xmax = float(np.nextafter(lam_max, 1.0)) - 1.0 if math.isfinite(emax) else 1e15
         bracket = elementwise.bracket_root(f, np.zeros_like(p) + 0.0, np.maximum(guess, 1e-300) * 1.0,
                                            xmin=0.0, xmax=xmax, args=(p,))
         if not np.all(bracket.success | (p == 0)):

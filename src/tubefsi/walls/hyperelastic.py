@@ -47,7 +47,7 @@ import numpy as np
 from scipy import differentiate
 
 from .._numerics import gauss_legendre, integrate_graded, integrate_panels
-from .._validation import choice
+from ..fields import choice
 from .base import WallModel
 
 #: scipy.differentiate tolerances: as tight as the error estimate allows
@@ -59,7 +59,27 @@ THICKNESS_CONVENTIONS = ("reference", "current")
 
 
 class HyperelasticWall(WallModel):
-    """Abstract base of plane-strain incompressible hyperelastic walls."""
+    r"""Abstract base of plane-strain incompressible hyperelastic walls (a material; pick a theory).
+
+    Hooks of a material (arrays of stretches; implement ``_dW`` or ``_energy``, override the
+    others for speed or accuracy):
+
+    ===========================  ============================================================
+    hook                         default
+    ===========================  ============================================================
+    ``_dW(stretch)``             natural hook: :math:`\hat W'(\lambda)`, or ``_energy``
+                                 differentiated numerically
+    ``_energy(stretch)``         :math:`\hat W(\lambda)` (optional natural hook)
+    ``_d2W(stretch)``            :math:`\hat W''(\lambda)` by ``scipy.differentiate``
+    ``_locking_stretch()``       ``inf``; the stretch where :math:`\hat W'` blows up (Gent)
+    ``_thick_integrand(s)``      :math:`\hat W'(s)/(s^2-1)`, with the removable singularity at
+                                 :math:`s = 1` taken from ``_d2W``; override with a form free of it
+    ===========================  ============================================================
+
+    The theory (:class:`ThinWall` with a ``thickness_convention``, or :class:`ThickWall`) gives
+    ``_pressure_at_strain`` and ``_stiffness``; the :class:`~tubefsi.walls.WallModel` hooks
+    (``_limit_pressure``, ``_max_stretch``, ...) may be overridden as for any wall.
+    """
 
     __slots__ = ()
 

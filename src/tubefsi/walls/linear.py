@@ -13,7 +13,7 @@ import attrs
 import numpy as np
 
 from .._numerics import expm1_ratio, log1p_ratio
-from .._validation import positive, real
+from ..fields import positive, real
 from .base import WallModel
 
 __all__ = ["ThinLinear", "ThickLinear"]
@@ -21,6 +21,8 @@ __all__ = ["ThinLinear", "ThickLinear"]
 
 class _LinearWall(WallModel):
     __slots__ = ()
+
+    closed_form_integral = True
 
     def _compliance(self, tb):
         """:math:`d\\lambda/dp` (1/Pa)."""

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import attrs
 
-from .._validation import real
+from ..fields import real
 from ..errors import InvalidParameterError
 from .hyperelastic import HyperelasticWall, ThickWall, ThinWall
 from .neo_hookean import _ThickForms, _ThinForms

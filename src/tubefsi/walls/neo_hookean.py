@@ -21,7 +21,7 @@ import attrs
 import numpy as np
 
 from .._numerics import expm1_ratio, log1p_ratio, solve_increasing
-from .._validation import positive
+from ..fields import positive
 from .hyperelastic import HyperelasticWall, ThickWall, ThinWall
 
 __all__ = ["NeoHookean", "ThinNeoHookean", "ThickNeoHookean"]
@@ -44,6 +44,8 @@ class _NeoHookeanLaw:
 
 class _ThinForms(_NeoHookeanLaw):
     __slots__ = ()
+
+    closed_form_integral = True
 
     def _pressure_at_strain(self, strain, tb):
         e = np.asarray(strain, dtype=float)

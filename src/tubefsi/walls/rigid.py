@@ -18,6 +18,7 @@ class Rigid(WallModel):
     """A wall that does not deform under any pressure; its tube law is the line ``stretch = 1``."""
 
     is_rigid = True
+    closed_form_integral = True     # Hagen–Poiseuille
     _examples = ({},)
 
     def _strain(self, pressure, tb):

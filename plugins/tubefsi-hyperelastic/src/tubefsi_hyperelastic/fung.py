@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import attrs
 import numpy as np
-from tubefsi._validation import positive
+from tubefsi.fields import positive
 from tubefsi.walls import HyperelasticWall, ThickWall, ThinWall
 
 from ._forms import hoop, quartic

@@ -11,7 +11,7 @@ a maximum stretch instead). :math:`J_m \to \infty` is neo-Hookean.
 from __future__ import annotations
 
 import attrs
-from tubefsi._validation import positive
+from tubefsi.fields import positive
 from tubefsi.walls import HyperelasticWall, ThickWall, ThinWall
 
 from ._forms import hoop, quartic

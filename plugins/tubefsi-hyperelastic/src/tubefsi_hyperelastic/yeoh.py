@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 
 import attrs
-from tubefsi._validation import positive, real
+from tubefsi.fields import nonnegative, positive, real
 from tubefsi.walls import HyperelasticWall, ThickWall, ThinWall
 
 from ._forms import hoop, quartic
@@ -28,7 +28,7 @@ class Yeoh(LimitPoint, HyperelasticWall):
 
     c1: float = positive(unit="Pa", doc="c1 = half the small-strain shear modulus")
     c2: float = real(unit="Pa", doc="c2 (may be negative)")
-    c3: float = real(low=0.0, low_open=False, unit="Pa", doc="c3 >= 0")
+    c3: float = nonnegative(unit="Pa", doc="c3 >= 0")
 
     def _f(self, y):  # dW/d lam = f(y) (lam - lam^-3), f = 2 dW/dI1
         return 2.0 * (self.c1 + y * (2.0 * self.c2 + 3.0 * self.c3 * y))

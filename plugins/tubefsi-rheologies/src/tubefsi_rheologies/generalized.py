@@ -14,14 +14,10 @@ from __future__ import annotations
 import attrs
 import numpy as np
 from tubefsi import InvalidParameterError
-from tubefsi._validation import positive, real
+from tubefsi.fields import nonnegative, positive
 from tubefsi.rheology import Rheology
 
 __all__ = ["Carreau", "CarreauYasuda", "Cross", "Ellis"]
-
-
-def _nonnegative(*, unit="", doc=""):
-    return real(low=0.0, low_open=False, unit=unit, doc=doc)
 
 
 class _ViscosityRange(Rheology):
@@ -53,7 +49,7 @@ class CarreauYasuda(_ViscosityRange):
                   "index": 1.6, "transition": 1.0})
 
     zero_shear_viscosity: float = positive(unit="Pa s", doc="zero-shear viscosity eta_0")
-    infinite_shear_viscosity: float = _nonnegative(unit="Pa s", doc="infinite-shear viscosity eta_inf")
+    infinite_shear_viscosity: float = nonnegative(unit="Pa s", doc="infinite-shear viscosity eta_inf")
     relaxation_time: float = positive(unit="s", doc="relaxation time lambda")
     index: float = positive(doc="power-law index n")
     transition: float = positive(doc="Yasuda transition parameter a")
@@ -76,7 +72,7 @@ class Carreau(_ViscosityRange):
                   "index": 0.5})
 
     zero_shear_viscosity: float = positive(unit="Pa s", doc="zero-shear viscosity eta_0")
-    infinite_shear_viscosity: float = _nonnegative(unit="Pa s", doc="infinite-shear viscosity eta_inf")
+    infinite_shear_viscosity: float = nonnegative(unit="Pa s", doc="infinite-shear viscosity eta_inf")
     relaxation_time: float = positive(unit="s", doc="relaxation time lambda")
     index: float = positive(doc="power-law index n")
 
@@ -103,7 +99,7 @@ class Cross(_ViscosityRange):
                   "exponent": 0.6})
 
     zero_shear_viscosity: float = positive(unit="Pa s", doc="zero-shear viscosity eta_0")
-    infinite_shear_viscosity: float = _nonnegative(unit="Pa s", doc="infinite-shear viscosity eta_inf")
+    infinite_shear_viscosity: float = nonnegative(unit="Pa s", doc="infinite-shear viscosity eta_inf")
     relaxation_time: float = positive(unit="s", doc="relaxation time lambda")
     exponent: float = positive(doc="Cross exponent m")
 

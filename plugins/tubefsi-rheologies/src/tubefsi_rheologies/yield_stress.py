@@ -21,14 +21,14 @@ from math import comb
 
 import attrs
 import numpy as np
-from tubefsi._validation import positive, real
+from tubefsi.fields import nonnegative, positive
 from tubefsi.rheology import Rheology
 
 __all__ = ["Bingham", "Casson", "HerschelBulkley"]
 
 
 def _yield(*, doc="yield stress tau_y"):
-    return real(low=0.0, low_open=False, unit="Pa", doc=doc)
+    return nonnegative(unit="Pa", doc=doc)
 
 
 def _plug(r, radius, g, tau_y):
