@@ -5,11 +5,11 @@ Run ``python examples/stability_map.py [OUTDIR]`` (default: the repository's ``d
 ``--quick`` samples each panel at three points only (a smoke test, not the published map).
 The map is discussed in ``docs/stability.md``.
 
-Every number is compared with an independent ``mpmath`` reference (the formulas of
-``docs/theory.md``, sections "Tube laws" and "Coupling without an ODE"; the same code as
-``examples/work_precision.py``: tube laws, hand-derived slopes checked against
-``mpmath.diff``, ``J(λ) = ∫_1^λ P'(s) s^k ds`` by ``mpmath.quad``), at the exact double the
-method receives. Markers: filled = a number and no warning; hollow = a number *and* a warning
+Every number is compared with an independent ``mpmath`` reference (``tubefsi.testing.reference``,
+written from the formulas of ``docs/theory.md``, sections "Tube laws" and "Coupling without an
+ODE", as in ``examples/work_precision.py``: tube laws with hand-derived slopes,
+``J(λ) = ∫_1^λ P'(s) s^k ds`` by ``mpmath.quad``), at the exact double the method receives.
+Markers: filled = a number and no warning; hollow = a number *and* a warning
 (``tubefsi.AccuracyWarning`` or a SciPy integrator warning); ``×`` on the "raised" line = a
 typed ``tubefsi`` error (``ConvergenceError``, ``NoSteadyStateError``); a red ``!`` = an
 untyped exception or a NaN/inf (a bug). A dotted grey line is the conditioning floor
@@ -57,12 +57,16 @@ import numpy as np  # noqa: E402
 from matplotlib.colors import LogNorm  # noqa: E402
 from mpmath import mp, mpf  # noqa: E402
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-import work_precision as ref  # noqa: E402  (the mpmath reference lives there)
-
 import tubefsi  # noqa: E402
 from tubefsi.couplers import ODE  # noqa: E402
 from tubefsi.registry import rheologies, walls  # noqa: E402
+from tubefsi.testing.reference.power_law import (  # noqa: E402
+    flow_rate_cases,
+    ref_J_direct,
+    ref_phi_inverse,
+    ref_q_max,
+)
+from tubefsi.testing.reference.tube_laws import MooneyRivlin, NeoHookean, RefWall  # noqa: E402
 
 EPS = 2.0**-52
 A, LEN, M = 1e-4, 1e-2, 0.01
@@ -76,6 +80,18 @@ def tube_for(tb):
 
 def power_law(n):
     return rheologies["power-law"](consistency=M, index=n)
+
+
+# ------------------------------------------------------------------------- the reference
+def ref_J(wall, lam, k):
+    """``J(λ) = ∫_1^λ P'(s) s^k ds``: a positive integrand, on geometrically split intervals."""
+    return ref_J_direct(wall, lam, k, geometric=True)
+
+
+def reference_cases(wall, n, lams):
+    """Flow rates (doubles) near the inlet stretches ``lams`` and the exact (Δp, u) for them."""
+    qs, dps, us = flow_rate_cases(wall, n, M, A, LEN, lams)
+    return np.array(qs), dps, us
 
 
 # ------------------------------------------------------------------------- running a method
@@ -170,14 +186,14 @@ def panel_singular(ax, log, points=31):
     tube = tube_for(tb)
     for label, kind, n_star, color, naive_J in cases:
         wall = walls["thin-neo-hookean"](shear_modulus=mu, thickness_convention=kind.split("-")[1])
-        rw = ref.RefWall(kind, mu, mpf(tube.reduced_thickness))
+        rw = RefWall(kind, NeoHookean(mu), mpf(tube.reduced_thickness))
         dp = float(rw.P(mpf(lam_float)))
         lam_ref = mpmath.findroot(lambda s: rw.P(s) - mpf(dp), mpf(lam_float))
         lam_lib = wall.stretch(dp, tube.reduced_thickness)      # the same stretch for the naive formula
 
         def errors(n):
             k_mp = 3 * mpf(n) + 1
-            q_ref = ref.ref_phi_inverse(ref.ref_J(rw, lam_ref, k_mp) * mpf(A) ** k_mp / LEN, mpf(n), mpf(M))
+            q_ref = ref_phi_inverse(ref_J(rw, lam_ref, k_mp) * mpf(A) ** k_mp / LEN, mpf(n), mpf(M))
             value, status, _ = attempt(lambda: tubefsi.solve(power_law(n), wall, tube, pressure_drop=dp).flow_rate)
             ours = (None if value is None else rel(value, q_ref), status)
             with np.errstate(all="ignore"):
@@ -219,7 +235,7 @@ def panel_singular(ax, log, points=31):
 def limit_scene():
     tb, mu, n = 0.3, 2e4, 0.7
     tube = tube_for(tb)
-    rw = ref.RefWall("thick", mu, mpf(tube.reduced_thickness))
+    rw = RefWall("thick", NeoHookean(mu), mpf(tube.reduced_thickness))
     wall = walls["thick-neo-hookean"](shear_modulus=mu)
     return tube, rw, wall, n
 
@@ -228,14 +244,14 @@ def panel_max_flow(ax, log, points=13):
     tube, rw, wall, n = limit_scene()
     fluid = power_law(n)
     k = 3 * mpf(n) + 1
-    q_max = ref.power_law_q_max(rw, n, M)
+    q_max = ref_q_max(rw, n, M, A, LEN)
     lams = np.geomspace(2.0, 1e6, points)
-    q, dps, us = ref.power_law_reference(rw, n, M, lams)
+    q, dps, us = reference_cases(rw, n, lams)
     x = [float(1 - mpf(qi) / q_max) for qi in q]
     floor = []
     for qi, dp, u in zip(q, dps, us):
         lam = u / mpf(A) + 1
-        J = ref.ref_J(rw, lam, k)
+        J = ref_J(rw, lam, k)
         kappa_lam = mpf(n) * J / (lam ** (k + 1) * rw.dP(lam))
         floor.append(float(max(kappa_lam * lam / (lam - 1), mpf(n) * J / (lam**k * dp), 1)) * EPS)
     ax.plot(x, floor, ls=":", color="0.4")
@@ -278,8 +294,8 @@ def panel_limit_pressure(ax, log, points=12):
             while rw.P(hi) < target:
                 lo, hi = hi, 2 * hi
             lam = mpmath.findroot(lambda s: rw.P(s) - target, (lo, hi), solver="anderson")
-            J = ref.ref_J(rw, lam, k)
-            q = ref.ref_phi_inverse(J * mpf(A) ** k / LEN, mpf(n), mpf(M))
+            J = ref_J(rw, lam, k)
+            q = ref_phi_inverse(J * mpf(A) ** k / LEN, mpf(n), mpf(M))
             kappa_q = lam**k * target / (mpf(n) * J)
             cases.append((dp, q))
             x.append(float(1 - target / p_lim))
@@ -314,7 +330,7 @@ def panel_strain(ax, log, points=18):
     tube, rw, wall, n = limit_scene()
     fluid = power_law(n)
     strains = np.geomspace(1e-15, 1e2, points)
-    q, dps, us = ref.power_law_reference(rw, n, M, [1 + mpf(float(s)) for s in strains])
+    q, dps, us = reference_cases(rw, n, [1 + mpf(float(s)) for s in strains])
     methods = {"tubefsi default": ("auto", "k", "*")} | odes()
     for label, (coupler, color, marker) in methods.items():
         res = []
@@ -358,9 +374,9 @@ def panel_heat(ax, fig, kind, log, n_points=12, tb_points=11):
     marks = []
     for i, tb in enumerate(tbs):
         tube = tube_for(tb)
-        rw = ref.RefWall(kind, 2 * (c1 + c2), mpf(tube.reduced_thickness))
+        rw = RefWall(kind, MooneyRivlin(c1, c2), mpf(tube.reduced_thickness))
         for j, n in enumerate(ns):
-            (q,), (dp,), (u,) = ref.power_law_reference(rw, n, M, [mpf(2)])
+            (q,), (dp,), (u,) = reference_cases(rw, n, [mpf(2)])
             fluid = power_law(n)
             sol, s1, m1 = attempt(lambda: tubefsi.solve(fluid, wall, tube, flow_rate=q))
             sol2, s2, m2 = attempt(lambda: tubefsi.solve(fluid, wall, tube, pressure_drop=float(dp)))
@@ -368,8 +384,8 @@ def panel_heat(ax, fig, kind, log, n_points=12, tb_points=11):
                 marks.append((j, i, "x" if "untyped" not in (s1, s2) else "!"))
                 log.append(f"({kind} heat map) n={n:.3g} t/a={tb:.3g}: {s1} {m1} / {s2} {m2}")
                 continue
-            q_ref = ref.ref_phi_inverse(ref.ref_J(rw, mpf(2), 3 * mpf(n) + 1) * mpf(A) ** (3 * mpf(n) + 1) / LEN,
-                                        mpf(n), mpf(M))
+            q_ref = ref_phi_inverse(ref_J(rw, mpf(2), 3 * mpf(n) + 1) * mpf(A) ** (3 * mpf(n) + 1) / LEN,
+                                    mpf(n), mpf(M))
             err[i, j] = max(rel(sol.pressure_drop, dp), rel(sol.inlet_displacement, u),
                             rel(sol2.flow_rate, q_ref), 1e-17)
             if s1 != "ok" or s2 != "ok":

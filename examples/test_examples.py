@@ -14,7 +14,6 @@ import csv
 import importlib.util
 import math
 import re
-import sys
 from pathlib import Path
 
 import matplotlib
@@ -31,11 +30,7 @@ def load(name):
     """The example script ``examples/<name>.py`` as a fresh module."""
     spec = importlib.util.spec_from_file_location(f"examples_{name}", EXAMPLES / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
-    sys.path.insert(0, str(EXAMPLES))          # stability_map imports work_precision
-    try:
-        spec.loader.exec_module(module)
-    finally:
-        sys.path.remove(str(EXAMPLES))
+    spec.loader.exec_module(module)
     return module
 
 

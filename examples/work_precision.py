@@ -24,39 +24,39 @@ for k = 4, 6, 8, 12, 16, 24, 32, ``ODE`` with DOP853, LSODA and Radau at rtol = 
 (atol = rtol/1000, ``check_error=False`` so that the integrator alone is timed; scene 4 uses
 rtol = 1e-4, 1e-8, 1e-12 only), ``ODE(method="odeint")`` (the chapter's ``odeint`` defaults inside tubefsi) and the lean
 chapter baseline of ``benchmarks/speed.py`` (a scalar, pure-float right-hand side for
-``scipy.integrate.odeint`` at its default tolerances, one ODE per point; copied below so this
-script stands alone). Scene 4 has no lean baseline (the chapter treats power laws only); its
-ratios are against ``ODE(method="odeint")``.
+``scipy.integrate.odeint`` at its default tolerances, one ODE per point;
+``tubefsi.testing.reference.chapter_baseline``). Scene 4 has no lean baseline (the chapter
+treats power laws only); its ratios are against ``ODE(method="odeint")``.
 
 Reference values (independent of tubefsi's numerics)
 -----------------------------------------------------
-All references are computed with ``mpmath`` at ``mp.dps = 30`` straight from the formulas of
-``docs/theory.md``:
+All references come from ``tubefsi.testing.reference``, written in ``mpmath`` straight from the
+formulas of ``docs/theory.md`` without calling tubefsi's numerics, here at ``mp.dps = 30``:
 
-* tube laws (section "Tube laws"): thin reference ``P = μ t̄ (λ − λ⁻³)``; thick (Lamé)
-  ``P = (μ/2)[f(x_o) − f(x_i)]``, ``f(x) = x + ln x``, ``x_o = b/(b − 1 + λ²)``, ``x_i = λ⁻²``,
-  ``b = (1 + t̄)²``, ``μ = 2(c1 + c2)``; hand-derived slopes ``P' = μ t̄ (1 + 3 s⁻⁴)`` and
-  ``P' = μ d ((d+2) s² + d) / (s³ (s² + d)²)``, ``d = b − 1`` (checked against ``mpmath.diff``
-  of ``P`` when the script starts);
-* power law (section "The flow law of a generalized Newtonian fluid"):
+* tube laws (section "Tube laws"; ``tube_laws.RefWall``): thin reference ``P = μ t̄ (λ − λ⁻³)``;
+  thick (Lamé) ``P = (μ/2)[f(x_o) − f(x_i)]``, ``f(x) = x + ln x``, ``x_o = b/(b − 1 + λ²)``,
+  ``x_i = λ⁻²``, ``b = (1 + t̄)²``, ``μ = 2(c1 + c2)``; hand-derived slopes
+  ``P' = μ t̄ (1 + 3 s⁻⁴)`` and ``P' = μ d ((d+2) s² + d) / (s³ (s² + d)²)``, ``d = b − 1``
+  (checked against ``mpmath.diff`` of ``P`` when the script starts);
+* power law (section "The flow law of a generalized Newtonian fluid"; ``power_law``):
   ``G(q, R) = φ(q) R^−k``, ``k = 3n + 1``, ``φ(q) = 2m[(3n+1)q/(πn)]^n``;
   separation (section "Coupling without an ODE") with the outlet at zero pressure:
   ``L φ(q) = a^k ∫_1^λin P'(s) s^k ds``
   (a positive integrand, ``mpmath.quad`` on geometrically split intervals — no cancellation,
   also at λ = 2000). Each scene picks exact inlet stretches λ, gets ``q``, rounds it to the
   double that the methods receive, and moves λ by one Newton step so that the reference is the
-  exact answer for that double (the rounding would otherwise show near the limit);
-* Carreau (scene 4): with the wall shear rate γ as parameter, ``q = π R³ Q(γ)/3`` and
-  ``G = 2σ(γ)/R``, ``Q(γ) = γ − I(γ)/σ(γ)³``, ``I(γ) = ∫_0^γ σ³`` in closed form (binomial
-  expansion, ``∫ x³ (1 + c x²)^p dx`` is elementary). The separated identity becomes an
-  integral over γ between the outlet and inlet wall shear rates,
-  ``L = ∫ a s P'(s) |ds/dγ| / (2σ(γ)) dγ``, ``s = (3q/(π a³ Q(γ)))^{1/3}``,
-  ``ds/dγ = −(s/3) Q'/Q``, ``Q' = 3 I σ'/σ⁴`` (``I`` and ``Q'`` are checked against
-  ``mpmath.quad``/``mpmath.diff`` when the script starts). For each flow rate (a double), the
-  inlet stretch is the root of that identity, by Newton's method on ``ln λ`` with the exact
-  derivative ``λ P'(λ)/G(q, aλ)`` (``mp.dps = 25``).
+  exact answer for that double (the rounding would otherwise show near the limit;
+  ``power_law.flow_rate_cases``); the maximum flow rate is ``φ⁻¹(a^k ∫_1^∞ P'(s) s^k ds / L)``
+  (``power_law.ref_q_max``);
+* Carreau (scene 4; ``rheology.CarreauYasudaRef`` with transition 2 and
+  ``rheology.solve_flow_controlled``): with the wall shear rate γ as parameter, the Rabinowitsch–Mooney integral gives
+  ``4q/(πR³) = Γ(γ) = 4/σ(γ)³ ∫_0^γ σ² σ' x dx`` and ``G = 2σ(γ)/R``; the separated identity
+  becomes an integral over γ between the inlet and outlet wall shear rates (fixed
+  Gauss–Legendre rules on geometrically graded sub-intervals), and the inlet wall shear rate
+  is its root by Newton's method (``mp.dps = 25``; for each flow rate, a double, starting from
+  the inlet stretch of the linearised tube law).
 
-``examples/stability_map.py`` imports this reference (``RefWall`` also has the thin
+``examples/stability_map.py`` uses the same references (and ``RefWall``'s thin
 current-thickness law ``μ t̄ (1 − λ⁻⁴)``, ``P' = 4 μ t̄ λ⁻⁵``).
 
 The error of a method is the larger relative error of pressure drop and inlet displacement,
@@ -95,6 +95,9 @@ from tubefsi.couplers import ODE, ClosedForm, Quadrature  # noqa: E402
 from tubefsi.registry import rheologies, walls  # noqa: E402
 from tubefsi.rheology import Rheology  # noqa: E402
 from tubefsi.testing.reference.chapter_baseline import chapter_thick, chapter_thin  # noqa: E402
+from tubefsi.testing.reference.power_law import flow_rate_cases, ref_q_max  # noqa: E402
+from tubefsi.testing.reference.rheology import CarreauYasudaRef, solve_flow_controlled  # noqa: E402
+from tubefsi.testing.reference.tube_laws import MooneyRivlin, NeoHookean, RefWall  # noqa: E402
 
 mp.dps = 30
 
@@ -131,104 +134,19 @@ QUICK = Sizes(n_ref=3, n_vector=20, carreau_ref=2, carreau_vector=10, budget=0.0
 
 
 # ============================================================================ reference (mpmath)
-class RefWall:
-    """Tube law P(λ) and its hand-derived slope P'(λ) in mpmath (``docs/theory.md``, "Tube laws").
-
-    ``kind``: "thin-reference" (μ t̄ (λ − λ⁻³)), "thin-current" (μ t̄ (1 − λ⁻⁴), P' = 4 μ t̄ λ⁻⁵)
-    or "thick" (Lamé); ``mu`` is the shear modulus, 2 (c1 + c2) for Mooney–Rivlin.
-    """
-
-    def __init__(self, kind, mu, tb):
-        self.kind, self.mu, self.tb = kind, mpf(mu), mpf(tb)
-
-    def P(self, lam):
-        mu, tb = self.mu, self.tb
-        if self.kind == "thin-reference":
-            return mu * tb * (lam - lam**-3)
-        if self.kind == "thin-current":
-            return mu * tb * (1 - lam**-4)
-        b = (1 + tb) ** 2
-        xo, xi = b / (b - 1 + lam**2), 1 / lam**2
-        return mu / 2 * ((xo + mpmath.log(xo)) - (xi + mpmath.log(xi)))
-
-    def dP(self, s):
-        mu, tb = self.mu, self.tb
-        if self.kind == "thin-reference":
-            return mu * tb * (1 + 3 * s**-4)
-        if self.kind == "thin-current":
-            return 4 * mu * tb * s**-5
-        d = (1 + tb) ** 2 - 1
-        return mu * d * ((d + 2) * s**2 + d) / (s**3 * (s**2 + d) ** 2)
-
-    def limit_pressure(self):
-        if self.kind == "thin-reference":
-            return mpmath.inf
-        return self.mu * (self.tb if self.kind == "thin-current" else mpmath.log(1 + self.tb))
-
-    def check_slope(self):
-        for lam in (mpf("1.001"), mpf("1.7"), mpf(30)):
-            num = mpmath.diff(self.P, lam)
-            assert abs(num / self.dP(lam) - 1) < mpf(10) ** -20, (self.kind, lam)
-
-
-def geometric_split(lo, hi):
-    pts = [lo]
-    while pts[-1] * 2 < hi:
-        pts.append(pts[-1] * 2)
-    return pts + [hi]
-
-
-def ref_J(wall, lam, k):
-    """∫_1^λ P'(s) s^k ds (positive integrand)."""
-    return mpmath.quad(lambda s: wall.dP(s) * s**k, geometric_split(mpf(1), lam))
-
-
-def ref_phi(q, n, m):
-    return 2 * m * ((3 * n + 1) * q / (mpmath.pi * n)) ** n
-
-
-def ref_phi_inverse(phi, n, m):
-    return mpmath.pi * n / (3 * n + 1) * (phi / (2 * m)) ** (1 / n)
+# RefWall, flow_rate_cases, ref_q_max, CarreauYasudaRef and solve_flow_controlled (imported above)
+# come from tubefsi.testing.reference (module docstring).
+def check_slope(wall):
+    """The reference's hand-derived slope ``P'`` against ``mpmath.diff`` of its tube law."""
+    for lam in (mpf("1.001"), mpf("1.7"), mpf(30)):
+        num = mpmath.diff(wall.P, lam)
+        assert abs(num / wall.dP(lam) - 1) < mpf(10) ** -20, (wall, lam)
 
 
 def power_law_reference(wall, n, m, lams, a=A, length=LEN):
     """Flow rates (doubles) and exact (Δp, u) for them, at inlet stretches near ``lams``."""
-    n, m, a, length = mpf(n), mpf(m), mpf(a), mpf(length)
-    k = 3 * n + 1
-    qs, dps, us = [], [], []
-    for lam in lams:
-        lam = mpf(lam)
-        J = ref_J(wall, lam, k)
-        q = float(ref_phi_inverse(J * a**k / length, n, m))
-        # one Newton step: the exact inlet stretch for the double q (error ~ 1e-32)
-        J_target = length * ref_phi(mpf(q), n, m) / a**k
-        lam = lam + (J_target - J) / (wall.dP(lam) * lam**k)
-        qs.append(q)
-        dps.append(wall.P(lam))
-        us.append(a * (lam - 1))
+    qs, dps, us = flow_rate_cases(wall, n, m, a, length, lams)
     return np.array(qs), dps, us
-
-
-def power_law_q_max(wall, n, m, a=A, length=LEN):
-    """Maximum flow rate (limit-pressure wall, n < 1): L φ(q_max) = a^k ∫_1^∞ P' s^k ds.
-
-    Thin current thickness: the integral is 4 μ t̄/(4 − k). Thick: s = 1/t, then t = w^(1/(4−k))
-    removes the endpoint singularity, leaving a smooth integrand on [0, 1].
-    """
-    n, m = mpf(n), mpf(m)
-    k = 3 * n + 1
-    alpha = 4 - k
-    if wall.kind == "thin-current":
-        J_inf = 4 * wall.mu * wall.tb / alpha
-    else:
-        d = (1 + wall.tb) ** 2 - 1
-
-        def integrand(w):
-            t2 = w ** (2 / alpha)
-            return ((d + 2) + d * t2) / (1 + d * t2) ** 2
-
-        J_inf = wall.mu * d / alpha * mpmath.quad(integrand, [0, 1])
-    return ref_phi_inverse(J_inf * mpf(a) ** k / mpf(length), n, m)
 
 
 # ---------------------------------------------------------------------------- Carreau
@@ -247,96 +165,21 @@ class Carreau(Rheology):
         return shear_rate * (mui + (mu0 - mui) * (1.0 + (lt * shear_rate) ** 2) ** (0.5 * (n - 1.0)))
 
 
-class RefCarreau:
-    """The Carreau flow law in mpmath, parametrised by the wall shear rate (module docstring)."""
-
-    def __init__(self, fluid):
-        self.mui = mpf(fluid.infinite_shear_viscosity)
-        self.delta = mpf(fluid.zero_shear_viscosity) - self.mui
-        self.c = mpf(fluid.relaxation_time) ** 2
-        self.m = (mpf(fluid.index) - 1) / 2
-
-    def sigma(self, g):
-        return g * (self.mui + self.delta * (1 + self.c * g**2) ** self.m)
-
-    def dsigma(self, g):
-        w = 1 + self.c * g**2
-        return self.mui + self.delta * w**self.m + self.delta * g * self.m * w ** (self.m - 1) * 2 * self.c * g
-
-    def I(self, g):
-        """∫_0^g σ(x)³ dx, term by term: ∫_0^g x³ (1 + c x²)^p dx elementary."""
-        c, W = self.c, 1 + self.c * g**2
-        total = mpf(0)
-        for j, binom in enumerate((1, 3, 3, 1)):
-            p = j * self.m
-            if p == 0:
-                piece = g**4 / 4
-            else:
-                piece = ((W ** (p + 2) - 1) / (p + 2) - (W ** (p + 1) - 1) / (p + 1)) / (2 * c**2)
-            total += binom * self.mui ** (3 - j) * self.delta**j * piece
-        return total
-
-    def Q(self, g):
-        return g - self.I(g) / self.sigma(g) ** 3
-
-    def dQ(self, g):
-        return 3 * self.I(g) * self.dsigma(g) / self.sigma(g) ** 4
-
-    def shear_rate_for(self, target):
-        """γ with Q(γ) = target (Q(γ)/γ lies in (1/3, 3/4] for this law)."""
-        return mpmath.findroot(lambda g: self.Q(g) - target, (target, 3 * target), solver="anderson")
-
-    def check(self):
-        """The closed forms against mpmath quadrature / differentiation."""
-        for g in (mpf("0.5"), mpf(30), mpf(3000)):
-            direct = mpmath.quad(lambda x: self.sigma(x) ** 3, [0, g])
-            assert abs(self.I(g) / direct - 1) < mpf(10) ** -20, g
-            assert abs(mpmath.diff(self.Q, g) / self.dQ(g) - 1) < mpf(10) ** -20, g
-
-
 def carreau_reference(fluid, wall, qs, a=A, length=LEN):
     """Exact (Δp, u) for a Carreau fluid in ``wall`` at the flow rates ``qs`` (module docstring)."""
-    ref = RefCarreau(fluid)
-    ref.check()
-    a, length = mpf(a), mpf(length)
-
-    def length_for(c0, lam_in):
-        """∫_1^λin P'(s)/G(q, a s) ds as an integral over the wall shear rate."""
-        g_out, g_in = ref.shear_rate_for(c0), ref.shear_rate_for(c0 / lam_in**3)
-
-        def integrand(g):
-            sig, i3 = ref.sigma(g), ref.I(g)
-            Q = g - i3 / sig**3
-            s = (c0 / Q) ** (mpf(1) / 3)
-            ds = s * i3 * ref.dsigma(g) / (Q * sig**4)          # |ds/dγ| = (s/3) Q'/Q
-            return a * s * wall.dP(s) * ds / (2 * sig)
-
-        return mpmath.quad(integrand, [g_in, g_out])
-
-    def gradient(c0, lam):
-        """G(q, aλ) = 2σ(γ_w)/(aλ), Q(γ_w) = 3q/(π a³ λ³)."""
-        return 2 * ref.sigma(ref.shear_rate_for(c0 / lam**3)) / (a * lam)
-
     dps, us = [], []
     with mp.workdps(25):
-        lam = None
+        ref = CarreauYasudaRef(fluid.zero_shear_viscosity, fluid.infinite_shear_viscosity,
+                               fluid.relaxation_time, fluid.index, transition=2)
+        a, length = mpf(a), mpf(length)
         for q in qs:
-            c0 = 3 * mpf(float(q)) / (mpmath.pi * a**3)
-            if lam is None:                                    # linearised tube law: a first guess
-                lam = 1 + length * gradient(c0, mpf(1)) / wall.dP(mpf(1))
-            v = mpmath.log(lam)
-            for _ in range(30):                                # Newton on v = ln λ_in
-                lam = mpmath.exp(v)
-                f = length_for(c0, lam) - length
-                step = f / (lam * wall.dP(lam) / gradient(c0, lam))
-                v = v - step if step < v else v / 2
-                if abs(step) < mpf(10) ** -20 * v:
-                    break
-            else:
-                raise RuntimeError("Carreau reference: Newton did not converge")
-            lam = mpmath.exp(v)
-            dps.append(wall.P(lam))
-            us.append(a * mpmath.expm1(v))
+            q = float(q)
+            rate = 4 * mpf(q) / (mpmath.pi * a**3)              # Γ at the undeformed radius
+            gradient = 2 * ref.tau(ref.at_apparent(rate, rate)) / a
+            guess = 1 + length * gradient / wall.dP(mpf(1))    # the linearised tube law
+            dp, lam = solve_flow_controlled(ref, wall, a, length, q, guess)
+            dps.append(dp)
+            us.append(a * (lam - 1))
     return np.asarray(qs, dtype=float), dps, us
 
 
@@ -368,8 +211,8 @@ def build_scenes(sizes=Sizes()):
     scenes = []
 
     mu = 2e3
-    thin = RefWall("thin-reference", mu, tb)
-    thin.check_slope()
+    thin = RefWall("thin-reference", NeoHookean(mu), tb)
+    check_slope(thin)
     q, dp, u = power_law_reference(thin, N_FLUID, M_FLUID, 1 + np.geomspace(0.01, 3, sizes.n_ref))
     scenes.append(Scene("thin", "1. thin neo-Hookean (ref. thickness), power law n = 0.7: closed form",
                         fluid, walls["thin-neo-hookean"](shear_modulus=mu, thickness_convention="reference"),
@@ -378,17 +221,17 @@ def build_scenes(sizes=Sizes()):
 
     c1, c2 = 1.5e3, -0.5e3
     mu = 2 * (c1 + c2)
-    thick = RefWall("thick", mu, tb)
-    thick.check_slope()
+    thick = RefWall("thick", MooneyRivlin(c1, c2), tb)
+    check_slope(thick)
     mr = walls["thick-mooney-rivlin"](c1=c1, c2=c2)
-    q_max = power_law_q_max(thick, N_FLUID, M_FLUID)
+    q_max = ref_q_max(thick, N_FLUID, M_FLUID, A, LEN)
     q, dp, u = power_law_reference(thick, N_FLUID, M_FLUID, 1 + np.geomspace(0.02, 1.5, sizes.n_ref))
     scenes.append(Scene("moderate", "2. thick Mooney–Rivlin, power law n = 0.7: moderate load",
                         fluid, mr, q, dp, u, baseline=lambda qi: chapter_thick(qi, N_FLUID, M_FLUID, mu, TUBE),
                         note=f"q/q_max {q.min() / float(q_max):.3g}–{q.max() / float(q_max):.3g}",
                         n_vector=sizes.n_vector))
     q, dp, u = power_law_reference(thick, N_FLUID, M_FLUID, np.geomspace(10, 2000, sizes.n_ref))
-    p_lim = thick.mu * mpmath.log(1 + thick.tb)
+    p_lim = thick.limit_pressure()
     scenes.append(Scene("limit", "3. thick Mooney–Rivlin, power law n = 0.7: near the maximum flow rate",
                         fluid, mr, q, dp, u, baseline=lambda qi: chapter_thick(qi, N_FLUID, M_FLUID, mu, TUBE),
                         note=f"q/q_max {q.min() / float(q_max):.4f}–{q.max() / float(q_max):.4f}, "
@@ -396,7 +239,7 @@ def build_scenes(sizes=Sizes()):
                         n_vector=sizes.n_vector))
 
     carreau = Carreau()
-    nh = RefWall("thick", 2e3, tb)
+    nh = RefWall("thick", NeoHookean(2e3), tb)
     q, dp, u = carreau_reference(carreau, nh, np.geomspace(2e-11, 1.2e-9, sizes.carreau_ref))
     scenes.append(Scene("carreau", "4. Carreau fluid (non-separable), thick neo-Hookean",
                         carreau, walls["thick-neo-hookean"](shear_modulus=2e3), q, dp, u,

@@ -76,13 +76,22 @@ from tubefsi.testing.reference.power_law import (
 )
 from tubefsi.testing.reference.tube_laws import LIMIT_KINDS, WALLS, RefWall, stretch_at_pressure
 
+from accuracy_helpers import (  # the scene: A = 2**-13 m, L = 1e-2 m, M = 0.01 Pa s^n
+    A,
+    L,
+    M,
+    assert_contract,
+    kappas,
+    make_tube,
+    make_wall,
+    power_law,
+    ref_wall,
+    stretch_for_tail,
+)
+from accuracy_helpers import CONTRACT_RTOL as RTOL  # 1e-12, the contract
+
 DPS = 40          # reference precision
 pytestmark = pytest.mark.usefixtures("mp_precision")
-RTOL = 1e-12      # the contract
-
-A = 2.0**-13      # undeformed inner radius (m); a power of two: tb * A and thickness / A are exact
-L = 1e-2          # length (m)
-M = 0.01          # power-law consistency (Pa s^n); also the Newtonian viscosity (shares references)
 MAX_STRETCH = 1e15   # the library's documented cap on the inlet stretch
 
 N_VALUES = (0.2, 0.5, 2 / 3, 1.0, 1.5, 2.0)
@@ -111,11 +120,6 @@ def regime(level):
 
 
 # ---------------------------------------------------------------------------- reference
-def _ref_wall(wall_name, tb_float):
-    _, params, kind = WALLS[wall_name]
-    return RefWall(kind, params, mpf(tb_float))     # thickness / a is exactly tb_float (a = 2**-13)
-
-
 def _dJ(wall, k, lam, order):
     """d^order/dlam^order of Jhat at lam (order >= 1): derivatives of P'(s) s^k."""
     f = lambda s: wall.dP(s) * s**k                                   # noqa: E731
@@ -136,14 +140,8 @@ def _dpoly(c, d):
 
 
 def _kappas(wall, n, k, e, J):
-    lam = 1 + e
-    P, dP = wall.P(lam), wall.dP(lam)
-    return dict(
-        u_of_dp=P / (e * dP),
-        q_of_dp=P * lam**k / (n * J),
-        dp_of_q=n * J / (P * lam**k),
-        u_of_q=n * J / (e * dP * lam**k),
-    )
+    """The contract's kappas at the inlet strain ``e`` (exact), ``lam = 1 + e``."""
+    return kappas(wall, n, k, 1 + e, J, e=e)
 
 
 def reference(wall_name, tb_float, n_float, level):
@@ -164,7 +162,7 @@ def reference_set(wall_name, tb_float, level):
 
 def compute_reference(wall_name, tb_float, level, n_values):
     """``reference_set`` at the caller's precision (``mp.dps``), uncached."""
-    wall = _ref_wall(wall_name, tb_float)
+    wall = ref_wall(wall_name, tb_float)
     # The grid's inlet state below does not depend on n, so neither do the quadrature nodes of
     # Jhat(lam0) = P lam0^k - k int_0^ln(lam0) P(e^x) e^(kx) dx: remember P at the nodes.
     wall.P = functools.lru_cache(maxsize=None)(wall.P)
@@ -211,32 +209,17 @@ def compute_reference(wall_name, tb_float, level, n_values):
 
 
 def _stretch_for_tail(wall, k, tail_target):
-    """lam with tail(lam) = tail_target: Newton on ln tail in x = ln lam (tail ~ C lam^-(4-k))."""
-    alpha = 4 - k
-    d = (1 + wall.tb) ** 2 - 1
-    C = wall.mu * d * (d + 2) / alpha if wall.kind == "thick" else 4 * wall.mu * wall.tb / alpha
-    x = mpmath.log(C / tail_target) / alpha
-    for dps in (min(20, mp.dps), mp.dps):          # converge cheaply at 20 digits, then polish
-        with mp.workdps(dps):
-            for _ in range(40):
-                lam = mpmath.exp(x)
-                tail = ref_J_tail(wall, lam, k)
-                dx = mpmath.log(tail / tail_target) * tail / (wall.dP(lam) * lam ** (k + 1))
-                x += dx
-                if abs(dx) < mpf(10) ** (5 - dps) * max(1, abs(x)):
-                    break
-            else:
-                raise AssertionError("reference Newton did not converge")
-    lam = mpmath.exp(x)
-    assert abs(ref_J_tail(wall, lam, k) / tail_target - 1) < mpf(10) ** (8 - mp.dps)
-    return lam
+    """lam with tail(lam) = tail_target: Newton on ln tail in x = ln lam (tail ~ C lam^-(4-k)),
+    converged cheaply at 20 digits (at most 40 steps), then polished at ``mp.dps`` (at most 40),
+    and checked: ``|tail(lam) / tail_target - 1| < 10^(8 - mp.dps)``."""
+    return stretch_for_tail(wall, k, tail_target, steps=40, tol_digits=5, coarse_dps=20, check_digits=8)
 
 
 @functools.lru_cache(maxsize=None)
 @mp.workdps(DPS)
 def reference_near_qmax(wall_name, tb_float, n_float, m_float, fraction):
     """Flow-controlled at q_in = float(fraction * q_max): (q_in, dp, u, kappa_dp, kappa_u, lam)."""
-    wall = _ref_wall(wall_name, tb_float)
+    wall = ref_wall(wall_name, tb_float)
     n, m = mpf(n_float), mpf(m_float)
     k = 3 * n + 1
     a, length = mpf(A), mpf(L)
@@ -251,19 +234,10 @@ def reference_near_qmax(wall_name, tb_float, n_float, m_float, fraction):
 
 
 # ---------------------------------------------------------------------------- library side
-def make_wall(wall_name):
-    reg_name, params, _ = WALLS[wall_name]
-    return tubefsi.registry.walls[reg_name](**params)
-
-
-def make_tube(tb):
-    return tubefsi.Tube(radius=A, thickness=tb * A, length=L)
-
-
 def make_fluid(n, newtonian=False):
     if newtonian:
         return tubefsi.registry.rheologies["newtonian"](viscosity=M)
-    return tubefsi.registry.rheologies["power-law"](consistency=M, index=n)
+    return power_law(n)
 
 
 def grid_errors(wall_name, n, tb, level, mode, newtonian=False):
@@ -286,12 +260,6 @@ def near_qmax_errors(wall_name, n, tb, fraction):
     sol = tubefsi.solve(make_fluid(n), make_wall(wall_name), make_tube(tb), flow_rate=q_in)
     return [("dp(q)", rel_err(sol.pressure_drop, dp_ref), float(k_dp)),
             ("u(q)", rel_err(sol.inlet_displacement, u_ref), float(k_u))]
-
-
-def assert_contract(errors, label):
-    bad = [f"{name}: err {err:.3g} > {RTOL:g} * max(1, kappa={kappa:.3g})"
-           for name, err, kappa in errors if not err <= RTOL * max(1.0, kappa)]
-    assert not bad, f"{label}: " + "; ".join(bad)
 
 
 # ---------------------------------------------------------------------------- the grid
@@ -376,7 +344,7 @@ def test_beyond_stretch_cap_raises(wall_name, tb):
     """
     n = 0.99
     with mp.workdps(DPS):
-        wall_ref = _ref_wall(wall_name, tb)
+        wall_ref = ref_wall(wall_name, tb)
         nn = mpf(n)
         k = 3 * nn + 1
         J_inf = ref_J_inf(wall_ref, k)
@@ -402,7 +370,7 @@ def test_reference_derivative_is_the_tube_law_slope(wall_name):
     """The hand-derived P' (used for kappas, Taylor shifts, tails) is d/dlam of the tube law."""
     with mp.workdps(DPS):
         for tb in TB_VALUES:
-            wall = _ref_wall(wall_name, tb)
+            wall = ref_wall(wall_name, tb)
             for lam in (mpf(1) + mpf("1e-6"), mpf("1.5"), mpf(31), mpf(201)):
                 numeric = mpmath.diff(wall.P, lam)
                 assert abs(numeric / wall.dP(lam) - 1) < mpf(10) ** (12 - DPS)
@@ -415,7 +383,7 @@ def test_reference_closed_forms_match_the_strain_energy(wall_name):
     hand-written plane-strain dW is the derivative of W(1/s, s, 1)."""
     with mp.workdps(DPS):
         for tb in TB_VALUES:
-            wall = _ref_wall(wall_name, tb)
+            wall = ref_wall(wall_name, tb)
             generic = RefWall(wall.kind, wall.material, wall.tb, closed_form=False)
             assert wall.mu is not None and generic.mu is None
             for lam in (mpf(1) + mpf("1e-6"), mpf("1.5"), mpf(31), mpf(201)):
@@ -430,7 +398,7 @@ def test_reference_integrators_agree(wall_name):
     """Jhat by parts integrated in ln s on one interval (used here) equals the geometric-split
     integration in s (used by test_reference_accuracy.py)."""
     with mp.workdps(DPS):
-        wall = _ref_wall(wall_name, 0.3)
+        wall = ref_wall(wall_name, 0.3)
         k = 3 * mpf(2 / 3) + 1
         for lam in (mpf(1) + mpf("1e-6"), mpf(40)):
             assert abs(ref_J_log(wall, lam, k) / ref_J(wall, lam, k) - 1) < mpf(10) ** (12 - DPS)
@@ -441,7 +409,7 @@ def test_reference_tail_matches_integration_by_parts(wall_name):
     """J_inf - tail(lam) (used near q_max) equals Jhat(lam) by parts (used elsewhere)."""
     with mp.workdps(DPS):
         for tb in TB_VALUES:
-            wall = _ref_wall(wall_name, tb)
+            wall = ref_wall(wall_name, tb)
             wall.P = functools.lru_cache(maxsize=None)(wall.P)
             for n in QMAX_N_VALUES:
                 k = 3 * mpf(n) + 1

@@ -69,6 +69,9 @@ from tubefsi.testing.reference import rel_err
 from tubefsi.testing.reference.power_law import ref_J, ref_J_inf, ref_phi, ref_phi_inverse
 from tubefsi.testing.reference.tube_laws import WALLS, RefWall, stretch_at_pressure
 
+import accuracy_helpers
+from accuracy_helpers import make_wall
+
 DPS = 40   # working precision of the reference (set per module, restored afterwards)
 pytestmark = pytest.mark.usefixtures("mp_precision")
 
@@ -127,17 +130,10 @@ def ref_max_flow_rate(wall_name, tb_float, n_float, m_float):
 
 
 # ---------------------------------------------------------------------------- library side
-def make_wall(wall_name):
-    reg_name, params, _ = WALLS[wall_name]
-    return tubefsi.registry.walls[reg_name](**params)
-
-
-def make_tube(tb):
-    return tubefsi.Tube(radius=A, thickness=tb * A, length=L)
-
-
-def power_law(n, m=M):
-    return tubefsi.registry.rheologies["power-law"](consistency=m, index=n)
+# make_wall (imported above) and these come from accuracy_helpers, bound to this file's scene
+# (radius A = 1e-4 m, not the contract tests' 2**-13 m).
+make_tube = functools.partial(accuracy_helpers.make_tube, radius=A, length=L)
+power_law = functools.partial(accuracy_helpers.power_law, m=M)
 
 
 def check_case(fluid, wall_name, tb, n, m, level):

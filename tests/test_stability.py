@@ -9,7 +9,8 @@ limit pressure, and at 99 % of the maximum flow rate. Each case is checked flow-
 against the independent mpmath reference of ``tubefsi.testing.reference`` (40 digits; tube laws and
 hand-derived slopes from ``docs/theory.md``, section "Tube laws"). The bound is ``1e-12 * max(1, κ)`` with ``κ`` the
 relative condition number of the output with respect to the load, evaluated on the reference
-(the same convention as ``test_accuracy_contract.py``; ``e = λ - 1``, ``k = 3n + 1``,
+(the same convention as ``test_accuracy_contract.py``, with the same helpers,
+``accuracy_helpers.py``; ``e = λ - 1``, ``k = 3n + 1``,
 ``Ĵ(λ) = ∫_1^λ P'(s) s^k ds``):
 
 * ``u(Δp)``: ``κ = P / (e P')``        * ``q(Δp)``: ``κ = P λ^k / (n Ĵ)``
@@ -42,17 +43,25 @@ from mpmath import mp, mpf
 import tubefsi
 from tubefsi.couplers import ODE, Quadrature
 from tubefsi.testing.reference import rel_err
-from tubefsi.testing.reference.power_law import ref_J_inf, ref_J_tail, ref_phi, ref_phi_inverse
-from tubefsi.testing.reference.tube_laws import WALLS, RefWall, stretch_at_pressure
+from tubefsi.testing.reference.power_law import ref_J_inf, ref_phi, ref_phi_inverse
+from tubefsi.testing.reference.tube_laws import WALLS, stretch_at_pressure
+
+from accuracy_helpers import (  # the scene: A = 2**-13 m, L = 1e-2 m, M = 0.01 Pa s^n
+    A,
+    L,
+    M,
+    assert_contract,
+    kappas,
+    make_tube,
+    make_wall,
+    power_law,
+    ref_wall,
+    stretch_for_tail,
+)
 
 DPS = 40
 pytestmark = pytest.mark.usefixtures("mp_precision")
-RTOL = 1e-12
 FAR = 1e-3           # "far from the truth" for a non-default method
-
-A = 2.0**-13         # m; a power of two, so thickness = tb * A and thickness / A are exact
-L = 1e-2             # m
-M = 0.01             # Pa s^n
 
 
 # ---------------------------------------------------------------------------- reference
@@ -66,28 +75,6 @@ def _J(wall, lam, k):
     return mpmath.quad(lambda x: wall.dP(mpmath.exp(x)) * mpmath.exp((k + 1) * x), pts)
 
 
-def _kappas(wall, n, k, lam, J):
-    e, P, dP = lam - 1, wall.P(lam), wall.dP(lam)
-    return dict(u_of_dp=P / (e * dP), q_of_dp=P * lam**k / (n * J), dp_of_q=n * J / (P * lam**k),
-                u_of_q=n * J / (e * dP * lam**k))
-
-
-def _stretch_for_tail(wall, k, tail_target):
-    """λ with ∫_λ^∞ P' s^k ds = tail_target: Newton on ln tail in ln λ (tail ~ C λ^-(4-k))."""
-    alpha = 4 - k
-    d = (1 + wall.tb) ** 2 - 1
-    C = wall.mu * d * (d + 2) / alpha if wall.kind == "thick" else 4 * wall.mu * wall.tb / alpha
-    x = mpmath.log(C / tail_target) / alpha
-    for _ in range(60):
-        lam = mpmath.exp(x)
-        tail = ref_J_tail(wall, lam, k)
-        dx = mpmath.log(tail / tail_target) * tail / (wall.dP(lam) * lam ** (k + 1))
-        x += dx
-        if abs(dx) < mpf(10) ** (6 - mp.dps) * max(1, abs(x)):
-            return mpmath.exp(x)
-    raise AssertionError("reference Newton did not converge")
-
-
 @functools.lru_cache(maxsize=None)
 def reference(wall_name, tb, n, how, value):
     """Loads (doubles) and exact answers for one state.
@@ -97,8 +84,7 @@ def reference(wall_name, tb, n, how, value):
     (q_in, Δp_ref, u_ref, κ_Δp, κ_u) and, unless "qmax", ``pressure`` = (Δp_in, q_ref, u_ref, κ_q, κ_u).
     """
     with mp.workdps(DPS):
-        _, params, kind = WALLS[wall_name]
-        wall = RefWall(kind, params, mpf(tb))
+        wall = ref_wall(wall_name, tb)
         n_mp, a, length, m = mpf(n), mpf(A), mpf(L), mpf(M)
         k = 3 * n_mp + 1
         out = {}
@@ -106,8 +92,9 @@ def reference(wall_name, tb, n, how, value):
             J_inf = ref_J_inf(wall, k)
             q_in = float(mpf(value) * ref_phi_inverse(J_inf * a**k / length, n_mp, m))
             target = length * ref_phi(mpf(q_in), n_mp, m) / a**k
-            lam = _stretch_for_tail(wall, k, J_inf - target)
-            kq = _kappas(wall, n_mp, k, lam, target)
+            # λ with ∫_λ^∞ P' s^k ds = J_inf - target: one pass of at most 60 Newton steps
+            lam = stretch_for_tail(wall, k, J_inf - target, steps=60, tol_digits=6)
+            kq = kappas(wall, n_mp, k, lam, target)
             out["flow"] = (q_in, wall.P(lam), a * (lam - 1), kq["dp_of_q"], kq["u_of_q"])
             return out
         if how == "strain":
@@ -119,7 +106,7 @@ def reference(wall_name, tb, n, how, value):
         q_in = float(ref_phi_inverse(J0 * a**k / length, n_mp, m))
         target = length * ref_phi(mpf(q_in), n_mp, m) / a**k
         lam_q = lam0 + (target - J0) / slope
-        kq = _kappas(wall, n_mp, k, lam_q, target)
+        kq = kappas(wall, n_mp, k, lam_q, target)
         out["flow"] = (q_in, wall.P(lam_q), a * (lam_q - 1), kq["dp_of_q"], kq["u_of_q"])
         # pressure-controlled at the double Δp_in: Newton on the closed-form tube law
         dp_in = float(wall.P(lam0))
@@ -127,26 +114,13 @@ def reference(wall_name, tb, n, how, value):
         for _ in range(4):
             lam_p += (mpf(dp_in) - wall.P(lam_p)) / wall.dP(lam_p)
         J_p = J0 + slope * (lam_p - lam0)
-        kp = _kappas(wall, n_mp, k, lam_p, J_p)
+        kp = kappas(wall, n_mp, k, lam_p, J_p)
         out["pressure"] = (dp_in, ref_phi_inverse(J_p * a**k / length, n_mp, m), a * (lam_p - 1),
                            kp["q_of_dp"], kp["u_of_dp"])
         return out
 
 
 # ---------------------------------------------------------------------------- library side
-def make_wall(wall_name):
-    reg, params, _ = WALLS[wall_name]
-    return tubefsi.registry.walls[reg](**params)
-
-
-def make_tube(tb):
-    return tubefsi.Tube(radius=A, thickness=tb * A, length=L)
-
-
-def power_law(n):
-    return tubefsi.registry.rheologies["power-law"](consistency=M, index=n)
-
-
 def default_path_errors(wall_name, tb, n, how, value):
     """[(quantity, error, κ)] of the default solve, flow- and (if available) pressure-controlled."""
     ref = reference(wall_name, tb, n, how, value)
@@ -161,12 +135,6 @@ def default_path_errors(wall_name, tb, n, how, value):
         errors += [("q(dp)", rel_err(sol.flow_rate, q_ref), float(k_q)),
                    ("u(dp)", rel_err(sol.inlet_displacement, u_ref), float(k_u))]
     return errors
-
-
-def assert_contract(errors, label):
-    bad = [f"{name}: {err:.3g} > {RTOL:g} * max(1, κ={kappa:.3g})"
-           for name, err, kappa in errors if not err <= RTOL * max(1.0, kappa)]
-    assert not bad, f"{label}: " + "; ".join(bad)
 
 
 # ============================================================================ part 1: default path

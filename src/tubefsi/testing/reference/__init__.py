@@ -23,8 +23,9 @@ tubefsi.testing`` does not need mpmath. Import the modules directly:
   given pressure.
 * :mod:`.power_law` — power-law flow (Newtonian included) in such a wall, separated:
   :math:`\phi(q)` and its inverse, :math:`\hat J(\lambda) = \int_1^\lambda P'(s)s^k ds` (by parts,
-  in :math:`\ln s`, or directly), its tail and :math:`J_\infty` for limit walls, the inlet
-  stretch of a flow rate.
+  in :math:`\ln s`, or directly), its tail, :math:`J_\infty` and the maximum flow rate for limit
+  walls, the inlet stretch of a flow rate, and flow-controlled cases at the double flow rates of
+  given inlet stretches.
 * :mod:`.rheology` — generalized Newtonian flow (Carreau–Yasuda, and any law given by its shear
   rate, yield stress included) in a reference wall, through the Rabinowitsch–Mooney integral
   parametrized by the wall shear rate or stress; velocity profiles; the yield pressure drop.
