@@ -156,9 +156,10 @@ def _cmd_list(args, out) -> int:
             fields = parameters(cls)
             if not fields:
                 print(f"      {'(no parameters)' if title != 'couplers' else '(no options)'}", file=out)
+            width = max([22] + [len(p.name) + 2 for p in fields])
             for p in fields:
                 default = "" if p.required else f"  default {p.default!r}"
-                line = f"      {p.name:<22}{p.unit or '-':<9}{p.admissible:<26}{p.doc}{default}"
+                line = f"      {p.name:<{width}}{p.unit or '-':<9}{p.admissible:<26}{p.doc}{default}"
                 print(line.rstrip(), file=out)
     return 0
 
