@@ -18,7 +18,8 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "tubefsi"
 
 #: Lower layers first; a module may import only from its own layer or below.
 LAYERS = [
-    {"tubefsi.errors", "tubefsi.fields", "tubefsi._numerics", "tubefsi._validation", "tubefsi.registry"},
+    {"tubefsi.errors", "tubefsi.fields", "tubefsi._numerics", "tubefsi._quadrature", "tubefsi._validation",
+     "tubefsi.registry"},
     {"tubefsi.geometry", "tubefsi.rheology", "tubefsi.walls"},
     {"tubefsi.scene"},
     {"tubefsi.couplers"},
@@ -120,3 +121,13 @@ def test_the_import_graph_has_no_cycle():
     for node in graph:
         if node not in state:
             visit(node, [node])
+
+
+@pytest.mark.parametrize("path", sorted(MODULES.values()), ids=lambda p: p.name)
+def test_sources_compile_without_warnings(path):
+    """No invalid escape sequence (a docstring with TeX that should be raw) or other warning."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        compile(path.read_text(encoding="utf-8"), str(path), "exec")

@@ -1,11 +1,10 @@
 r"""``quadrature``: any rheology with any wall, by the separated-variables identity.
 
-:math:`J(v) = \int_0^v s P'(s)/G(q, as)\,du` is evaluated by composite
-Gauss–Legendre quadrature in the log-stretch :math:`u`, where the integrand of every
-built-in pair is analytic in a strip of half-width :math:`\pi/2` about the real axis
-(16 nodes per panel of width 2 give full double precision), and the inlet
-log-stretch is found by safeguarded Newton iteration. No ODE is integrated. Toward a
-wall's maximum stretch the panels are graded geometrically (:meth:`Scene.integrate`).
+:math:`J(v) = \int_0^v s P'(s)/G(q, as)\,du` is evaluated by adaptive Gauss–Kronrod
+quadrature in the log-stretch :math:`u` with an a-posteriori error estimate per point
+(``docs/theory.md``, section "Coupling without an ODE"), and the inlet log-stretch is found by
+safeguarded Newton iteration. No ODE is integrated. Toward a wall's locking stretch the
+integral is graded in :math:`\ln(v_{max} - u)` (:meth:`SeparatedVariables.integrate`).
 """
 
 from __future__ import annotations
@@ -23,31 +22,42 @@ __all__ = ["Quadrature"]
 @final
 @attrs.frozen(kw_only=True)
 class Quadrature(SeparatedVariables):
-    """Gauss–Legendre quadrature of the separated identity (any pair)."""
+    """Quadrature of the separated identity (any pair): adaptive and error-controlled by default.
 
-    order: int = attrs.field(default=16, converter=int)
+    ``order=None`` (the default): adaptive Gauss–Kronrod quadrature with an a-posteriori error
+    estimate per point, refined until it is below ``rtol`` relative. An integer ``order`` selects
+    a fixed composite Gauss–Legendre rule of that order on panels of ``panel_width`` (coarse,
+    cheaper, unchecked by itself); with ``check_error`` (the default) :func:`tubefsi.solve`
+    compares it with the adaptive rule and warns (``AccuracyWarning``) above 1e-8.
+    """
+
+    order: int | None = attrs.field(default=None, converter=attrs.converters.optional(int))
     panel_width: float = attrs.field(default=2.0, converter=float)
-    #: A coarser rule than the default (order < 16 or panels wider than 2) is checked
-    #: against the default rule (:meth:`refined`), with an AccuracyWarning above 1e-8
-    #: relative difference.
+    rtol: float = attrs.field(default=1e-14, converter=float)
     check_error: bool = attrs.field(default=True, converter=bool)
 
     cost_rank: ClassVar[int] = 10
 
     @property
+    def _RTOL(self) -> float:                      # the engine's tolerance: this coupler's option
+        return self.rtol
+
+    @property
     def _coarse(self) -> bool:
-        return self.order < 16 or self.panel_width > 2.0
+        return self.order is not None
 
     def max_flow_rate(self, scene):
         # a property of the problem, not of the rule: a coarse rule must not move it
         return (Quadrature() if self._coarse else super()).max_flow_rate(scene)
 
     def refined(self):
-        """The default rule, against which a coarser rule is checked (``check_error``)."""
+        """The adaptive rule, against which a fixed rule is checked (``check_error``)."""
         return Quadrature() if self._coarse and self.check_error else None
 
     def describe(self) -> str:
-        return f"Quadrature(order={self.order}, panel_width={self.panel_width:g})"
+        if self._coarse:
+            return f"Quadrature(order={self.order}, panel_width={self.panel_width:g})"
+        return f"Quadrature(rtol={self.rtol:g})"
 
     def supports(self, rheology, wall) -> bool:
         return True

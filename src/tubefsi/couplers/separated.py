@@ -37,6 +37,7 @@ from scipy import interpolate, optimize
 from scipy.optimize import elementwise
 
 from .._numerics import EPS, integrate_graded, solve_increasing
+from .._quadrature import adaptive_to_pole, quiet, warn_unconverged
 from ..errors import NoSteadyStateError
 from ..scene import Scene, State
 from .base import Coupler
@@ -69,13 +70,28 @@ class SeparatedVariables(Coupler):
         """Hoop strain at log-stretch ``u``, without cancellation."""
         return scene.outlet_strain + scene.outlet_stretch * np.expm1(u)
 
-    def integrate(self, scene: Scene, f, upper, *, order=16, panel_width=2.0):
-        """``∫_0^upper f(u, idx) du`` over log-stretch: composite Gauss–Legendre, panels narrowed
-        where ``f`` grows fast and graded toward a locking stretch (see :func:`integrate_graded`)."""
+    #: Relative tolerance of every quadrature of the separated integrand (error-controlled).
+    _RTOL: float = 1e-14
+
+    def integrate(self, scene: Scene, f, upper, *, order=None, panel_width=2.0):
+        r"""``∫_0^upper f(u, idx) du`` over log-stretch, per point.
+
+        By default adaptive Gauss–Kronrod quadrature with an a-posteriori error estimate per
+        point, refined to ``_RTOL`` (:func:`tubefsi._quadrature.adaptive_to_pole`), graded in
+        :math:`\ln(v_{max} - u)` toward a locking stretch; an estimate that stays above the
+        tolerance is an ``AccuracyWarning``. With ``order`` a fixed composite Gauss–Legendre
+        rule of that order on panels of ``panel_width`` (a coarse rule, for the work-precision
+        chart; its coupler checks it against the adaptive one).
+        """
         # a maximum stretch with an unbounded pressure (a locking wall) is a singularity of P'
         singular = math.isfinite(scene.log_stretch_max) and not math.isfinite(scene.wall._limit_pressure(scene.tb))
         pole = scene.log_stretch_max if singular else math.inf
-        return integrate_graded(f, upper, pole, order=order, panel_width=panel_width)
+        if order is not None:
+            return integrate_graded(f, upper, pole, order=order, panel_width=panel_width)
+        result = adaptive_to_pole(f, 0.0, upper, pole, rtol=self._RTOL, panel_width=panel_width)
+        if not np.all(result.converged):
+            warn_unconverged("the separated-variables integral", result)
+        return result.value
 
     def pressure_rise(self, scene: Scene, v):
         r""":math:`P(\lambda_{out}e^v) - p_{out}`, computed without cancellation."""
@@ -147,12 +163,14 @@ class SeparatedVariables(Coupler):
         dp = self.pressure_rise(scene, v)
         return State(q, dp, self.strain_at(scene, v), v)
 
-    def solve_log_stretch(self, scene: Scene, target, q=None, upper=None):
+    def solve_log_stretch(self, scene: Scene, target, q=None, upper=None, *, check=True):
         r"""Log-stretch :math:`v` with :math:`J(v; q) = ` ``target``, elementwise; returns ``(v, ok)``.
 
         Safeguarded Newton on :math:`\ln J`. For a separable rheology a whole curve
         shares :math:`J`, so a coarse solve on a few quantiles of the targets gives
-        every point a starting value within a few Newton steps of its root.
+        every point a starting value within a few Newton steps of its root. Trial points do
+        not warn (:func:`~tubefsi._quadrature.quiet`); with ``check`` the integral at the answer
+        is evaluated once more, with its error estimate (``AccuracyWarning`` beyond tolerance).
         """
         sep = scene.rheology.separable
         target = np.asarray(target, dtype=float)
@@ -167,7 +185,7 @@ class SeparatedVariables(Coupler):
         positive = target[target > 0]
         if sep and positive.size > 256:
             anchors = np.geomspace(positive.min(), positive.max(), 129)
-            v_anchor, ok = self.solve_log_stretch(scene, anchors)
+            v_anchor, ok = self.solve_log_stretch(scene, anchors, check=False)
             keep = ok & (v_anchor < MAX_LOG_STRETCH)
             if np.count_nonzero(keep) >= 2:
                 shape = interpolate.PchipInterpolator(np.log(anchors[keep]), v_anchor[keep], extrapolate=True)
@@ -184,8 +202,12 @@ class SeparatedVariables(Coupler):
         if math.isfinite(scene.log_stretch_max):
             upper = cap if upper is None else np.minimum(upper, cap)
             guess = np.minimum(guess, 0.5 * cap)
-        v, ok = solve_increasing(F, dF, target, guess=guess, upper=upper, xmax=MAX_LOG_STRETCH, max_step=2.0,
-                                 log=True)
+        with quiet():
+            v, ok = solve_increasing(F, dF, target, guess=guess, upper=upper, xmax=MAX_LOG_STRETCH, max_step=2.0,
+                                     log=True)
+        answered = np.flatnonzero(ok.ravel() & (target.ravel() > 0))
+        if check and answered.size:
+            F(v.ravel()[answered], answered)                            # the answer's own error estimate
         if math.isfinite(scene.log_stretch_max):
             # converged onto the maximum stretch without reaching the target: out of reach
             at_cap = np.flatnonzero((v.ravel() >= cap * (1 - 1e-12)) & (target.ravel() > 0))

@@ -23,6 +23,7 @@ from scipy import differentiate
 from scipy.optimize import elementwise
 
 from .._numerics import as_output, solve_increasing
+from .._quadrature import quiet
 from .._validation import as_array
 from ..errors import ConvergenceError, InvalidParameterError, NoSteadyStateError
 
@@ -166,11 +167,13 @@ class WallModel(abc.ABC):
             res = differentiate.derivative(lambda s: self._pressure_at_strain(s - 1.0, tb), lam,
                                            initial_step=step, tolerances=_DIFF_TOL)
             return res.df
-        # only the inverse is natural: dP/dlam = 1 / (d lam / dp)
+        # only the inverse is natural: dP/dlam = 1 / (d lam / dp), with steps no smaller than a
+        # tenth of the pressure at strain 1e-6 (a strain law written as stretch - 1 cancels below it)
         p = self._pressure_at_strain(lam - 1.0, tb)
+        step = 0.1 * np.maximum(p, self._pressure_at_strain(np.asarray(1e-6), tb))
         res = differentiate.derivative(lambda q: self._strain(q, tb), p,
-                                       step_direction=np.where(p > 0, 0, 1),
-                                       initial_step=np.where(p > 0, 0.1 * p, 1.0), tolerances=_DIFF_TOL)
+                                       step_direction=np.where(p > 4 * step, 0, 1),
+                                       initial_step=step, tolerances=_DIFF_TOL)
         return 1.0 / res.df
 
     def _limit_pressure(self, tb):
@@ -220,15 +223,18 @@ class WallModel(abc.ABC):
         # never evaluate the law at a locking stretch (where it is singular): the largest strain
         # searched is that of the last double below the lock (lam - 1 is exact for lam < 2^53)
         xmax = float(np.nextafter(lam_max, 1.0)) - 1.0 if math.isfinite(emax) else 1e15
-        bracket = elementwise.bracket_root(f, np.zeros_like(p) + 0.0, np.maximum(guess, 1e-300) * 1.0,
-                                           xmin=0.0, xmax=xmax, args=(p,))
+        with quiet():
+            bracket = elementwise.bracket_root(f, np.zeros_like(p) + 0.0, np.maximum(guess, 1e-300) * 1.0,
+                                               xmin=0.0, xmax=xmax, args=(p,))
         if not np.all(bracket.success | (p == 0)):
             bad = ~(bracket.success | (p == 0))
             limit = float(np.max(self._pressure_at_strain(np.asarray(xmax * 0.999999), tb)))
             raise NoSteadyStateError("pressure", min(limit, self._limit_pressure(tb)),
                                      p[bad].flat[0], "the tube law never reaches it")
-        res = elementwise.find_root(f, bracket.bracket, args=(p,),
-                                    tolerances=dict(xrtol=2 * np.finfo(float).eps, xatol=1e-300))
+        with quiet():
+            res = elementwise.find_root(f, bracket.bracket, args=(p,),
+                                        tolerances=dict(xrtol=2 * np.finfo(float).eps, xatol=1e-300))
+        self._pressure_at_strain(res.x, tb)      # the answer's own error estimate (AccuracyWarning)
         return np.where(p == 0, 0.0, res.x)
 
     def _newton_strain(self, p, tb, emax, scale):
@@ -238,13 +244,14 @@ class WallModel(abc.ABC):
         upper = 0.999999 * emax if math.isfinite(emax) else None
         guess = np.minimum(p / scale, 0.5 * emax) if math.isfinite(emax) else p / scale
         try:
-            with np.errstate(all="ignore"):
+            with quiet():                        # trial strains: no warnings (the answer is checked below)
                 e, ok = solve_increasing(lambda x, i: self._pressure_at_strain(x, tb),
                                          lambda x, i: self._stiffness(1.0 + x, tb),
                                          p, guess=guess, upper=upper, xmax=1e15, maxiter=100)
-                converged = ok & np.isfinite(e) & (np.abs(self._pressure_at_strain(e, tb) - p) <= 1e-12 * p)
         except ConvergenceError:
             return None
+        with np.errstate(all="ignore"):
+            converged = ok & np.isfinite(e) & (np.abs(self._pressure_at_strain(e, tb) - p) <= 1e-12 * p)
         return e if np.all(converged) else None
 
     def _invert_strain(self, strain, tb):

@@ -46,7 +46,7 @@ import attrs
 import numpy as np
 from scipy import differentiate
 
-from .._numerics import gauss_legendre, integrate_graded, integrate_panels
+from .._quadrature import adaptive_to_pole, warn_unconverged
 from ..fields import choice
 from .base import WallModel
 
@@ -161,55 +161,40 @@ class ThickWall(HyperelasticWall):
 
     __slots__ = ()
 
-    _ORDER = 24
+    #: Relative tolerance of the Lamé integral (its error estimate is checked, ``AccuracyWarning`` beyond).
+    _RTOL = 1e-14
 
     def _pressure_at_strain(self, strain, tb):
+        r""":math:`\int_{\ln\lambda_o}^{\ln\lambda} s\,\hat W'(s)/(s^2-1)\,du`, :math:`s = e^u`, by adaptive
+        Gauss–Kronrod quadrature with an a-posteriori error estimate per point; graded toward a
+        locking stretch in :math:`\ln(\ln\lambda_{max} - u)`."""
         e = np.asarray(strain, dtype=float)
+        tb = np.asarray(tb, dtype=float)
+        shape = np.broadcast_shapes(e.shape, tb.shape)
+        e, tb = np.broadcast_to(e, shape).ravel(), np.broadcast_to(tb, shape).ravel()
         b = (1.0 + tb) ** 2
-        x = e * (2.0 + e)                       # lam^2 - 1
-        lam_o = np.sqrt(1.0 + x / b)
-        width = 0.5 * np.log1p(x * (b - 1.0) / (b + x))   # ln(lam / lam_o), no cancellation
-        nodes, weights = gauss_legendre(self._ORDER)
-        s = lam_o[..., None] * np.exp(width[..., None] * nodes)
-        values = s * self._thick_integrand(s)
-        p = width * np.sum(weights * values, axis=-1)
-        # a fast-growing integrand (strain stiffening, e.g. Fung) gets panels with kappa h <= ORDER,
-        # kappa = |d ln(integrand)/du| estimated from the nodes just used
-        with np.errstate(all="ignore"):
-            kappa = np.max(np.abs(np.diff(np.log(values), axis=-1)) / np.diff(nodes), axis=-1) / width
-        fast = np.flatnonzero(np.isfinite(kappa) & (kappa * width > self._ORDER))
-        if fast.size:
-            p = np.array(p, dtype=float).ravel()
-            lo, w = lam_o.ravel()[fast], width.ravel()[fast]
-            panels = kappa.ravel()[fast] * w / self._ORDER
-            h = w / panels
-
-            def g(x, idx):
-                s = lo[idx, None] * np.exp(x * h[idx, None])
-                return s * self._thick_integrand(s) * h[idx, None]
-
-            p[fast] = integrate_panels(g, panels, order=self._ORDER, panel_width=1.0)
-            p = p.reshape(width.shape)
+        x = e * (2.0 + e)                                   # lam^2 - 1
+        log_lam_o = 0.5 * np.log1p(x / b)
+        width = 0.5 * np.log1p(x * (b - 1.0) / (b + x))     # ln(lam / lam_o), no cancellation
         lam_max = self._locking_stretch()
         if math.isfinite(lam_max):
-            # toward a locking stretch the integrand may blow up: grade the panels there
-            gap = -np.log1p((e - (lam_max - 1.0)) / lam_max)        # ln(lam_max / lam), no cancellation
-            near = np.flatnonzero(gap < width)
-            if near.size:
-                p, lo = np.array(p, dtype=float).ravel(), lam_o.ravel()[near]
+            pole = np.log(lam_max) - log_lam_o                  # the lock, in u from ln(lam_o)
+            gap = -np.log1p((e - (lam_max - 1.0)) / lam_max)    # ln(lam_max / lam), no cancellation
+        else:
+            pole, gap = np.inf, None
 
-                def f(u, idx):
-                    s = lo[idx, None] * np.exp(u)
-                    return s * self._thick_integrand(s)
+        def f(u, idx):
+            s = np.exp(log_lam_o[idx, None] + u)
+            return s * self._thick_integrand(s)
 
-                w = width.ravel()[near]
-                p[near] = integrate_graded(f, w, w + gap.ravel()[near], gap=gap.ravel()[near], reach=np.inf,
-                                           order=self._ORDER)
-                p = p.reshape(width.shape)
-        return p
+        result = adaptive_to_pole(f, 0.0, width, pole, gap=gap, rtol=self._RTOL)
+        if not np.all(result.converged):
+            warn_unconverged("the thick-wall (Lamé) integral", result)
+        return result.value.reshape(shape)
 
     def _stiffness(self, stretch, tb):
         lam = np.asarray(stretch, dtype=float)
         b = (1.0 + tb) ** 2
         lam_o = np.sqrt(1.0 + (lam * lam - 1.0) / b)
         return self._thick_integrand(lam) - self._thick_integrand(lam_o) * lam / (b * lam_o)
+

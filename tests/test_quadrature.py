@@ -1,0 +1,99 @@
+"""The error-controlled adaptive quadrature every default path uses (tubefsi._quadrature).
+
+References: the Kronrod rule's exactness for polynomials (closed form 1/(d+1)), numpy's
+Gauss–Legendre nodes, and mpmath at 30 digits for the integrals.
+"""
+
+from __future__ import annotations
+
+import mpmath
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from tubefsi._quadrature import (GAUSS_WEIGHTS, KRONROD_NODES, KRONROD_WEIGHTS, adaptive, adaptive_to_pole,
+                                 quiet, warn_unconverged)
+from tubefsi.errors import AccuracyWarning
+
+
+def test_kronrod_rule_is_exact_to_degree_31_and_embeds_gauss_10():
+    t = 2.0 * KRONROD_NODES - 1.0                       # back on [-1, 1]: mean of t^d is (1 + (-1)^d) / (2 (d + 1))
+    for degree in range(32):
+        assert abs(KRONROD_WEIGHTS @ t**degree - (1 + (-1) ** degree) / (2.0 * (degree + 1))) < 2e-16
+    assert abs(KRONROD_WEIGHTS @ t**32 - 1.0 / 33) > 1e-12                # and not beyond
+    x, w = np.polynomial.legendre.leggauss(10)
+    np.testing.assert_allclose(KRONROD_NODES[1::2], 0.5 * (x + 1.0), rtol=0, atol=2e-16)
+    np.testing.assert_allclose(GAUSS_WEIGHTS, 0.5 * w, rtol=0, atol=2e-16)
+
+
+@pytest.mark.parametrize("b", [0.0, 1.0, 20.0, 100.0, 400.0])
+def test_fast_growth_reaches_the_tolerance(b):
+    """exp(b x^2) on [0, 1]: growth by e^400 across the interval is still resolved."""
+    r = adaptive(lambda x, i: np.exp(b * x * x), 0.0, 1.0)
+    with mpmath.workdps(30):
+        ref = mpmath.quad(lambda x: mpmath.exp(b * x * x), [0, 0.5, 0.9, 1])
+    assert r.converged
+    assert abs(r.value / ref - 1) < 1e-14
+    assert r.error <= 1e-14 * abs(r.value)
+
+
+@settings(deadline=None, max_examples=30)
+@given(st.lists(st.tuples(st.floats(0.0, 3.0), st.floats(0.1, 30.0)), min_size=1, max_size=20))
+def test_vectorized_equals_one_point_at_a_time(cases):
+    k = np.array([c[0] for c in cases])
+    upper = np.array([c[1] for c in cases])
+
+    def f(x, i):
+        return np.exp(-k[i, None] * x) * np.sqrt(1.0 + np.exp(x))
+
+    together = adaptive(f, 0.0, upper, panels=np.ceil(upper / 2))
+    for j in range(k.size):
+        alone = adaptive(lambda x, i: np.exp(-k[j] * x) * np.sqrt(1.0 + np.exp(x)), 0.0, upper[j],
+                         panels=np.ceil(upper[j] / 2))
+        assert together.value[j] == pytest.approx(float(alone.value), rel=1e-14, abs=0)
+    assert np.all(together.converged)
+
+
+@pytest.mark.parametrize("distance", [1e-3, 1e-8, 1e-13])
+def test_pole_beyond_the_end_is_graded(distance):
+    """1/(pole - x) on [0, 1] with the pole at 1 + distance: the log substitution resolves it, to
+    the accuracy the abscissae allow (x near 1 is rounded to eps, the distance to the pole is not
+    finer), and the reported estimate covers the true error."""
+    pole = 1.0 + distance
+    r = adaptive_to_pole(lambda x, i: 1.0 / (pole - x), 0.0, 1.0, pole, gap=pole - 1.0)
+    with mpmath.workdps(30):
+        exact = mpmath.log(mpmath.mpf(pole) / (mpmath.mpf(pole) - 1))
+    assert r.converged
+    assert abs(r.value - exact) <= r.error
+    assert r.error <= max(1e-14, 100 * np.finfo(float).eps / distance) * abs(r.value)
+    assert r.panels < 60
+
+
+def test_noise_is_reported_not_hidden():
+    """An integrand with relative noise 1e-9 cannot be integrated to 1e-14: converged is False,
+    the estimate says about 1e-9, and refinement stops instead of running to the panel limit."""
+    rng = np.random.default_rng(1)
+
+    def noisy(x, i):
+        return np.exp(x) * (1.0 + 1e-9 * rng.standard_normal(x.shape))
+
+    r = adaptive(noisy, 0.0, 1.0)
+    assert not r.converged
+    assert 1e-11 < r.error / r.value < 1e-7
+    assert r.panels < 2048
+    assert abs(r.value / (np.e - 1.0) - 1) < 1e-8
+    with pytest.warns(AccuracyWarning, match="estimated relative error"):
+        warn_unconverged("the test integral", r)
+    with quiet():            # trial points inside an iteration do not warn
+        import warnings
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            warn_unconverged("the test integral", r)
+
+
+def test_zero_width_and_reversed_intervals():
+    r = adaptive(lambda x, i: np.cos(x), np.array([0.0, 1.0, 2.0]), np.array([0.0, 0.0, 2.0]))
+    np.testing.assert_allclose(r.value, [0.0, -np.sin(1.0), 0.0], rtol=1e-15, atol=0)
+    assert np.all(r.converged)
