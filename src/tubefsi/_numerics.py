@@ -22,29 +22,36 @@ def gauss_legendre(order: int) -> tuple[np.ndarray, np.ndarray]:
     return 0.5 * (x + 1.0), 0.5 * w
 
 
-def expm1_ratio(k: float, x):
-    r"""Stable :math:`(e^{k x} - 1)/k`, equal to ``x`` at ``k = 0``.
+def expm1_ratio(k, x):
+    r"""Stable :math:`(e^{k x} - 1)/k`, equal to ``x`` at ``k = 0`` (``k`` a float or an array).
 
     This is :math:`\int_0^x e^{k u}\,du`; the removable singularity at ``k = 0``
     (n = 2/3 for thin reference walls, n = 1 for thin current walls) is taken
     exactly, and ``expm1`` keeps full relative accuracy for small ``k x``.
     """
-    if k == 0.0:
-        return np.asarray(x, dtype=float) * 1.0
-    return np.expm1(k * np.asarray(x, dtype=float)) / k
+    x = np.asarray(x, dtype=float)
+    if np.ndim(k) == 0:
+        return x * 1.0 if k == 0.0 else np.expm1(k * x) / k
+    k = np.asarray(k, dtype=float)
+    zero = k == 0.0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(zero, x, np.expm1(k * x) / np.where(zero, 1.0, k))
 
 
-def log1p_ratio(k: float, y):
+def log1p_ratio(k, y):
     r"""Inverse of :func:`expm1_ratio` in ``x``: :math:`\ln(1 + k y)/k`, ``y`` at ``k = 0``.
 
     Returns ``inf`` where :math:`1 + k y \le 0` (the integral never reaches ``y``).
     """
     y = np.asarray(y, dtype=float)
-    if k == 0.0:
+    k = np.asarray(k, dtype=float)
+    if k.ndim == 0 and k == 0.0:
         return y * 1.0
     arg = k * y
+    zero = k == 0.0
     with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(arg > -1.0, np.log1p(np.maximum(arg, -1.0)) / k, np.inf)
+        out = np.where(arg > -1.0, np.log1p(np.maximum(arg, -1.0)) / np.where(zero, 1.0, k), np.inf)
+        return np.where(zero, y, out)
 
 
 def integrate_panels(f, upper, *, order=16, panel_width=2.0):

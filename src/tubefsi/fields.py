@@ -32,27 +32,44 @@ factory              admissible values
 
 from __future__ import annotations
 
+import copy
+import functools
 import math
 
 import attrs
+import numpy as np
 
 from .errors import InvalidParameterError
 
-__all__ = ["real", "positive", "nonnegative", "choice", "Parameter", "parameters"]
+__all__ = ["real", "positive", "nonnegative", "choice", "Parameter", "parameters", "parameter_shape",
+           "broadcast_model", "model_at", "parameter_sets", "evaluate", "flat_points", "take"]
 
 
-def _convert_float(value, field):
-    if isinstance(value, (bool, str)):
-        raise InvalidParameterError(field.name, "the real numbers", value,
-                                    "give a plain number in SI units")
-    try:
+def _invalid_type(field, value):
+    return InvalidParameterError(field.name, "the real numbers", value,
+                                 "give a plain number in SI units, or an array of them")
+
+
+def _convert_real(value, field):
+    """A float for a scalar, a read-only float ndarray for an array (any shape)."""
+    if isinstance(value, (bool, str, bytes)):
+        raise _invalid_type(field, value)
+    if isinstance(value, (int, float)):
         return float(value)
-    except (TypeError, ValueError):
-        raise InvalidParameterError(field.name, "the real numbers", value,
-                                    "give a plain number in SI units") from None
+    try:
+        a = np.asarray(value)
+    except Exception:
+        raise _invalid_type(field, value) from None
+    if a.dtype.kind not in "iuf":           # booleans, complex numbers, strings, objects
+        raise _invalid_type(field, value)
+    if a.ndim == 0:
+        return float(a)
+    a = np.array(a, dtype=float)            # a private copy: the model is immutable
+    a.setflags(write=False)
+    return a
 
 
-_float_converter = attrs.Converter(_convert_float, takes_field=True)
+_real_converter = attrs.Converter(_convert_real, takes_field=True)
 
 
 def _fmt(x) -> str:
@@ -65,30 +82,51 @@ def _fmt(x) -> str:
 
 def _interval_validator(low, high, low_open, high_open, admissible):
     def check(instance, attribute, value):
-        ok = math.isfinite(value) or (value == math.inf and high == math.inf and not high_open)
-        ok = ok and (value > low if low_open else value >= low)
-        ok = ok and (value < high if high_open else value <= high)
-        if not ok:
-            raise InvalidParameterError(attribute.name, admissible, value)
+        v = np.asarray(value)
+        with np.errstate(invalid="ignore"):
+            ok = np.isfinite(v) | ((v == math.inf) & (high == math.inf) & (not high_open))
+            ok &= (v > low) if low_open else (v >= low)
+            ok &= (v < high) if high_open else (v <= high)
+        if not np.all(ok):
+            if v.ndim == 0:
+                raise InvalidParameterError(attribute.name, admissible, float(v))
+            where = tuple(int(i) for i in np.argwhere(~ok)[0])
+            raise InvalidParameterError(attribute.name, admissible, float(v[where]),
+                                        f"entry {where} of an array of shape {v.shape}")
 
     return check
 
 
+def _same(a, b) -> bool:
+    """Equality of two parameter values (floats or arrays), as one bool."""
+    if isinstance(a, float) and isinstance(b, float):
+        return a == b
+    a, b = np.asarray(a), np.asarray(b)
+    return a.shape == b.shape and bool(np.all(a == b))
+
+
+_EQ = attrs.cmp_using(eq=_same)
+
+
 def real(*, low=-math.inf, high=math.inf, low_open=True, high_open=True, unit="", doc="",
          default=attrs.NOTHING):
-    """A float parameter in the interval from ``low`` to ``high`` (open ends by default).
+    """A real parameter in the interval from ``low`` to ``high`` (open ends by default).
 
-    NaN is always rejected, and an infinite value unless the interval is closed at infinity.
-    ``unit`` is the SI unit as text (``"Pa"``, ``"Pa s^n"``, ``""`` for a number), ``doc`` a
-    few words for ``tubefsi list``.
+    The value is a float, or an array of any shape (read-only, broadcast against the other
+    parameters and the load by NumPy's rules, as :mod:`scipy.stats` broadcasts its shape
+    parameters). NaN is always rejected, and an infinite value unless the interval is closed
+    at infinity; an offending array entry is named by its index. ``unit`` is the SI unit as
+    text (``"Pa"``, ``"Pa s^n"``, ``""`` for a number), ``doc`` a few words for
+    ``tubefsi list``.
     """
     lo = "(" if low_open else "["
     hi = ")" if high_open else "]"
     admissible = f"{lo}{_fmt(low)}, {_fmt(high)}{hi}"
     return attrs.field(
-        converter=_float_converter,
+        converter=_real_converter,
         validator=_interval_validator(low, high, low_open, high_open, admissible),
-        metadata={"unit": unit, "doc": doc, "admissible": admissible,
+        eq=_EQ, hash=False,
+        metadata={"unit": unit, "doc": doc, "admissible": admissible, "array": True,
                   "low": low, "high": high, "low_open": low_open, "high_open": high_open},
         default=default,
     )
@@ -151,3 +189,106 @@ def parameters(model) -> tuple[Parameter, ...]:
                            admissible=f.metadata.get("admissible", ""), doc=f.metadata.get("doc", ""),
                            default=f.default)
                  for f in attrs.fields(cls) if f.init)
+
+
+# ------------------------------------------------------------------------- arrays of parameters
+@functools.cache
+def _array_fields(cls) -> tuple[str, ...]:
+    """The names of the fields of ``cls`` that may hold arrays (declared with :func:`real`)."""
+    if not attrs.has(cls):
+        return ()
+    return tuple(f.name for f in attrs.fields(cls) if f.metadata.get("array"))
+
+
+def parameter_shape(model) -> tuple[int, ...]:
+    """The broadcast shape of a model's array parameters (``()`` when all are scalars)."""
+    shapes = [np.shape(getattr(model, name)) for name in _array_fields(type(model))]
+    return np.broadcast_shapes(*shapes) if shapes else ()
+
+
+def _replace(model, values: dict):
+    """A copy of ``model`` with some parameters replaced, bypassing validation (already done)."""
+    new = copy.copy(model)
+    for name, value in values.items():
+        object.__setattr__(new, name, value)
+    return new
+
+
+def broadcast_model(model, shape):
+    """``model`` with every array parameter broadcast to ``shape`` and flattened (1-D, aligned
+    with the flat points of ``shape``); the model itself if all its parameters are scalars."""
+    arrays = {name: v for name in _array_fields(type(model)) if isinstance(v := getattr(model, name), np.ndarray)}
+    if not arrays:
+        return model
+    return _replace(model, {name: np.broadcast_to(v, shape).ravel() for name, v in arrays.items()})
+
+
+def model_at(model, index, *, column=False):
+    """``model`` with its flat (1-D) array parameters taken at ``index``, as a column (``(n, 1)``,
+    to broadcast against ``(n, nodes)`` arguments) if ``column``; the model itself if scalar."""
+    arrays = {name: v for name in _array_fields(type(model)) if isinstance(v := getattr(model, name), np.ndarray)}
+    if not arrays:
+        return model
+    return _replace(model, {name: (v[index][:, None] if column else v[index]) for name, v in arrays.items()})
+
+
+def parameter_sets(model, shape):
+    """``[(index, model_with_scalar_parameters), ...]``: the distinct parameter sets of ``model``
+    broadcast to ``shape``, with the flat indices of the points that have each one. For models
+    whose hooks are not vectorized over their parameters (``broadcasts = False``), and for
+    tables built per parameter set."""
+    arrays = {name: v for name in _array_fields(type(model)) if isinstance(v := getattr(model, name), np.ndarray)}
+    n = int(np.prod(shape, dtype=int))
+    if not arrays:
+        return [(np.arange(n), model)]
+    names = list(arrays)
+    stack = np.stack([np.broadcast_to(arrays[k], shape).ravel() for k in names], axis=1)
+    rows, inverse = np.unique(stack, axis=0, return_inverse=True)
+    inverse = inverse.ravel()
+    order = np.argsort(inverse, kind="stable")
+    bounds = np.searchsorted(inverse[order], np.arange(rows.shape[0] + 1))
+    return [(order[bounds[j]:bounds[j + 1]], _replace(model, {k: float(rows[j, c]) for c, k in enumerate(names)}))
+            for j in range(rows.shape[0])]
+
+
+def evaluate(model, fn, *args):
+    """``fn(model', *args')`` with the arguments and the model's parameters broadcast together.
+
+    The arguments (floats or arrays) and the model's array parameters are broadcast to one
+    shape and flattened; ``fn`` gets the model with aligned 1-D parameters (or, for a model
+    with ``broadcasts = False``, one call per distinct parameter set) and returns values of the
+    flat shape. Returns a float when everything is scalar, else an array of the broadcast shape.
+    """
+    arrays = [np.asarray(a, dtype=float) for a in args]
+    shape = np.broadcast_shapes(*(a.shape for a in arrays), parameter_shape(model))
+    if shape == ():
+        return float(np.asarray(fn(model, *arrays), dtype=float))
+    flat = [np.broadcast_to(a, shape).ravel() if a.ndim else a for a in arrays]
+    n = int(np.prod(shape, dtype=int))
+    if getattr(type(model), "broadcasts", True):
+        out = np.asarray(fn(broadcast_model(model, shape), *flat), dtype=float)
+        return np.array(np.broadcast_to(out.reshape(-1) if out.ndim else out, (n,)).reshape(shape))
+    out = np.empty(n)
+    for index, scalar_model in parameter_sets(model, shape):
+        out[index] = fn(scalar_model, *(a[index] if a.ndim else a for a in flat))
+    return out.reshape(shape)
+
+
+def flat_points(model, *values):
+    """``(shape, model', [values'])``: the values and the model's array parameters broadcast
+    together and flattened to aligned 1-D arrays (scalar values and a model's scalar parameters
+    stay scalars; :func:`take` reads either at some points).
+
+    Generic hooks that iterate with only some points active (root finders, differentiation) use
+    it, then take the model at the active indices with :func:`model_at`.
+    """
+    arrays = [np.asarray(v, dtype=float) for v in values]
+    shape = np.broadcast_shapes(*(a.shape for a in arrays), parameter_shape(model))
+    n = (int(np.prod(shape, dtype=int)),)
+    return shape, broadcast_model(model, shape), [np.broadcast_to(a, shape).reshape(n).copy() if a.ndim else a
+                                                  for a in arrays]
+
+
+def take(value, index):
+    """A per-point value (a scalar, shared by all points, or a 1-D array) at ``index``."""
+    return value if np.ndim(value) == 0 else value[index]

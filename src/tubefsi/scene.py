@@ -13,14 +13,16 @@ import math
 import attrs
 import numpy as np
 
+from ._validation import as_array
 from .errors import InvalidParameterError, NoSteadyStateError
 from .geometry import Tube
 from .registry import rheologies as _rheologies
 from .registry import walls as _walls
 from .rheology.base import Rheology
 from .walls.base import WallModel
+from .fields import _array_fields, _replace, model_at, parameter_shape
 
-__all__ = ["Scene", "State", "make_scene", "resolve"]
+__all__ = ["Scene", "State", "Points", "make_scene", "resolve"]
 
 
 @attrs.frozen
@@ -45,43 +47,185 @@ class State:
     log_stretch: np.ndarray
 
 
+def _value_eq(a, b) -> bool:
+    a, b = np.asarray(a), np.asarray(b)
+    return a.shape == b.shape and bool(np.all(a == b))
+
+
 @attrs.frozen(kw_only=True)
 class Scene:
     r"""A rheology, a wall, a tube and an outlet pressure: everything but the load.
 
-    Build it with :func:`make_scene` (which validates); the outlet state is derived once:
+    Build it with :func:`make_scene` (which validates). Every model parameter, every tube field
+    and the outlet pressure may be an array: the scene's :attr:`shape` is their broadcast shape,
+    and the loads of a solve broadcast against it. The outlet state is derived once:
 
     Attributes
     ----------
-    outlet_strain, outlet_stretch : float
+    shape : tuple
+        The broadcast shape of the scene's array parameters (``()`` when all are scalars).
+    outlet_strain, outlet_stretch : float or ndarray
         The hoop strain and stretch at the outlet, under ``outlet_pressure``.
-    log_stretch_max : float
+    log_stretch_max : float or ndarray
         :math:`\ln(\lambda_{max}/\lambda_{out})`, the largest log-stretch the wall admits
         (``inf`` unless it locks or its tube law peaks).
+
+    :meth:`flat` broadcasts everything to a shape and flattens it (what couplers work on: one
+    entry per point), :meth:`take` selects points of a flat scene, and :meth:`at` gathers the
+    per-point quantities of some points for an integrand.
     """
 
     rheology: Rheology
     wall: WallModel
     tube: Tube
-    outlet_pressure: float = 0.0
+    outlet_pressure: float = attrs.field(default=0.0, eq=attrs.cmp_using(eq=_value_eq), hash=False)
 
-    outlet_strain: float = attrs.field(init=False)
-    outlet_stretch: float = attrs.field(init=False)
-    log_stretch_max: float = attrs.field(init=False)
+    shape: tuple = attrs.field(init=False, eq=False)
+    outlet_strain: float = attrs.field(init=False, eq=False, hash=False)
+    outlet_stretch: float = attrs.field(init=False, eq=False, hash=False)
+    log_stretch_max: float = attrs.field(init=False, eq=False, hash=False)
 
     def __attrs_post_init__(self):
+        shape = np.broadcast_shapes(parameter_shape(self.rheology), parameter_shape(self.wall),
+                                    parameter_shape(self.tube), np.shape(self.outlet_pressure))
+        object.__setattr__(self, "shape", shape)
         # the hoop strain at the outlet, once: every J evaluation needs it
-        strain = 0.0 if self.outlet_pressure == 0 else float(
-            self.wall._strain(np.asarray(self.outlet_pressure), self.tb))
+        p_out, tb = self.outlet_pressure, self.tb
+        if np.ndim(p_out) == 0 and p_out == 0:
+            strain = 0.0
+        elif shape == ():
+            strain = float(self.wall._strain(np.asarray(p_out), tb))
+        else:
+            strain = np.where(np.asarray(p_out) == 0, 0.0, self.wall.strain(p_out, tb))
         object.__setattr__(self, "outlet_strain", strain)
         object.__setattr__(self, "outlet_stretch", 1.0 + strain)
-        lam_max = float(self.wall._max_stretch(self.tb))
-        object.__setattr__(self, "log_stretch_max", math.log(lam_max / (1.0 + strain)))
+        lam_max = self.wall._max_stretch(tb) if shape == () else self.wall.max_stretch(tb)
+        with np.errstate(divide="ignore"):
+            v_max = np.log(np.asarray(lam_max, dtype=float) / (1.0 + np.asarray(strain)))
+        object.__setattr__(self, "log_stretch_max", float(v_max) if v_max.ndim == 0 else v_max)
 
     @property
-    def tb(self) -> float:
+    def tb(self):
         """The reduced thickness t/a of the tube."""
         return self.tube.reduced_thickness
+
+    @property
+    def size(self) -> int:
+        """The number of points of the scene (1 when all its parameters are scalars)."""
+        return int(np.prod(self.shape, dtype=int))
+
+    def flat(self, shape) -> Scene:
+        """This scene broadcast to ``shape`` and flattened: every array quantity becomes a 1-D
+        array with one entry per point of ``shape`` (scalars stay scalars)."""
+        if self.shape == () or (len(self.shape) == 1 and tuple(shape) == self.shape):
+            return self
+        return _evolve_arrays(self, lambda v: np.broadcast_to(v, shape).ravel())
+
+    def take(self, index) -> Scene:
+        """The points ``index`` of a flat scene (a scene whose arrays are 1-D)."""
+        if self.shape == ():
+            return self
+        return _evolve_arrays(self, lambda v: v[index])
+
+    def point(self, i: int) -> Scene:
+        """Point ``i`` of a flat scene as a scene of scalars."""
+        if self.shape == ():
+            return self
+        return _evolve_arrays(self, lambda v: float(v[i]))
+
+    def split(self, todo):
+        """``[(index, scene), ...]``: the points ``todo`` of a flat scene with, for each part, the
+        flat scene of those points. A model that needs it — a rheology of the generic
+        (non-separable) path, whose flow table is built per parameter set, or a model whose hooks
+        do not broadcast (``broadcasts = False``) — has one parameter set per part, as scalars."""
+        todo = np.asarray(todo)
+        if self.size == 1 or todo.size == 0:
+            return [(todo, self)]
+        grouped = []
+        for model in (self.rheology, self.wall):
+            broadcasts = getattr(type(model), "broadcasts", True)
+            if model is self.rheology:
+                broadcasts = broadcasts and model.separable
+            if not broadcasts and _array_values(model):
+                grouped.append(model)
+        if not grouped:
+            return [(todo, self.take(todo))]
+        keys = [np.broadcast_to(v, (self.size,))[todo] for m in grouped for v in _array_values(m).values()]
+        _, inverse = np.unique(np.stack(keys, axis=1), axis=0, return_inverse=True)
+        inverse = inverse.ravel()
+        order = np.argsort(inverse, kind="stable")
+        bounds = np.searchsorted(inverse[order], np.arange(int(inverse.max()) + 2))
+        parts = []
+        for j in range(len(bounds) - 1):
+            index = todo[order[bounds[j]:bounds[j + 1]]]
+            part = self.take(index)
+            for name in ("rheology", "wall"):
+                if any(getattr(self, name) is m for m in grouped):
+                    model = getattr(part, name)
+                    scalar = _replace(model, {k: float(v[0]) for k, v in _array_values(model).items()})
+                    object.__setattr__(part, name, scalar)
+            parts.append((index, _refresh(part)))
+        return parts
+
+    def at(self, index, *, column=False) -> Points:
+        """The per-point quantities of a flat scene at ``index``, as columns (shape ``(n, 1)``, to
+        broadcast against ``(n, nodes)`` arrays) if ``column``."""
+        return Points(self, index, column)
+
+
+def _evolve_arrays(scene, transform):
+    """The scene with ``transform`` applied to every array it holds (models, tube, outlet state)."""
+    def models(m):
+        arrays = {n: transform(v) for n, v in _array_values(m).items()}
+        return _replace(m, arrays) if arrays else m
+
+    new = object.__new__(Scene)
+    for name, value in (("rheology", models(scene.rheology)), ("wall", models(scene.wall)),
+                        ("tube", models(scene.tube))):
+        object.__setattr__(new, name, value)
+    for name in ("outlet_pressure", "outlet_strain", "outlet_stretch", "log_stretch_max"):
+        value = getattr(scene, name)
+        object.__setattr__(new, name, transform(np.asarray(value)) if np.ndim(value) else value)
+    probe = transform(np.zeros(scene.shape)) if scene.shape else None
+    object.__setattr__(new, "shape", np.shape(probe) if probe is not None else ())
+    return new
+
+
+def _refresh(scene):
+    """A scene whose derived shape is recomputed after a model was made scalar in place."""
+    shape = np.broadcast_shapes(parameter_shape(scene.rheology), parameter_shape(scene.wall),
+                                parameter_shape(scene.tube), np.shape(scene.outlet_pressure),
+                                np.shape(scene.outlet_strain), np.shape(scene.log_stretch_max))
+    object.__setattr__(scene, "shape", shape)
+    return scene
+
+
+def _array_values(model) -> dict:
+    return {n: v for n in _array_fields(type(model)) if isinstance(v := getattr(model, n), np.ndarray)}
+
+
+class Points:
+    """The per-point quantities of some points of a flat scene (see :meth:`Scene.at`)."""
+
+    __slots__ = ("wall", "rheology", "radius", "length", "tb", "outlet_stretch", "outlet_strain",
+                 "outlet_pressure", "log_stretch_max")
+
+    def __init__(self, scene, index, column):
+        def pick(value):
+            if np.ndim(value) == 0:
+                return value
+            v = value[index]
+            return v[:, None] if column else v
+
+        self.wall = model_at(scene.wall, index, column=column)
+        self.rheology = model_at(scene.rheology, index, column=column)
+        self.radius = pick(scene.tube.radius)
+        self.length = pick(scene.tube.length)
+        self.tb = pick(scene.tb)
+        self.outlet_stretch = pick(scene.outlet_stretch)
+        self.outlet_strain = pick(scene.outlet_strain)
+        self.outlet_pressure = pick(scene.outlet_pressure)
+        self.log_stretch_max = pick(scene.log_stretch_max)
 
 
 _KINDS = {"rheology": (Rheology, _rheologies), "wall": (WallModel, _walls)}
@@ -128,13 +272,13 @@ def make_scene(rheology, wall, tube, *, outlet_pressure=0.0) -> Scene:
     wall = resolve("wall", wall)
     if not isinstance(tube, Tube):
         raise InvalidParameterError("tube", "a tubefsi.Tube", tube)
-    try:
-        p_out = float(outlet_pressure)
-    except (TypeError, ValueError):
-        raise InvalidParameterError("outlet_pressure", "[0, inf)", outlet_pressure) from None
-    if not (math.isfinite(p_out) and p_out >= 0):
-        raise InvalidParameterError("outlet_pressure", "[0, inf)", p_out)
+    p_out = as_array("outlet_pressure", outlet_pressure, "[0, inf)", lambda a: a >= 0)
+    p_out = float(p_out) if p_out.ndim == 0 else p_out
     lim = wall.limit_pressure(tube.reduced_thickness)
-    if p_out >= lim:
-        raise NoSteadyStateError("pressure", lim, p_out, "the outlet pressure already exceeds it")
+    beyond = np.asarray(p_out >= lim)
+    if np.any(beyond):
+        i = np.unravel_index(int(np.argmax(beyond.ravel())), beyond.shape) if beyond.ndim else ()
+        raise NoSteadyStateError("pressure", float(np.broadcast_to(lim, beyond.shape)[i]),
+                                 float(np.broadcast_to(p_out, beyond.shape)[i]),
+                                 "the outlet pressure already reaches it")
     return Scene(rheology=rheology, wall=wall, tube=tube, outlet_pressure=p_out)

@@ -19,6 +19,9 @@ from .scene import Scene, State
 
 __all__ = ["Solution"]
 
+#: Points per coupler call of a profile (bounded working memory).
+_CHUNK = 1 << 14
+
 
 @attrs.frozen(kw_only=True)
 class Solution:
@@ -35,6 +38,8 @@ class Solution:
     scalar: bool = True
     #: The registered name of the coupler (its class name if it is not registered).
     coupler_name: str = ""
+    #: Where ``solve(..., on_infeasible="nan")`` found a steady state (None: everywhere).
+    feasible: object = None
 
     # ------------------------------------------------------------------ loads
     @property
@@ -86,11 +91,33 @@ class Solution:
 
     # ------------------------------------------------------------------ profiles
     def _profile(self, z):
-        """``(strain, pressure_rise, flow_rate)`` at ``z`` from the coupler, broadcast with the loads."""
-        L = self.tube.length
-        z = as_array("z", z, f"[0, {L:g}] (m)", lambda a: (a >= 0) & (a <= L))
-        strain, rise = self.coupler.profile(self.scene, self.state, z)
-        return strain, rise, np.broadcast_to(self.state.flow_rate, np.shape(strain))
+        """``(strain, pressure_rise, flow_rate)`` at ``z`` from the coupler, broadcast with the loads
+        (and the scene's array parameters); NaN at infeasible points."""
+        z = as_array("z", z, "[0, L] (m)", lambda a: a >= 0)
+        st = self.state
+        shape = np.broadcast_shapes(z.shape, np.shape(st.flow_rate))
+        length = np.broadcast_to(np.asarray(self.tube.length, dtype=float), shape) if np.ndim(self.tube.length) \
+            else self.tube.length
+        zz = np.broadcast_to(z, shape)
+        if np.any(zz > length):
+            bad = zz > length
+            raise InvalidParameterError("z", f"[0, L] (m), L = {np.max(np.asarray(length)):g}", float(zz[bad].flat[0]))
+        n = int(np.prod(shape, dtype=int))
+        flat = self.scene.flat(shape) if self.scene.shape != () else self.scene
+        fields = {f.name: np.broadcast_to(np.asarray(getattr(st, f.name), dtype=float), shape).ravel()
+                  for f in attrs.fields(State)}
+        zf = zz.ravel()
+        strain, rise = np.full(n, np.nan), np.full(n, np.nan)
+        ok = np.flatnonzero(np.isfinite(fields["flow_rate"]))
+        for index, part in flat.split(ok):
+            for start in range(0, index.size, _CHUNK):
+                idx = index[start:start + _CHUNK]
+                chunk = part if part.size == 1 or idx.size == index.size else \
+                    part.take(np.arange(start, start + idx.size))
+                sub = State(**{k: v[idx] for k, v in fields.items()})
+                e, r = self.coupler.profile(chunk, sub, zf[idx])
+                strain[idx], rise[idx] = np.broadcast_to(e, idx.shape), np.broadcast_to(r, idx.shape)
+        return strain.reshape(shape), rise.reshape(shape), fields["flow_rate"].reshape(shape)
 
     def _out(self, value, *arguments):
         return as_output(value, self.scalar and all(np.ndim(a) == 0 for a in arguments))

@@ -8,8 +8,6 @@ loads and returns a :class:`~tubefsi.Solution`.
 
 from __future__ import annotations
 
-import math
-
 import attrs
 import numpy as np
 
@@ -47,11 +45,14 @@ def select_coupler(rheology, wall, coupler="auto") -> Coupler:
 
 
 def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="auto",
-          outlet_pressure=0.0) -> Solution:
+          outlet_pressure=0.0, on_infeasible="raise") -> Solution:
     r"""Solve steady flow of ``rheology`` through ``tube`` with wall ``wall``.
 
     Exactly one of ``flow_rate`` (flow-controlled) and ``pressure_drop``
-    (pressure-controlled) is given, as a float or an array (every entry >= 0).
+    (pressure-controlled) is given, as a float or an array (every entry >= 0). Every model
+    parameter, every ``Tube`` field and the outlet pressure may be arrays too: all broadcast
+    together with the load by NumPy's rules (as :mod:`scipy.stats` broadcasts its shape
+    parameters), the results have the broadcast shape, and scalars in give floats out.
 
     Parameters
     ----------
@@ -64,8 +65,12 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
     coupler : "auto", registered name, or Coupler instance
         ``"auto"`` takes the cheapest coupler that supports the pair and meets the
         accuracy contract (``closed-form`` where it exists, else ``quadrature``).
-    outlet_pressure : float
+    outlet_pressure : float or array_like
         Transmural pressure at the outlet, p(L) >= 0 (Pa).
+    on_infeasible : {"raise", "nan"}
+        What a point beyond a limit (the maximum flow rate, the limit pressure) gets:
+        ``"raise"`` (the default) raises :class:`NoSteadyStateError` for the whole call;
+        ``"nan"`` gives that point NaN results and ``False`` in :attr:`Solution.feasible`.
 
     Returns
     -------
@@ -76,60 +81,90 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
     InvalidParameterError
         For any input outside its admissible range.
     NoSteadyStateError
-        Beyond the wall's limit pressure or the maximum flow rate.
+        Beyond the wall's limit pressure or the maximum flow rate (``on_infeasible="raise"``).
     """
     scene = make_scene(rheology, wall, tube, outlet_pressure=outlet_pressure)
     if (flow_rate is None) == (pressure_drop is None):
         raise InvalidParameterError("flow_rate / pressure_drop", "exactly one of the two",
                                     None, "give flow_rate= or pressure_drop=, not both or neither")
+    if on_infeasible not in ("raise", "nan"):
+        raise InvalidParameterError("on_infeasible", "{'raise', 'nan'}", on_infeasible)
     chosen = select_coupler(scene.rheology, scene.wall, coupler)
     runner = checked(chosen)            # a self-checking coupler is re-solved finer (AccuracyWarning)
-    if flow_rate is not None:
-        q = as_load("flow_rate", flow_rate)
-        q_max = _finite_max_flow(chosen, scene, q)
-        beyond = (q > 0) & (q >= q_max) if q_max is not None else None
-        if beyond is not None and np.any(beyond):
-            raise NoSteadyStateError("flow_rate", q_max, q[beyond].flat[0],
-                                     "the tube inflates without bound")
-        state = _chunked(runner.flow_controlled, scene, q)
-        scalar = np.ndim(flow_rate) == 0
-    else:
-        dp = as_load("pressure_drop", pressure_drop)
-        state = _chunked(runner.pressure_controlled, scene, dp)
-        scalar = np.ndim(pressure_drop) == 0
-    return Solution(scene=scene, coupler=chosen, state=state, scalar=scalar,
-                    coupler_name=registry.couplers.name_of(chosen) or type(chosen).__name__)
+    controlled = "flow_rate" if flow_rate is not None else "pressure_drop"
+    load = as_load(controlled, flow_rate if flow_rate is not None else pressure_drop)
+    shape = np.broadcast_shapes(scene.shape, load.shape)
+    flat = scene.flat(shape)
+    values = np.broadcast_to(load, shape).ravel()
+    method = runner.flow_controlled if controlled == "flow_rate" else runner.pressure_controlled
+    n = values.size
+    out = {f.name: np.full(n, np.nan) for f in attrs.fields(State)}
+    feasible = np.ones(n, dtype=bool)
+    for index, part in flat.split(np.arange(n)):
+        for start in range(0, index.size, CHUNK):
+            idx = index[start:start + CHUNK]
+            chunk = part if part.size == 1 or idx.size == index.size else part.take(np.arange(start, start + idx.size))
+            ok = _feasible(runner, chunk, values[idx], controlled, raise_=on_infeasible == "raise")
+            go = np.arange(idx.size) if ok is None else np.flatnonzero(ok)
+            if ok is not None:
+                feasible[idx] = ok
+            if go.size == 0:
+                continue
+            sub = chunk if go.size == idx.size else (chunk.take(go) if chunk.size > 1 else chunk)
+            state = method(sub, values[idx][go])
+            for name in out:
+                out[name][idx[go]] = np.broadcast_to(np.asarray(getattr(state, name), dtype=float), go.shape)
+    state = State(*(out[f.name].reshape(shape) for f in attrs.fields(State)))
+    return Solution(scene=scene, coupler=chosen, state=state, scalar=shape == (),
+                    coupler_name=registry.couplers.name_of(chosen) or type(chosen).__name__,
+                    feasible=None if np.all(feasible) else feasible.reshape(shape))
 
 
-#: Loads per coupler call: bounds the working memory (a few tens of MB) of any sweep.
+#: Points per coupler call: bounds the working memory (a few tens of MB) of any sweep.
 CHUNK = 1 << 14
 
 
-def _chunked(method, scene, load):
-    """Run ``method`` on slices of at most CHUNK loads; cost stays linear, memory bounded."""
-    if load.size <= CHUNK:
-        return method(scene, load)
-    flat = load.ravel()
-    parts = [method(scene, flat[i:i + CHUNK]) for i in range(0, flat.size, CHUNK)]
-    fields = {f.name: np.concatenate([getattr(p, f.name) for p in parts]).reshape(load.shape)
-              for f in attrs.fields(State)}
-    return State(**fields)
-
-
-def _finite_max_flow(coupler, scene, q):
-    if not math.isfinite(scene.wall.limit_pressure(scene.tb)):     # the rigid wall's included
+def _feasible(coupler, scene, load, controlled, *, raise_):
+    """The points below every limit (None: all of them); raises for the first one beyond if ``raise_``."""
+    if controlled == "flow_rate":
+        limit = np.asarray(coupler.max_flow_rate(scene), dtype=float)
+        if not np.any(np.isfinite(limit)):
+            return None
+        beyond = (load > 0) & (load >= limit)
+        quantity, detail = "flow_rate", "the tube inflates without bound"
+    else:
+        limit = np.asarray(scene.wall.limit_pressure(scene.tb), dtype=float) - scene.outlet_pressure
+        if not np.any(np.isfinite(limit)):
+            return None
+        beyond = load >= limit
+        limit = limit + np.asarray(scene.outlet_pressure)
+        quantity, detail = "pressure", "the inlet pressure, outlet pressure + pressure drop, reaches it"
+    beyond = np.broadcast_to(beyond, load.shape)
+    if not np.any(beyond):
         return None
-    q_max = coupler.max_flow_rate(scene)
-    return q_max if math.isfinite(q_max) else None
+    if raise_:
+        i = int(np.argmax(beyond))
+        value = float(load[i]) if quantity == "flow_rate" else float(
+            np.broadcast_to(np.asarray(scene.outlet_pressure), load.shape)[i] + load[i])
+        raise NoSteadyStateError(quantity, float(np.broadcast_to(limit, load.shape)[i]), value, detail)
+    return ~beyond
 
 
-def max_flow_rate(rheology, wall, tube, *, outlet_pressure=0.0, coupler="auto") -> float:
+def max_flow_rate(rheology, wall, tube, *, outlet_pressure=0.0, coupler="auto"):
     r"""The largest flow rate with a steady state (m^3/s); ``inf`` where every flow rate has one.
 
     Finite only for a wall with a limit pressure (thick or thin-current
     Mooney–Rivlin/neo-Hookean) and a fluid whose :math:`G(q,R)` falls off slowly
     enough in :math:`R`: for a power law, exactly when :math:`n < 1`. Then
-    :math:`L\,\phi(q_{max}) = \int_0^\infty s P'(s)/\psi(as)\,du`.
+    :math:`L\,\phi(q_{max}) = \int_0^\infty s P'(s)/\psi(as)\,du`. Array parameters broadcast
+    (an array of the scene's shape comes back).
     """
     scene = make_scene(rheology, wall, tube, outlet_pressure=outlet_pressure)
-    return float(select_coupler(scene.rheology, scene.wall, coupler).max_flow_rate(scene))
+    chosen = select_coupler(scene.rheology, scene.wall, coupler)
+    if scene.shape == ():
+        return float(chosen.max_flow_rate(scene))
+    flat = scene.flat(scene.shape)
+    out = np.empty(flat.size)
+    for index, part in flat.split(np.arange(flat.size)):
+        out[index] = chosen.max_flow_rate(part)
+    return out.reshape(scene.shape)

@@ -36,26 +36,29 @@ class ClosedForm(SeparatedVariables):
     def supports(self, rheology, wall) -> bool:
         return rheology.separable and rheology.radius_exponent is not None and wall.closed_form_integral
 
-    def _J(self, scene, v, q):
-        k = scene.rheology.radius_exponent
-        a = scene.tube.radius
-        return a**k * scene.wall._power_law_integral(np.asarray(v, dtype=float), scene.outlet_stretch, k,
-                                                     scene.tb)
+    def _J(self, scene, v, index, q=None):
+        pts = scene.at(np.asarray(index))
+        k = pts.rheology.radius_exponent
+        return pts.radius**k * pts.wall._power_law_integral(np.asarray(v, dtype=float), pts.outlet_stretch, k,
+                                                            pts.tb)
 
-    def _J_infinity(self, scene, q=None):
-        return float(self._J(scene, np.asarray(np.inf), None))
+    def _J_infinity(self, scene, index, q=None):
+        index = np.asarray(index)
+        return self._J(scene, np.full(index.shape, np.inf), index) + np.zeros(index.shape)
 
     def flow_controlled(self, scene, flow_rate):
         """Explicit inverse where the wall has one (linear, thin current thickness), else Newton."""
         q = np.asarray(flow_rate, dtype=float)
         if scene.wall.is_rigid:
             return super().flow_controlled(scene, q)
-        k = scene.rheology.radius_exponent
-        target = self.target(scene, q) / scene.tube.radius**k
-        v = scene.wall._power_law_integral_inverse(target, scene.outlet_stretch, k, scene.tb)
+        index = np.arange(q.size)
+        pts = scene.at(index)
+        k = pts.rheology.radius_exponent
+        target = self.target(pts, q) / pts.radius**k
+        v = pts.wall._power_law_integral_inverse(target, pts.outlet_stretch, k, pts.tb)
         if v is None:
             return super().flow_controlled(scene, q)
         v = np.where(q == 0, 0.0, v)
         if not np.all(v <= MAX_LOG_STRETCH):
             self._raise_runaway(scene, q, v <= MAX_LOG_STRETCH)
-        return State(q, self.pressure_rise(scene, v), self.strain_at(scene, v), v)
+        return State(q, self.pressure_rise(scene, v, index), self.strain_at(pts, v) + 0.0 * v, v)

@@ -169,37 +169,44 @@ class ODE(Coupler):
         q = np.asarray(flow_rate, dtype=float)
         if scene.wall.is_rigid:
             return _ENGINE.flow_controlled(scene, q)
-        q_max = self.max_flow_rate(scene)
+        q_max = np.broadcast_to(np.asarray(self.max_flow_rate(scene), dtype=float), q.shape)
         if np.any(q >= q_max):
-            raise NoSteadyStateError("flow_rate", q_max, q[q >= q_max].flat[0])
+            i = int(np.argmax(q >= q_max))
+            raise NoSteadyStateError("flow_rate", float(q_max[i]), float(q[i]))
         strain = np.empty(q.size)
         rise = np.empty(q.size)
-        for i, qi in enumerate(q.ravel()):
-            strain[i], rise[i] = (scene.outlet_strain, 0.0) if qi == 0 else self._integrate(scene, qi)
-        strain, rise = strain.reshape(q.shape), rise.reshape(q.shape)
-        v = np.log1p((strain - scene.outlet_strain) / scene.outlet_stretch)
+        for i, qi in enumerate(q.ravel()):          # one ODE per point, on that point's scene
+            one = scene.point(i)
+            strain[i], rise[i] = (one.outlet_strain, 0.0) if qi == 0 else self._integrate(one, qi)
+        out_strain = np.broadcast_to(np.asarray(scene.outlet_strain), q.shape)
+        out_stretch = np.broadcast_to(np.asarray(scene.outlet_stretch), q.shape)
+        v = np.log1p((strain - out_strain) / out_stretch)
         return State(q, rise, strain, v)
 
     def pressure_controlled(self, scene, pressure_drop) -> State:
         dp = np.asarray(pressure_drop, dtype=float)
         if scene.wall.is_rigid:
             return _ENGINE.pressure_controlled(scene, dp)
-        tb, a, L, rheo = scene.tb, scene.tube.radius, scene.tube.length, scene.rheology
-        scene.wall._check_pressure(scene.outlet_pressure + dp, tb)
-        e_in = scene.wall._strain(scene.outlet_pressure + dp, tb)
         q = np.zeros(dp.size)
-        q_max = self.max_flow_rate(scene)
-        for i, (d, e) in enumerate(zip(dp.ravel(), np.ravel(e_in))):
+        e_in = np.zeros(dp.size)
+        q_max = np.broadcast_to(np.asarray(self.max_flow_rate(scene), dtype=float), dp.shape)
+        for i, d in enumerate(dp.ravel()):
+            one = scene.point(i)
+            tb, a, L, rheo = one.tb, one.tube.radius, one.tube.length, one.rheology
+            one.wall._check_pressure(one.outlet_pressure + d, tb)
+            e = float(one.wall._strain(np.asarray(one.outlet_pressure + d), tb))
+            e_in[i] = e
             if d == 0:
                 continue
             # the flow lies between the rigid-tube flows at the outlet and inlet radii (and below q_max)
-            lo = float(rheo._flow_rate(np.asarray([a * scene.outlet_stretch]), np.asarray([d / L]))[0])
+            lo = float(rheo._flow_rate(np.asarray([a * one.outlet_stretch]), np.asarray([d / L]))[0])
             hi = min(float(rheo._flow_rate(np.asarray([a * (1.0 + e)]), np.asarray([d / L]))[0]),
-                     q_max * (1 - 1e-12))
+                     float(q_max[i]) * (1 - 1e-12))
             if hi <= lo * (1 + 1e-14):
                 q[i] = lo
                 continue
-            q[i] = self._shoot(scene, d, lo, hi)
-        q = q.reshape(dp.shape)
-        v = np.log1p((e_in - scene.outlet_strain) / scene.outlet_stretch)
-        return State(q, dp, e_in, v)
+            q[i] = self._shoot(one, d, lo, hi)
+        out_strain = np.broadcast_to(np.asarray(scene.outlet_strain), dp.shape)
+        out_stretch = np.broadcast_to(np.asarray(scene.outlet_stretch), dp.shape)
+        v = np.log1p((e_in - out_strain) / out_stretch)
+        return State(q.reshape(dp.shape), dp, e_in, v)

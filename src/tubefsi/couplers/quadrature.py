@@ -62,11 +62,15 @@ class Quadrature(SeparatedVariables):
     def supports(self, rheology, wall) -> bool:
         return True
 
-    def _J(self, scene, v, q):
+    def _J(self, scene, v, index, q=None):
         v = np.asarray(v, dtype=float)
+        index = np.asarray(index)
         if q is None:
-            return self.integrate(scene, lambda u, idx: self.integrand(scene, u), v, order=self.order,
-                                  panel_width=self.panel_width)
-        qflat = np.broadcast_to(np.asarray(q, dtype=float), v.shape).ravel()
-        return self.integrate(scene, lambda u, idx: self.integrand(scene, u, qflat[idx, None]), v,
-                              order=self.order, panel_width=self.panel_width)
+            def f(u, i):
+                return self.integrand(scene.at(index[i], column=True), u)
+        else:
+            qq = np.broadcast_to(np.asarray(q, dtype=float), v.shape).ravel()
+
+            def f(u, i):
+                return self.integrand(scene.at(index[i], column=True), u, qq[i, None])
+        return self.integrate(scene, f, v, index, order=self.order, panel_width=self.panel_width)

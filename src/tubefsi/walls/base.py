@@ -22,9 +22,10 @@ import numpy as np
 from scipy import differentiate
 from scipy.optimize import elementwise
 
-from .._numerics import as_output, solve_increasing
+from .._numerics import solve_increasing
 from .._quadrature import quiet
 from .._validation import as_array
+from ..fields import evaluate, flat_points, model_at, take
 from ..errors import ConvergenceError, InvalidParameterError, NoSteadyStateError
 
 #: scipy.differentiate tolerances: as tight as the error estimate allows
@@ -79,16 +80,21 @@ class WallModel(abc.ABC):
     closed_form_integral: ClassVar[bool] = False
 
     # ------------------------------------------------------------------ public API
+    # Every argument broadcasts with the others and with the wall's array parameters (NumPy's
+    # rules); scalars give a float, arrays an array of the broadcast shape.
     def pressure(self, stretch, reduced_thickness):
         r"""Transmural pressure :math:`P(\lambda; \bar t)` (Pa) at hoop stretch ``stretch``."""
-        tb = self._check_thickness(reduced_thickness)
-        lam = self._check_stretch(stretch, tb)
-        return as_output(self._pressure_at_strain(lam - 1.0, tb), _is_scalar(stretch, reduced_thickness))
+        tb = _check_thickness(reduced_thickness)
+
+        def fn(wall, lam, tb):
+            return wall._pressure_at_strain(wall._check_stretch(lam, tb) - 1.0, tb)
+
+        return evaluate(self, fn, _as_floats("stretch", stretch), tb)
 
     def stretch(self, pressure, reduced_thickness):
         r"""Hoop stretch :math:`\lambda = R/a` under transmural pressure ``pressure`` (Pa)."""
-        return as_output(1.0 + np.asarray(self.strain(pressure, reduced_thickness)),
-                         _is_scalar(pressure, reduced_thickness))
+        strain = self.strain(pressure, reduced_thickness)
+        return 1.0 + strain
 
     def strain(self, pressure, reduced_thickness):
         r"""Hoop strain :math:`\lambda - 1 = u/a`, computed without forming ``stretch - 1``.
@@ -98,28 +104,36 @@ class WallModel(abc.ABC):
         NoSteadyStateError
             If ``pressure`` reaches the wall's limit pressure.
         """
-        tb = self._check_thickness(reduced_thickness)
-        p = self._check_pressure(pressure, tb)
-        return as_output(self._strain(p, tb), _is_scalar(pressure, reduced_thickness))
+        tb = _check_thickness(reduced_thickness)
+
+        def fn(wall, p, tb):
+            return wall._strain(wall._check_pressure(p, tb), tb)
+
+        return evaluate(self, fn, _as_floats("pressure", pressure), tb)
 
     def stiffness(self, stretch, reduced_thickness):
         r"""Tube-law slope :math:`dP/d\lambda` (Pa)."""
-        tb = self._check_thickness(reduced_thickness)
-        lam = self._check_stretch(stretch, tb)
-        return as_output(self._stiffness(lam, tb), _is_scalar(stretch, reduced_thickness))
+        tb = _check_thickness(reduced_thickness)
 
-    def limit_pressure(self, reduced_thickness) -> float:
+        def fn(wall, lam, tb):
+            return wall._stiffness(wall._check_stretch(lam, tb), tb)
+
+        return evaluate(self, fn, _as_floats("stretch", stretch), tb)
+
+    def limit_pressure(self, reduced_thickness):
         r"""The pressure the wall can never reach (Pa); ``inf`` for most laws."""
-        return float(self._limit_pressure(self._check_thickness(reduced_thickness)))
+        return evaluate(self, lambda wall, tb: wall._limit_pressure(tb) + 0.0 * tb,
+                        _check_thickness(reduced_thickness))
 
-    def max_stretch(self, reduced_thickness) -> float:
+    def max_stretch(self, reduced_thickness):
         """The largest admissible stretch (``inf`` unless the material locks)."""
-        return float(self._max_stretch(self._check_thickness(reduced_thickness)))
+        return evaluate(self, lambda wall, tb: wall._max_stretch(tb) + 0.0 * tb,
+                        _check_thickness(reduced_thickness))
 
-    def small_strain_modulus(self, reduced_thickness) -> float:
+    def small_strain_modulus(self, reduced_thickness):
         r""":math:`dP/d\lambda` at :math:`\lambda = 1` (Pa): the slope of the linear limit."""
-        tb = self._check_thickness(reduced_thickness)
-        return float(self._stiffness(np.asarray(1.0), tb))
+        return evaluate(self, lambda wall, tb: wall._stiffness(np.ones(np.shape(tb)), tb),
+                        _check_thickness(reduced_thickness))
 
     def plot(self, reduced_thickness, *, ax=None, max_stretch=3.0, **kwargs):
         """Plot this wall's tube law; see :func:`tubefsi.plotting.plot_tube_law`."""
@@ -158,23 +172,24 @@ class WallModel(abc.ABC):
         return self._invert_pressure(pressure, tb)
 
     def _stiffness(self, stretch, tb):
-        lam = np.asarray(stretch, dtype=float)
+        shape, wall, (lam, tb) = flat_points(self, stretch, tb)
+        index = np.arange(lam.size)
         if self._natural() == "pressure":
             # central differences (the law is evaluated slightly below stretch 1, where it
             # still exists), steps kept clear of a locking stretch
-            room = self._max_stretch(tb) - lam
+            room = wall._max_stretch(tb) - lam
             step = 0.1 * np.minimum(lam, np.where(np.isfinite(room), 0.2 * room, np.inf))
-            res = differentiate.derivative(lambda s: self._pressure_at_strain(s - 1.0, tb), lam,
-                                           initial_step=step, tolerances=_DIFF_TOL)
-            return res.df
+            res = differentiate.derivative(lambda s, i: model_at(wall, i)._pressure_at_strain(s - 1.0, take(tb, i)), lam,
+                                           args=(index,), initial_step=step, tolerances=_DIFF_TOL)
+            return res.df.reshape(shape)
         # only the inverse is natural: dP/dlam = 1 / (d lam / dp), with steps no smaller than a
         # tenth of the pressure at strain 1e-6 (a strain law written as stretch - 1 cancels below it)
-        p = self._pressure_at_strain(lam - 1.0, tb)
-        step = 0.1 * np.maximum(p, self._pressure_at_strain(np.asarray(1e-6), tb))
-        res = differentiate.derivative(lambda q: self._strain(q, tb), p,
+        p = wall._pressure_at_strain(lam - 1.0, tb)
+        step = 0.1 * np.maximum(p, wall._pressure_at_strain(np.full(lam.shape, 1e-6), tb))
+        res = differentiate.derivative(lambda q, i: model_at(wall, i)._strain(q, take(tb, i)), p, args=(index,),
                                        step_direction=np.where(p > 4 * step, 0, 1),
                                        initial_step=step, tolerances=_DIFF_TOL)
-        return 1.0 / res.df
+        return (1.0 / res.df).reshape(shape)
 
     def _limit_pressure(self, tb):
         return math.inf
@@ -185,9 +200,9 @@ class WallModel(abc.ABC):
         Only used where the limit pressure is finite (to decide whether a maximum
         flow rate exists); estimated numerically unless overridden.
         """
-        lam = np.array([1e5, 1e6])
-        d = self._stiffness(lam, tb)
-        return float(-np.log(d[1] / d[0]) / np.log(lam[1] / lam[0]))
+        far = np.zeros(np.shape(tb))
+        d0, d1 = self._stiffness(far + 1e5, tb), self._stiffness(far + 1e6, tb)
+        return -np.log(d1 / d0) / np.log(10.0)
 
     def _power_law_integral(self, log_ratio, outlet_stretch, exponent, tb):
         r"""Closed form of :math:`\int_0^v s^{k+1} P'(s)\,du`, :math:`s = \lambda_{out} e^u`, or None.
@@ -208,45 +223,52 @@ class WallModel(abc.ABC):
     def _invert_pressure(self, pressure, tb):
         """Hoop strain at ``pressure``: safeguarded Newton iteration with the stiffness (vectorized,
         bracketed below a maximum stretch), else bracketed root finding on ``_pressure_at_strain``."""
-        p = np.asarray(pressure, dtype=float)
-        lam_max = self._max_stretch(tb)
+        shape, wall, (p, tb) = flat_points(self, pressure, tb)
+        p = np.broadcast_to(p, (max(1, p.size),))             # the root finders index their points
+        lam_max = np.asarray(wall._max_stretch(tb), dtype=float) + 0.0 * p
         emax = lam_max - 1.0
-        scale = max(self._stiffness(np.asarray(1.0), tb), 1e-300)
-        fast = self._newton_strain(p, tb, emax, scale)
+        scale = np.maximum(wall._stiffness(np.ones(p.shape), tb), 1e-300)
+        fast = wall._newton_strain(p, tb, emax, scale)
         if fast is not None:
-            return fast
+            return fast.reshape(shape)
+        index = np.arange(p.size)
 
-        def f(e, p):
-            return self._pressure_at_strain(e, tb) - p
+        def f(e, p, i):
+            return model_at(wall, i)._pressure_at_strain(e, take(tb, i)) - p
 
-        guess = np.minimum(np.maximum(p / scale, 1e-300), 0.5 * emax if math.isfinite(emax) else np.inf)
+        finite = np.isfinite(emax)
+        guess = np.minimum(np.maximum(p / scale, 1e-300), np.where(finite, 0.5 * emax, np.inf))
         # never evaluate the law at a locking stretch (where it is singular): the largest strain
         # searched is that of the last double below the lock (lam - 1 is exact for lam < 2^53)
-        xmax = float(np.nextafter(lam_max, 1.0)) - 1.0 if math.isfinite(emax) else 1e15
+        xmax = np.where(finite, np.nextafter(lam_max, 1.0) - 1.0, 1e15)
         with quiet():
-            bracket = elementwise.bracket_root(f, np.zeros_like(p) + 0.0, np.maximum(guess, 1e-300) * 1.0,
-                                               xmin=0.0, xmax=xmax, args=(p,))
+            bracket = elementwise.bracket_root(f, np.zeros_like(p), np.maximum(guess, 1e-300),
+                                               xmin=0.0, xmax=xmax, args=(p, index))
         if not np.all(bracket.success | (p == 0)):
-            bad = ~(bracket.success | (p == 0))
-            limit = float(np.max(self._pressure_at_strain(np.asarray(xmax * 0.999999), tb)))
-            raise NoSteadyStateError("pressure", min(limit, self._limit_pressure(tb)),
-                                     p[bad].flat[0], "the tube law never reaches it")
+            bad = int(np.argmax(~(bracket.success | (p == 0))))
+            with quiet():
+                top = float(model_at(wall, index[bad:bad + 1])._pressure_at_strain(
+                    xmax[bad:bad + 1] * 0.999999, take(tb, index[bad:bad + 1]))[0])
+            limit = min(top, float(np.broadcast_to(wall._limit_pressure(tb), p.shape)[bad]))
+            raise NoSteadyStateError("pressure", limit, float(p[bad]), "the tube law never reaches it")
         with quiet():
-            res = elementwise.find_root(f, bracket.bracket, args=(p,),
+            res = elementwise.find_root(f, bracket.bracket, args=(p, index),
                                         tolerances=dict(xrtol=2 * np.finfo(float).eps, xatol=1e-300))
-        self._pressure_at_strain(res.x, tb)      # the answer's own error estimate (AccuracyWarning)
-        return np.where(p == 0, 0.0, res.x)
+        wall._pressure_at_strain(res.x, tb)      # the answer's own error estimate (AccuracyWarning)
+        return np.where(p == 0, 0.0, res.x).reshape(shape)
 
     def _newton_strain(self, p, tb, emax, scale):
-        """The Newton path of :meth:`_invert_pressure`; None where it does not converge cleanly."""
+        """The Newton path of :meth:`_invert_pressure` (flat, aligned arguments); None where it does
+        not converge cleanly."""
         if self._natural() != "pressure":
             return None
-        upper = 0.999999 * emax if math.isfinite(emax) else None
-        guess = np.minimum(p / scale, 0.5 * emax) if math.isfinite(emax) else p / scale
+        finite = np.isfinite(emax)
+        upper = np.where(finite, 0.999999 * emax, np.inf) if np.any(finite) else None
+        guess = np.where(finite, np.minimum(p / scale, 0.5 * emax), p / scale)
         try:
             with quiet():                        # trial strains: no warnings (the answer is checked below)
-                e, ok = solve_increasing(lambda x, i: self._pressure_at_strain(x, tb),
-                                         lambda x, i: self._stiffness(1.0 + x, tb),
+                e, ok = solve_increasing(lambda x, i: model_at(self, i)._pressure_at_strain(x, take(tb, i)),
+                                         lambda x, i: model_at(self, i)._stiffness(1.0 + x, take(tb, i)),
                                          p, guess=guess, upper=upper, xmax=1e15, maxiter=100)
         except ConvergenceError:
             return None
@@ -256,44 +278,67 @@ class WallModel(abc.ABC):
 
     def _invert_strain(self, strain, tb):
         """Pressure at a strain when only the inverse law ``_strain`` is natural."""
-        e = np.asarray(strain, dtype=float)
+        shape, wall, (e, tb) = flat_points(self, strain, tb)
+        e = np.broadcast_to(e, (max(1, e.size),))
+        index = np.arange(e.size)
 
-        def f(p, e):
-            return self._strain(p, tb) - e
+        def f(p, e, i):
+            return model_at(wall, i)._strain(p, take(tb, i)) - e
 
-        lim = self._limit_pressure(tb)
+        lim = np.asarray(wall._limit_pressure(tb), dtype=float) + 0.0 * e
         hi = np.maximum(e, 1e-300) * 10.0
         bracket = elementwise.bracket_root(f, np.zeros_like(e), hi, xmin=0.0,
-                                           xmax=lim if math.isfinite(lim) else None, args=(e,))
-        res = elementwise.find_root(f, bracket.bracket, args=(e,),
+                                           xmax=np.where(np.isfinite(lim), lim, np.inf), args=(e, index))
+        res = elementwise.find_root(f, bracket.bracket, args=(e, index),
                                     tolerances=dict(xrtol=2 * np.finfo(float).eps, xatol=1e-300))
-        return np.where(e == 0, 0.0, res.x)
+        return np.where(e == 0, 0.0, res.x).reshape(shape)
 
-    # ------------------------------------------------------------------ validation
+    # ------------------------------------------------------------------ validation (vectorized)
     @staticmethod
-    def _check_thickness(reduced_thickness) -> float:
-        try:
-            tb = float(reduced_thickness)
-        except (TypeError, ValueError):
-            raise InvalidParameterError("reduced_thickness", "(0, inf)", reduced_thickness) from None
-        if not (math.isfinite(tb) and tb > 0):
-            raise InvalidParameterError("reduced_thickness", "(0, inf)", tb)
-        return tb
+    def _check_thickness(reduced_thickness):
+        """The reduced thickness t/a: finite and > 0 (a float or an array)."""
+        return _check_thickness(reduced_thickness)
 
-    def _check_stretch(self, stretch, tb):
-        lam_max = self._max_stretch(tb)
-        if math.isfinite(lam_max):
-            return as_array("stretch", stretch, f"[1, {lam_max:.10g})", lambda a: (a >= 1) & (a < lam_max))
-        return as_array("stretch", stretch, "[1, inf)", lambda a: a >= 1)
+    def _check_stretch(self, lam, tb):
+        """``lam`` (flat, aligned with the wall's parameters) checked against ``[1, max_stretch)``."""
+        lam = np.asarray(lam, dtype=float)
+        values, top = np.broadcast_arrays(lam, np.asarray(self._max_stretch(tb), dtype=float))
+        with np.errstate(invalid="ignore"):
+            ok = np.isfinite(values) & (values >= 1) & (values < top)
+        if not np.all(ok):
+            i = int(np.argmax(~ok.ravel()))
+            t = float(top.flat[i])
+            raise InvalidParameterError("stretch", "[1, inf)" if t == math.inf else f"[1, {t:.10g})",
+                                        float(values.flat[i]))
+        return lam
 
-    def _check_pressure(self, pressure, tb):
-        p = as_array("pressure", pressure, "[0, inf)", lambda a: a >= 0)
-        lim = self._limit_pressure(tb)
-        if np.any(p >= lim):
-            raise NoSteadyStateError("pressure", lim, p[p >= lim].flat[0],
+    def _check_pressure(self, p, tb):
+        """``p`` (flat, aligned) checked against ``[0, limit_pressure)``."""
+        p = np.asarray(p, dtype=float)
+        values, lim = np.broadcast_arrays(p, np.asarray(self._limit_pressure(tb), dtype=float))
+        with np.errstate(invalid="ignore"):
+            bad = ~(values >= 0)
+            beyond = values >= lim
+        if np.any(bad):
+            raise InvalidParameterError("pressure", "[0, inf)", float(values.flat[int(np.argmax(bad.ravel()))]))
+        if np.any(beyond):
+            i = int(np.argmax(beyond.ravel()))
+            raise NoSteadyStateError("pressure", float(lim.flat[i]), float(values.flat[i]),
                                      f"{type(self).__name__} cannot sustain it")
         return p
 
 
-def _is_scalar(*values) -> bool:
-    return all(np.ndim(v) == 0 for v in values)
+def _check_thickness(reduced_thickness):
+    """The reduced thickness t/a: finite and > 0 (a float or an array)."""
+    return as_array("reduced_thickness", reduced_thickness, "(0, inf)", lambda a: a > 0)
+
+
+def _as_floats(name, value):
+    """A float array of ``value``; the range is checked by the caller (it depends on the wall)."""
+    try:
+        a = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidParameterError(name, "the real numbers", value) from None
+    if not np.all(np.isfinite(a) | (a == np.inf)):
+        raise InvalidParameterError(name, "the real numbers", float(a[np.isnan(a)].flat[0]) if a.ndim else float(a))
+    return a

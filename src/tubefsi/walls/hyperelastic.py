@@ -47,7 +47,7 @@ import numpy as np
 from scipy import differentiate
 
 from .._quadrature import adaptive_to_pole, warn_unconverged
-from ..fields import choice
+from ..fields import choice, evaluate, flat_points, model_at, take
 from .base import WallModel
 
 #: scipy.differentiate tolerances: as tight as the error estimate allows
@@ -84,16 +84,16 @@ class HyperelasticWall(WallModel):
     __slots__ = ()
 
     def dW(self, stretch):
-        r"""Reduced strain-energy derivative :math:`\hat W'(\lambda)` (Pa)."""
-        lam = np.asarray(stretch, dtype=float)
-        out = self._dW(lam)
-        return float(out) if np.ndim(stretch) == 0 else out
+        r"""Reduced strain-energy derivative :math:`\hat W'(\lambda)` (Pa), broadcast with the parameters."""
+        return evaluate(self, lambda wall, lam: wall._dW(lam), np.asarray(stretch, dtype=float))
 
     def _dW(self, stretch):
         if type(self)._energy is HyperelasticWall._energy:
             raise TypeError(f"{type(self).__name__} must implement _dW or _energy")
-        return differentiate.derivative(self._energy, stretch, initial_step=0.1 * stretch,
-                                        tolerances=_DIFF_TOL).df
+        shape, wall, (lam,) = flat_points(self, stretch)
+        res = differentiate.derivative(lambda x, i: model_at(wall, i)._energy(x), lam, args=(np.arange(lam.size),),
+                                       initial_step=0.1 * lam, tolerances=_DIFF_TOL)
+        return res.df.reshape(shape)
 
     def _energy(self, stretch):
         """Reduced strain energy :math:`\\hat W(\\lambda)` (optional natural hook)."""
@@ -101,10 +101,12 @@ class HyperelasticWall(WallModel):
 
     def _d2W(self, stretch):
         r""":math:`\hat W''(\lambda)`, numerically unless overridden (steps clear of a locking stretch)."""
-        stretch = np.asarray(stretch, dtype=float)
-        room = self._locking_stretch() - stretch
-        step = 0.1 * np.minimum(stretch, np.where(np.isfinite(room), 0.2 * room, np.inf))
-        return differentiate.derivative(self._dW, stretch, initial_step=step, tolerances=_DIFF_TOL).df
+        shape, wall, (lam,) = flat_points(self, stretch)
+        room = wall._locking_stretch() - lam
+        step = 0.1 * np.minimum(lam, np.where(np.isfinite(room), 0.2 * room, np.inf))
+        res = differentiate.derivative(lambda x, i: model_at(wall, i)._dW(x), lam, args=(np.arange(lam.size),),
+                                       initial_step=step, tolerances=_DIFF_TOL)
+        return res.df.reshape(shape)
 
     def _locking_stretch(self) -> float:
         r"""The stretch at which the material locks (:math:`\hat W' \to \infty`, e.g. Gent); ``inf``.
@@ -168,24 +170,23 @@ class ThickWall(HyperelasticWall):
         r""":math:`\int_{\ln\lambda_o}^{\ln\lambda} s\,\hat W'(s)/(s^2-1)\,du`, :math:`s = e^u`, by adaptive
         Gauss–Kronrod quadrature with an a-posteriori error estimate per point; graded toward a
         locking stretch in :math:`\ln(\ln\lambda_{max} - u)`."""
-        e = np.asarray(strain, dtype=float)
-        tb = np.asarray(tb, dtype=float)
-        shape = np.broadcast_shapes(e.shape, tb.shape)
-        e, tb = np.broadcast_to(e, shape).ravel(), np.broadcast_to(tb, shape).ravel()
+        shape, wall, (e, tb) = flat_points(self, strain, tb)
+        e = np.broadcast_to(e, (max(1, e.size),))            # the quadrature indexes its points
         b = (1.0 + tb) ** 2
         x = e * (2.0 + e)                                   # lam^2 - 1
         log_lam_o = 0.5 * np.log1p(x / b)
         width = 0.5 * np.log1p(x * (b - 1.0) / (b + x))     # ln(lam / lam_o), no cancellation
-        lam_max = self._locking_stretch()
-        if math.isfinite(lam_max):
-            pole = np.log(lam_max) - log_lam_o                  # the lock, in u from ln(lam_o)
-            gap = -np.log1p((e - (lam_max - 1.0)) / lam_max)    # ln(lam_max / lam), no cancellation
-        else:
-            pole, gap = np.inf, None
+        lam_max = np.asarray(wall._locking_stretch(), dtype=float) + 0.0 * e
+        with np.errstate(divide="ignore", invalid="ignore"):
+            pole = np.where(np.isfinite(lam_max), np.log(lam_max) - log_lam_o, np.inf)   # the lock, in u
+            gap = np.where(np.isfinite(lam_max), -np.log1p((e - (lam_max - 1.0)) / lam_max),  # ln(lam_max/lam)
+                           np.inf)
+
+        log_lam_o = np.broadcast_to(log_lam_o, e.shape)
 
         def f(u, idx):
             s = np.exp(log_lam_o[idx, None] + u)
-            return s * self._thick_integrand(s)
+            return s * model_at(wall, idx, column=True)._thick_integrand(s)
 
         result = adaptive_to_pole(f, 0.0, width, pole, gap=gap, rtol=self._RTOL)
         if not np.all(result.converged):

@@ -11,6 +11,7 @@ the neo-Hookean ones with shear modulus :math:`\mu = 2(c_1 + c_2)`
 from __future__ import annotations
 
 import attrs
+import numpy as np
 
 from ..fields import real
 from ..errors import InvalidParameterError
@@ -28,9 +29,12 @@ class MooneyRivlin(HyperelasticWall):
     c2: float = real(unit="Pa", doc="second Mooney–Rivlin constant (often negative)")
 
     def __attrs_post_init__(self):
-        if not self.c1 + self.c2 > 0:
-            raise InvalidParameterError("c1 + c2", "(0, inf)", self.c1 + self.c2,
-                                        "the small-strain shear modulus 2 (c1 + c2) must be positive")
+        total = np.asarray(self.c1 + self.c2)
+        if not np.all(total > 0):
+            bad = np.argwhere(~(total > 0))[0] if total.ndim else ()
+            raise InvalidParameterError("c1 + c2", "(0, inf)", float(total[tuple(bad)]),
+                                        "the small-strain shear modulus 2 (c1 + c2) must be positive"
+                                        + (f" (entry {tuple(int(i) for i in bad)})" if total.ndim else ""))
 
     @property
     def shear_modulus(self) -> float:

@@ -106,14 +106,18 @@ class _ThickForms(_NeoHookeanLaw):
         return self.shear_modulus * stretch * d * (lam2 * (d + 2.0) + d) / (lam2 * lam2 * (lam2 + d) ** 2)
 
     def _strain(self, pressure, tb):
-        p = np.asarray(pressure, dtype=float)
-        e, _ = solve_increasing(lambda e, i: self._pressure_at_strain(e, tb),
-                                lambda e, i: self._stiffness(1.0 + e, tb),
-                                p, guess=p / self._stiffness(np.asarray(1.0), tb))
-        return e
+        # the law per unit modulus: no parameter but t/a, which is gathered for the active points
+        shape = np.broadcast_shapes(np.shape(pressure), np.shape(tb), np.shape(self.shear_modulus))
+        k = np.broadcast_to(np.asarray(pressure, dtype=float) / self.shear_modulus, shape).ravel()
+        tb = np.broadcast_to(np.asarray(tb, dtype=float), shape).ravel()
+        unit = _UNIT_THICK
+        e, _ = solve_increasing(lambda e, i: unit._pressure_at_strain(e, tb[i]),
+                                lambda e, i: unit._stiffness(1.0 + e, tb[i]),
+                                k, guess=k / unit._stiffness(np.ones(k.shape), tb))
+        return e.reshape(shape)
 
     def _limit_pressure(self, tb):
-        return self.shear_modulus * math.log1p(tb)
+        return self.shear_modulus * np.log1p(tb)
 
     def _stiffness_decay_exponent(self, tb):
         return 5.0
@@ -140,3 +144,7 @@ class ThickNeoHookean(_ThickForms, ThickWall, NeoHookean):
     :math:`\mu\ln(1+\bar t)`."""
 
     _examples = ({"shear_modulus": 2e3},)
+
+
+#: The thick neo-Hookean law of unit modulus (its inverse iterates on it, gathering only t/a).
+_UNIT_THICK = ThickNeoHookean(shear_modulus=1.0)

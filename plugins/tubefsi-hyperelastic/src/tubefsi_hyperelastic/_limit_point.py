@@ -47,19 +47,34 @@ class LimitPoint:
     infinity: ``inf`` for a law that grows without bound) and ``_asymptotic_decay(tb, theory)``
     (``kappa`` with :math:`P' \\sim \\lambda^{-\\kappa}`, where the asymptote is finite).
     ``theory`` is ``"reference"``, ``"current"`` (thin walls) or ``"thick"``.
+
+    The peak is found per parameter set and thickness (a scan), so these walls do not broadcast
+    their parameters (``broadcasts = False``: tubefsi solves each distinct set separately); an
+    array of thicknesses is scanned once per distinct value.
     """
 
     __slots__ = ()
 
+    broadcasts = False
+
     def _theory(self) -> str:
         return getattr(self, "thickness_convention", "thick")
 
+    def _peaks(self, tb):
+        """``(stretch, pressure)`` of the first peak per thickness (arrays for an array ``tb``)."""
+        tb = np.asarray(tb, dtype=float)
+        if tb.ndim == 0:
+            return first_peak(self, float(tb))
+        values, inverse = np.unique(tb.ravel(), return_inverse=True)
+        peaks = np.array([first_peak(self, float(t)) for t in values])
+        return peaks[inverse, 0].reshape(tb.shape), peaks[inverse, 1].reshape(tb.shape)
+
     def _max_stretch(self, tb):
-        return first_peak(self, float(tb))[0]
+        return self._peaks(tb)[0]
 
     def _limit_pressure(self, tb):
-        peak, pressure = first_peak(self, float(tb))
-        return pressure if math.isfinite(peak) else self._asymptote(tb, self._theory())
+        peak, pressure = self._peaks(tb)
+        return np.where(np.isfinite(peak), pressure, self._asymptote(tb, self._theory()))
 
     def _stiffness_decay_exponent(self, tb):
         return self._asymptotic_decay(tb, self._theory())

@@ -33,7 +33,7 @@ class Fung(HyperelasticWall):
         return 0.5 * (x + (x * x + 4.0) ** 0.5)
 
     def _limit_pressure(self, tb):
-        return float(self._pressure_at_strain(np.asarray(self._max_stretch(tb) - 1.0), tb))
+        return self._pressure_at_strain(np.asarray(self._max_stretch(tb) - 1.0 + 0.0 * np.asarray(tb)), tb)
 
     def _growth(self, s):
         with np.errstate(over="ignore"):

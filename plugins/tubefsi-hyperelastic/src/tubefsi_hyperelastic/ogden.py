@@ -89,7 +89,7 @@ class Ogden(LimitPoint, HyperelasticWall):
         lead = sum(m for m, a in zip(self.moduli, self.exponents) if abs(a) == crit) * 2.0 / crit
         if top < crit or not lead > 0:
             return 0.0  # the law falls back to zero: its peak is the limit (found by the scan)
-        return tb * lead if theory != "thick" else math.log1p(tb) * lead
+        return tb * lead if theory != "thick" else np.log1p(tb) * lead
 
     def _asymptotic_decay(self, tb, theory):
         crit = self._critical(theory)

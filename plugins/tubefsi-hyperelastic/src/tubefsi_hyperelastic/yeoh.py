@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 
 import attrs
+import numpy as np
 from tubefsi.fields import nonnegative, positive, real
 from tubefsi.walls import HyperelasticWall, ThickWall, ThinWall
 
@@ -55,7 +56,7 @@ class Yeoh(LimitPoint, HyperelasticWall):
     def _asymptote(self, tb, theory):
         if self.c2 != 0 or self.c3 != 0 or theory == "reference":
             return math.inf
-        return 2.0 * self.c1 * (tb if theory == "current" else math.log1p(tb))
+        return 2.0 * self.c1 * (tb if theory == "current" else np.log1p(tb))
 
     def _asymptotic_decay(self, tb, theory):
         return 5.0

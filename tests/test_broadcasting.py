@@ -1,0 +1,125 @@
+"""Every parameter an array: models, tube fields, outlet pressure and load broadcast together.
+
+The reference for every broadcast result is the loop of scalar solves it replaces (an
+independent call per entry): a broadcast solve must equal them entry by entry.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import tubefsi
+from tubefsi.registry import rheologies, walls
+
+TUBE = tubefsi.Tube(radius=1e-4, thickness=3e-5, length=1e-2)
+
+
+def _pl(m, n):
+    return rheologies["power-law"](consistency=m, index=n)
+
+
+@settings(deadline=None, max_examples=15)
+@given(st.lists(st.tuples(st.floats(1e3, 1e4), st.floats(0.01, 0.05), st.floats(0.5, 1.5),
+                          st.floats(5e-5, 3e-4), st.floats(0.05, 1.0), st.floats(5e-3, 5e-2), st.floats(0.05, 0.9)),
+                min_size=1, max_size=6),
+       st.sampled_from(["thick-neo-hookean", "thin-neo-hookean", "thick-linear"]))
+def test_broadcast_solve_equals_the_loop_of_scalar_solves(rows, wall_name):
+    mu, m, n, a, tb, L, frac = (np.array(c) for c in zip(*rows))
+    cls = walls[wall_name]
+    wall = cls(shear_modulus=mu) if "linear" not in wall_name else cls(youngs_modulus=3 * mu, poisson_ratio=0.5)
+    tube = tubefsi.Tube(radius=a, thickness=tb * a, length=L)
+    fluid = _pl(m, n)
+    # a flow rate below any maximum flow rate: a fraction of the rigid-tube flow at 0.3 mu t/a
+    q = frac * fluid.flow_rate(a, 0.3 * mu * tb / L)
+    together = tubefsi.solve(fluid, wall, tube, flow_rate=q)
+    assert together.pressure_drop.shape == (len(rows),)
+    for i in range(len(rows)):
+        w = cls(shear_modulus=mu[i]) if "linear" not in wall_name else cls(youngs_modulus=3 * mu[i], poisson_ratio=0.5)
+        one = tubefsi.solve(_pl(m[i], n[i]), w, tubefsi.Tube(radius=a[i], thickness=tb[i] * a[i], length=L[i]),
+                            flow_rate=q[i])
+        assert isinstance(one.pressure_drop, float)
+        assert together.pressure_drop[i] == pytest.approx(one.pressure_drop, rel=1e-13, abs=0)
+        assert together.inlet_displacement[i] == pytest.approx(one.inlet_displacement, rel=1e-13, abs=0)
+    back = tubefsi.solve(fluid, wall, tube, pressure_drop=together.pressure_drop)
+    np.testing.assert_allclose(back.flow_rate, q, rtol=1e-12, atol=0)
+
+
+def test_shapes_broadcast_like_numpy():
+    wall = walls["thick-neo-hookean"](shear_modulus=np.array([1e3, 2e3, 4e3]))          # (3,)
+    tube = tubefsi.Tube(radius=np.array([[1e-4], [2e-4]]), thickness=3e-5, length=1e-2)  # (2, 1)
+    sol = tubefsi.solve(_pl(0.017, 0.7), wall, tube, flow_rate=1e-10)
+    assert sol.pressure_drop.shape == (2, 3)
+    for i, a in enumerate([1e-4, 2e-4]):
+        for j, mu in enumerate([1e3, 2e3, 4e3]):
+            ref = tubefsi.solve(_pl(0.017, 0.7), walls["thick-neo-hookean"](shear_modulus=mu),
+                                tubefsi.Tube(radius=a, thickness=3e-5, length=1e-2), flow_rate=1e-10)
+            assert sol.pressure_drop[i, j] == pytest.approx(ref.pressure_drop, rel=1e-13)
+    # profiles broadcast z against the solution's shape
+    p = sol.pressure(np.array([0.0, 5e-3, 1e-2])[:, None, None])
+    assert p.shape == (3, 2, 3)
+    np.testing.assert_allclose(p[0], sol.inlet_pressure, rtol=1e-12)
+    np.testing.assert_array_equal(p[2], 0.0)
+
+
+def test_outlet_pressure_array():
+    wall = walls["thick-neo-hookean"](shear_modulus=2e3)
+    p_out = np.array([0.0, 50.0, 200.0])
+    sol = tubefsi.solve(_pl(0.017, 0.7), wall, TUBE, flow_rate=1e-10, outlet_pressure=p_out)
+    for i, p in enumerate(p_out):
+        ref = tubefsi.solve(_pl(0.017, 0.7), wall, TUBE, flow_rate=1e-10, outlet_pressure=float(p))
+        assert sol.pressure_drop[i] == pytest.approx(ref.pressure_drop, rel=1e-13)
+
+
+def test_scalars_in_give_floats_out():
+    sol = tubefsi.solve(_pl(0.017, 0.7), walls["thick-neo-hookean"](shear_modulus=2e3), TUBE, flow_rate=1e-9)
+    for name in ("pressure_drop", "flow_rate", "inlet_pressure", "inlet_displacement", "inlet_radius"):
+        assert isinstance(getattr(sol, name), float), name
+    assert isinstance(sol.pressure(1e-3), float)
+    assert isinstance(walls["thick-neo-hookean"](shear_modulus=2e3).limit_pressure(0.3), float)
+
+
+def test_bad_entries_are_named_with_their_index():
+    with pytest.raises(tubefsi.InvalidParameterError, match=r"shear_modulus.*entry \(1,\)"):
+        walls["thick-neo-hookean"](shear_modulus=np.array([1e3, -1.0, 2e3]))
+    with pytest.raises(tubefsi.InvalidParameterError, match=r"radius.*entry \(0, 1\)"):
+        tubefsi.Tube(radius=np.array([[1e-4, np.nan]]), thickness=3e-5, length=1e-2)
+    with pytest.raises(tubefsi.InvalidParameterError, match="index"):
+        rheologies["power-law"](consistency=0.01, index=np.array([0.5, 0.0]))
+    with pytest.raises(tubefsi.InvalidParameterError, match="shear_modulus"):
+        walls["thick-neo-hookean"](shear_modulus=np.array([1e3 + 1j]))
+    with pytest.raises(tubefsi.InvalidParameterError, match="outlet_pressure"):
+        tubefsi.solve(_pl(0.01, 0.7), "rigid", TUBE, flow_rate=1e-9, outlet_pressure=np.array([0.0, -1.0]))
+
+
+def test_infeasible_points_are_nan_on_request():
+    wall = walls["thick-neo-hookean"](shear_modulus=np.array([2e3, 4e3, 8e3]))
+    fluid = _pl(0.017, 0.7)
+    q_max = tubefsi.max_flow_rate(fluid, wall, TUBE)
+    assert q_max.shape == (3,)
+    q = 1.2 * q_max[0]                              # beyond the softest tube's maximum only
+    with pytest.raises(tubefsi.NoSteadyStateError) as info:
+        tubefsi.solve(fluid, wall, TUBE, flow_rate=q)
+    assert info.value.limit == pytest.approx(q_max[0])
+    sol = tubefsi.solve(fluid, wall, TUBE, flow_rate=q, on_infeasible="nan")
+    np.testing.assert_array_equal(sol.feasible, [False, True, True])
+    assert np.isnan(sol.pressure_drop[0]) and np.all(np.isfinite(sol.pressure_drop[1:]))
+    for i in (1, 2):
+        ref = tubefsi.solve(fluid, walls["thick-neo-hookean"](shear_modulus=float(wall.shear_modulus[i])), TUBE,
+                            flow_rate=q)
+        assert sol.pressure_drop[i] == pytest.approx(ref.pressure_drop, rel=1e-13)
+    assert np.isnan(sol.pressure(0.0)[0])
+    with pytest.raises(tubefsi.InvalidParameterError, match="on_infeasible"):
+        tubefsi.solve(fluid, wall, TUBE, flow_rate=q, on_infeasible="ignore")
+
+
+def test_walls_that_do_not_broadcast_are_solved_per_parameter_set():
+    """A plugin wall whose hooks are scalar (a first-peak scan per parameter set) still takes arrays."""
+    wall = walls["thick-yeoh"](c1=1e3, c2=np.array([-120.0, 50.0, -120.0]), c3=8.0)
+    fluid = _pl(0.017, 0.7)
+    sol = tubefsi.solve(fluid, wall, TUBE, flow_rate=1e-10)
+    for i, c2 in enumerate([-120.0, 50.0, -120.0]):
+        ref = tubefsi.solve(fluid, walls["thick-yeoh"](c1=1e3, c2=c2, c3=8.0), TUBE, flow_rate=1e-10)
+        assert sol.pressure_drop[i] == pytest.approx(ref.pressure_drop, rel=1e-13)
