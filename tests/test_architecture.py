@@ -131,3 +131,21 @@ def test_sources_compile_without_warnings(path):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         compile(path.read_text(encoding="utf-8"), str(path), "exec")
+
+
+def test_import_is_light_and_public_names_resolve():
+    """``import tubefsi`` loads neither SciPy nor matplotlib (the public names load on first use),
+    and the functions that share a submodule's name stay functions after that submodule loads."""
+    import subprocess
+    import sys
+
+    code = ("import sys, tubefsi\n"
+            "assert not any(m.split('.')[0] in ('scipy', 'matplotlib') for m in sys.modules), "
+            "sorted(m for m in sys.modules if m.startswith(('scipy', 'matplotlib')))[:5]\n"
+            "import importlib, types\n"
+            "for name in ('solve', 'advise', 'fit'):\n"
+            "    importlib.import_module('tubefsi.' + name)\n"
+            "    assert isinstance(getattr(tubefsi, name), types.FunctionType), name\n"
+            "assert tubefsi.Tube.__name__ == 'Tube' and callable(tubefsi.max_flow_rate)\n"
+            "assert set(tubefsi.__all__) <= set(dir(tubefsi))\n")
+    subprocess.run([sys.executable, "-c", code], check=True)

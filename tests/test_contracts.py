@@ -11,8 +11,8 @@ included) lists ``_examples`` covers them all.
 import pytest
 
 from tubefsi import registry
-from tubefsi.testing import (CouplerContract, HyperelasticWallContract, RheologyContract, WallContract,
-                             coupler_cases, examples)
+from tubefsi.testing import (AccuracyContract, CouplerContract, HyperelasticWallContract, RheologyContract,
+                             WallContract, accuracy_cases, coupler_cases, examples)
 from tubefsi.walls import HyperelasticWall
 
 BUILTIN = "tubefsi"     # the distribution that registers tubefsi's own models
@@ -55,5 +55,17 @@ class TestRheologies(RheologyContract):
 
 class TestCouplers(CouplerContract):
     @pytest.fixture(params=coupler_cases(WALLS))
+    def case(self, request):
+        return request.param
+
+
+class TestAccuracy(AccuracyContract):
+    """Every wall with the default fluids (power law, Newtonian); the other fluid examples in a
+    thick (limit-pressure) and a thin reference-thickness (closed-form) wall."""
+
+    @pytest.fixture(params=accuracy_cases(WALLS) + accuracy_cases(
+        [examples("walls", "thick-neo-hookean")[0], examples("walls", "thin-mooney-rivlin")[0]],
+        [f for f in RHEOLOGIES if f not in (examples("rheologies", "power-law")[0],
+                                            examples("rheologies", "newtonian")[0])]))
     def case(self, request):
         return request.param

@@ -14,15 +14,16 @@ The package is layered, lowest first (``docs/architecture.md``):
 ``scene``; ``couplers``; ``solution``; ``solve``; then ``advise``, ``fit``, ``dimensionless``,
 ``chapter``, ``plotting``, ``cli`` and ``testing``. A module imports only from its own layer
 or below (``tests/test_architecture.py``).
+
+``import tubefsi`` is light: the public names below are loaded on first use (PEP 562), so a
+script that only needs the errors or the registry does not pay for SciPy.
 """
 
-from . import dimensionless, fields, registry
-from .advise import Advice, Diagnostics, ModelValidityWarning, advise
+import importlib
+import sys
+import types
+
 from .errors import AccuracyWarning, ConvergenceError, InvalidParameterError, NoSteadyStateError, TubefsiError
-from .fit import FitResult, fit
-from .geometry import Tube
-from .solution import Solution
-from .solve import max_flow_rate, select_coupler, solve
 
 __all__ = [
     "dimensionless", "fields", "Tube", "solve", "max_flow_rate", "select_coupler", "Solution", "registry",
@@ -31,3 +32,44 @@ __all__ = [
 ]
 
 __version__ = "0.1.0"
+
+#: public name -> the module that defines it (``None``: the name is a submodule)
+_LAZY = {
+    "dimensionless": None, "fields": None, "registry": None,
+    "Tube": "geometry", "Solution": "solution",
+    "solve": "solve", "max_flow_rate": "solve", "select_coupler": "solve",
+    "advise": "advise", "Advice": "advise", "Diagnostics": "advise", "ModelValidityWarning": "advise",
+    "fit": "fit", "FitResult": "fit",
+}
+
+
+def __getattr__(name):
+    if name not in _LAZY:
+        raise AttributeError(f"module 'tubefsi' has no attribute {name!r}")
+    where = _LAZY[name]
+    if where is None:
+        value = importlib.import_module(f".{name}", __name__)
+    else:
+        value = getattr(importlib.import_module(f".{where}", __name__), name)
+    globals()[name] = value          # the next access is a plain attribute
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_LAZY))
+
+
+#: submodules that share their name with the function they define: the package attribute is the function
+_FUNCTIONS = ("solve", "advise", "fit")
+
+
+class _Package(types.ModuleType):
+    def __setattr__(self, name, value):
+        # importing the submodule ``tubefsi.solve`` sets the package attribute ``solve`` to that
+        # module; keep the public function there instead, as an eager import would
+        if name in _FUNCTIONS and isinstance(value, types.ModuleType):
+            value = getattr(value, name)
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package

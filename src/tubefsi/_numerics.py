@@ -240,6 +240,8 @@ def solve_increasing(F, dF, target, *, guess, upper=None, xmax=np.inf, maxiter=2
 
 def as_output(value, scalar: bool):
     """Return a Python float for scalar input, else an ndarray."""
+    if type(value) is float:
+        return value if scalar else np.asarray(value)
     a = np.asarray(value, dtype=float)
     if scalar and a.ndim == 0:
         return float(a)

@@ -151,6 +151,10 @@ class Registry(Mapping):
         self._entries = None
         self._origin = {}
         self._pending = {}
+        self.generation += 1
+
+    #: Incremented by :meth:`refresh`: lets callers cache what they derived from the registry.
+    generation = 0
 
     def __repr__(self) -> str:
         return f"Registry({self.group!r}: {', '.join(self)})"

@@ -104,6 +104,17 @@ class Scene:
             v_max = np.log(np.asarray(lam_max, dtype=float) / (1.0 + np.asarray(strain)))
         object.__setattr__(self, "log_stretch_max", float(v_max) if v_max.ndim == 0 else v_max)
 
+    @classmethod
+    def _trusted(cls, rheology, wall, tube, log_stretch_max) -> Scene:
+        """A scene of scalars with an unloaded outlet, from already validated models (the scalar
+        fast path of :func:`tubefsi.solve`)."""
+        new = object.__new__(cls)
+        for name, value in (("rheology", rheology), ("wall", wall), ("tube", tube), ("outlet_pressure", 0.0),
+                            ("shape", ()), ("outlet_strain", 0.0), ("outlet_stretch", 1.0),
+                            ("log_stretch_max", log_stretch_max)):
+            object.__setattr__(new, name, value)
+        return new
+
     @property
     def tb(self):
         """The reduced thickness t/a of the tube."""

@@ -103,21 +103,63 @@ class Solution:
             bad = zz > length
             raise InvalidParameterError("z", f"[0, L] (m), L = {np.max(np.asarray(length)):g}", float(zz[bad].flat[0]))
         n = int(np.prod(shape, dtype=int))
+        zf = zz.ravel()
+        strain, rise = np.full(n, np.nan), np.full(n, np.nan)
+        fields, parts = self._parts(shape)
+        for idx, chunk, sub in parts:
+            e, r = self.coupler.profile(chunk, sub, zf[idx])
+            strain[idx], rise[idx] = np.broadcast_to(e, idx.shape), np.broadcast_to(r, idx.shape)
+        return strain.reshape(shape), rise.reshape(shape), fields["flow_rate"].reshape(shape)
+
+    def _parts(self, shape):
+        """The state broadcast to ``shape`` and flattened (a dict), and an iterator over
+        ``(positions, flat scene, state)`` for its feasible points, in chunks of bounded memory
+        and one parameter set per chunk where a model needs it (:meth:`Scene.split`)."""
+        st = self.state
         flat = self.scene.flat(shape) if self.scene.shape != () else self.scene
         fields = {f.name: np.broadcast_to(np.asarray(getattr(st, f.name), dtype=float), shape).ravel()
                   for f in attrs.fields(State)}
-        zf = zz.ravel()
-        strain, rise = np.full(n, np.nan), np.full(n, np.nan)
         ok = np.flatnonzero(np.isfinite(fields["flow_rate"]))
-        for index, part in flat.split(ok):
-            for start in range(0, index.size, _CHUNK):
-                idx = index[start:start + _CHUNK]
-                chunk = part if part.size == 1 or idx.size == index.size else \
-                    part.take(np.arange(start, start + idx.size))
-                sub = State(**{k: v[idx] for k, v in fields.items()})
-                e, r = self.coupler.profile(chunk, sub, zf[idx])
-                strain[idx], rise[idx] = np.broadcast_to(e, idx.shape), np.broadcast_to(r, idx.shape)
-        return strain.reshape(shape), rise.reshape(shape), fields["flow_rate"].reshape(shape)
+
+        def parts():
+            for index, part in flat.split(ok):
+                for start in range(0, index.size, _CHUNK):
+                    idx = index[start:start + _CHUNK]
+                    chunk = part if part.size == 1 or idx.size == index.size else \
+                        part.take(np.arange(start, start + idx.size))
+                    yield idx, chunk, State(**{k: v[idx] for k, v in fields.items()})
+
+        return fields, parts()
+
+    # ------------------------------------------------------------------ sensitivities
+    def _sensitivities(self):
+        """The coupler's three derivatives per point, in the loads' shape (NaN where infeasible)."""
+        shape = np.shape(self.state.flow_rate)
+        out = np.full((3, int(np.prod(shape, dtype=int))), np.nan)
+        _, parts = self._parts(shape)
+        for idx, chunk, sub in parts:
+            out[:, idx] = self.coupler.sensitivities(chunk, sub)
+        return [as_output(row.reshape(shape), self.scalar) for row in out]
+
+    @property
+    def dpressure_drop_dflow_rate(self):
+        r""":math:`d\Delta p/dq` at a fixed outlet pressure (Pa s/m^3): :math:`G_{in}K/q`, with
+        :math:`K = \int_0^L \partial\ln G/\partial\ln q\,dz` (``docs/theory.md``, section
+        "Sensitivities"); :math:`L\,\phi'(q)\,\psi(R_{in})` for a separable rheology."""
+        return self._sensitivities()[0]
+
+    @property
+    def dflow_rate_dinlet_pressure(self):
+        r""":math:`\partial q/\partial p_{in}` at a fixed outlet pressure (m^3/(s Pa)):
+        :math:`1/(d\Delta p/dq)`, for pressure-controlled problems and networks."""
+        return self._sensitivities()[1]
+
+    @property
+    def dflow_rate_doutlet_pressure(self):
+        r""":math:`\partial q/\partial p_{out}` at a fixed inlet pressure (m^3/(s Pa)):
+        :math:`-q/(G_{out}K)`, negative; it differs from :math:`-\partial q/\partial p_{in}` because
+        the tube inflates with the outlet pressure."""
+        return self._sensitivities()[2]
 
     def _out(self, value, *arguments):
         return as_output(value, self.scalar and all(np.ndim(a) == 0 for a in arguments))

@@ -8,6 +8,8 @@ loads and returns a :class:`~tubefsi.Solution`.
 
 from __future__ import annotations
 
+import math
+
 import attrs
 import numpy as np
 
@@ -16,10 +18,27 @@ from ._validation import as_load
 from .couplers.base import Coupler
 from .couplers.checked import checked
 from .errors import InvalidParameterError, NoSteadyStateError
-from .scene import State, _resolve, make_scene
+from .couplers.separated import _TABLES
+from .geometry import Tube
+from .rheology.base import Rheology
+from .scene import Scene, State, _resolve, make_scene
 from .solution import Solution
+from .walls.base import WallModel
 
 __all__ = ["solve", "max_flow_rate", "select_coupler"]
+
+
+#: (registry generation, rheology class, wall class) -> the coupler "auto" picks and its name.
+_AUTO: dict = {}
+
+
+def _auto(rheology, wall):
+    key = (registry.couplers.generation, type(rheology), type(wall))
+    found = _AUTO.get(key)
+    if found is None:
+        chosen = select_coupler(rheology, wall)
+        found = _AUTO[key] = (chosen, registry.couplers.name_of(chosen) or type(chosen).__name__)
+    return found
 
 
 def select_coupler(rheology, wall, coupler="auto") -> Coupler:
@@ -83,6 +102,11 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
     NoSteadyStateError
         Beyond the wall's limit pressure or the maximum flow rate (``on_infeasible="raise"``).
     """
+    if (type(flow_rate) is float and pressure_drop is None and type(coupler) is str and coupler == "auto"
+            and type(outlet_pressure) is float and outlet_pressure == 0.0 and on_infeasible == "raise"):
+        fast = _scalar_flow(rheology, wall, tube, flow_rate)
+        if fast is not None:
+            return fast
     scene = make_scene(rheology, wall, tube, outlet_pressure=outlet_pressure)
     if (flow_rate is None) == (pressure_drop is None):
         raise InvalidParameterError("flow_rate / pressure_drop", "exactly one of the two",
@@ -118,6 +142,56 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
     return Solution(scene=scene, coupler=chosen, state=state, scalar=shape == (),
                     coupler_name=registry.couplers.name_of(chosen) or type(chosen).__name__,
                     feasible=None if np.all(feasible) else feasible.reshape(shape))
+
+
+_SUBCLASS: dict = {}
+
+
+def _is(cls, base) -> bool:
+    """``issubclass``, cached (an ABC's check is slow next to the rest of the scalar path)."""
+    key = (cls, base)
+    found = _SUBCLASS.get(key)
+    if found is None:
+        found = _SUBCLASS[key] = issubclass(cls, base)
+    return found
+
+
+def _scalar_flow(rheology, wall, tube, q):
+    """The lean scalar path: one flow rate through a scene of scalars whose curve table is cached
+    (a Monte Carlo loop over a modulus, a viscosity, the tube's size or the load). None where it
+    does not apply; the general path then answers (and builds the table for the next call)."""
+    if not (_is(type(rheology), Rheology) and _is(type(wall), WallModel) and type(tube) is Tube):
+        return None
+    if not (q > 0.0 and q < math.inf) or wall.is_rigid:
+        return None
+    k = rheology.radius_exponent
+    a, t, L = tube.radius, tube.thickness, tube.length
+    if type(k) is not float or type(a) is not float or type(t) is not float or type(L) is not float:
+        return None
+    try:
+        table = _TABLES.get((type(wall), wall._shape_key(), t / a, k))
+    except TypeError:                          # an array parameter in the wall's shape
+        return None
+    if not table:
+        return None
+    scale = wall._pressure_scale()
+    if type(scale) is not float:
+        return None
+    phi = rheology._flow_factor(q)
+    if type(phi) is not float or not rheology.separable:
+        return None
+    x = math.log(L * phi / (a**k * scale))
+    if not table.x_lo <= x <= table.x_hi:
+        return None
+    y = table.inverse.scalar(x)
+    v = math.exp(y)
+    strain = math.expm1(v)
+    drop = scale * math.exp(table.pressure.scalar(y))
+    chosen, name = _auto(rheology, wall)
+    lam_max = wall._max_stretch(t / a)
+    scene = Scene._trusted(rheology, wall, tube, math.log(lam_max) if type(lam_max) is float else
+                           float(np.log(lam_max)))
+    return Solution(scene=scene, coupler=chosen, state=State(q, drop, strain, v), scalar=True, coupler_name=name)
 
 
 #: Points per coupler call: bounds the working memory (a few tens of MB) of any sweep.

@@ -9,7 +9,8 @@ import math
 import pytest
 import tubefsi
 from tubefsi import registry
-from tubefsi.testing import CouplerContract, HyperelasticWallContract, coupler_cases, examples
+from tubefsi.testing import (AccuracyContract, CouplerContract, HyperelasticWallContract, accuracy_cases,
+                             coupler_cases, examples)
 
 NAMES = ["thin-gent", "thick-gent", "thin-fung", "thick-fung", "thin-ogden", "thick-ogden", "thin-yeoh", "thick-yeoh"]
 WALLS = [wall for name in NAMES for wall in examples("walls", name)]
@@ -29,6 +30,12 @@ class TestWalls(HyperelasticWallContract):      # includes every WallContract te
 
 class TestCouplers(CouplerContract):
     @pytest.fixture(params=coupler_cases(WALLS))
+    def case(self, request):
+        return request.param
+
+
+class TestAccuracy(AccuracyContract):          # the default answers against the brute force
+    @pytest.fixture(params=accuracy_cases(WALLS))
     def case(self, request):
         return request.param
 

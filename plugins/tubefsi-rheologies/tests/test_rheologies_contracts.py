@@ -9,7 +9,7 @@ import pytest
 import tubefsi
 from tubefsi import registry
 from tubefsi.couplers import Quadrature
-from tubefsi.testing import CouplerContract, RheologyContract, examples
+from tubefsi.testing import AccuracyContract, CouplerContract, RheologyContract, examples
 
 NAMES = ["carreau", "carreau-yasuda", "cross", "ellis", "bingham", "casson", "herschel-bulkley"]
 FLUIDS = [fluid for name in NAMES for fluid in examples("rheologies", name)]
@@ -42,6 +42,12 @@ def _cases():
 
 class TestCouplers(CouplerContract):
     @pytest.fixture(params=_cases())
+    def case(self, request):
+        return request.param
+
+
+class TestAccuracy(AccuracyContract):          # the default answers against the brute force
+    @pytest.fixture(params=_cases())           # (its coupler is ignored: the default path is checked)
     def case(self, request):
         return request.param
 

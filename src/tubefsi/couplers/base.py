@@ -15,7 +15,9 @@ hook                                           returns
 ``profile(scene, state, z)``                   the hoop strain and pressure rise at positions z
 =============================================  ===================================================
 
-and the class attributes ``cost_rank`` (lower is cheaper; ``coupler="auto"`` takes the
+and, optionally, ``index_integral(scene, state)`` (:math:`K = \int_0^L k\,dz`, the flow index
+along the tube, from which :meth:`Coupler.sensitivities` builds the derivatives of a solve;
+the default integrates it over the coupler's own profile). Class attributes ``cost_rank`` (lower is cheaper; ``coupler="auto"`` takes the
 cheapest that supports the pair) and ``meets_accuracy_contract`` (whether ``auto`` may pick
 it). A coupler that can estimate its own error by solving again at a finer setting returns
 that finer version from :meth:`Coupler.refined`; :class:`~tubefsi.couplers.Checked` then
@@ -29,7 +31,12 @@ or implement the interface from scratch.
 from __future__ import annotations
 
 import abc
+import math
 from typing import ClassVar
+
+import numpy as np
+
+from .._quadrature import adaptive, warn_unconverged
 
 __all__ = ["Coupler"]
 
@@ -74,6 +81,71 @@ class Coupler(abc.ABC):
         ``strain`` is the hoop strain :math:`\lambda(z) - 1` (never formed by subtraction) and
         ``pressure_rise`` is :math:`p(z) - p_{out}`.
         """
+
+    def index_integral(self, scene, state):
+        r""":math:`K = \int_0^L k(q, R(z))\,dz` per point of a flat scene (m), :math:`k` the flow
+        index :math:`\partial\ln G/\partial\ln q` (``docs/theory.md``, section "Sensitivities").
+
+        The default integrates :math:`k` over this coupler's :meth:`profile` by adaptive
+        Gauss–Kronrod quadrature in :math:`z` (relative tolerance 1e-12, a warning otherwise);
+        couplers with a cheaper form override it. Points with ``q = 0`` are not asked for.
+        """
+        q = np.asarray(state.flow_rate, dtype=float)
+        n = q.size
+        length = np.broadcast_to(np.asarray(scene.tube.length, dtype=float), (n,))
+        radius = np.broadcast_to(np.asarray(scene.tube.radius, dtype=float), (n,))
+        fields = {name: np.broadcast_to(np.asarray(getattr(state, name), dtype=float), (n,))
+                  for name in ("flow_rate", "pressure_drop", "inlet_strain", "log_stretch")}
+        kind = type(state)
+
+        def f(z, idx):
+            rows = np.repeat(idx, z.shape[1])
+            part = scene.take(rows) if scene.size != 1 else scene
+            strain, _ = self.profile(part, kind(**{k: v[rows] for k, v in fields.items()}), z.ravel())
+            r = radius[rows] * (1.0 + np.asarray(strain))
+            return np.asarray(scene.rheology._flow_index(fields["flow_rate"][rows], r)).reshape(z.shape)
+
+        result = adaptive(f, np.zeros(n), length, rtol=1e-12)
+        if not np.all(result.converged):
+            warn_unconverged("the flow-index integral of the sensitivities", result)
+        return result.value
+
+    def sensitivities(self, scene, state):
+        r"""The derivatives of a solve at each point of a flat scene: ``(dpressure_drop_dflow_rate,
+        dflow_rate_dinlet_pressure, dflow_rate_doutlet_pressure)``.
+
+        With :math:`F(q, p_{in}, p_{out}) = \int_{p_{out}}^{p_{in}} dp/G(q, R(p)) - L = 0` and
+        :math:`\partial_q F = -K/q` (:meth:`index_integral`):
+        :math:`d\Delta p/dq = G_{in} K/q`, :math:`\partial q/\partial p_{in} = q/(G_{in}K)`,
+        :math:`\partial q/\partial p_{out} = -q/(G_{out}K)`, :math:`G_{in}, G_{out}` the pressure
+        gradients at the ends. At ``q = 0`` the limit :math:`q \to 0^+` (the tube uniform).
+        """
+        q = np.asarray(state.flow_rate, dtype=float).ravel()
+        n = q.size
+        rheo = scene.rheology
+        a = np.broadcast_to(np.asarray(scene.tube.radius, dtype=float), (n,))
+        length = np.broadcast_to(np.asarray(scene.tube.length, dtype=float), (n,))
+        r_out = a * np.broadcast_to(np.asarray(scene.outlet_stretch, dtype=float), (n,))
+        r_in = a * (1.0 + np.broadcast_to(np.asarray(state.inlet_strain, dtype=float), (n,)))
+        flowing = q > 0
+        k_int = np.empty(n)
+        if np.any(flowing):
+            live = np.flatnonzero(flowing)
+            part = scene if live.size == n else scene.take(live)
+            sub = type(state)(**{name: np.broadcast_to(np.asarray(getattr(state, name), dtype=float), (n,))[live]
+                                 for name in ("flow_rate", "pressure_drop", "inlet_strain", "log_stretch")})
+            k_int[live] = self.index_integral(part, sub)
+        # q = 0: the tube is uniform at the outlet radius; the limit at an apparent shear rate 1e-30/s
+        q_use = np.where(flowing, q, 0.25e-30 * math.pi * r_out**3)
+        r_in = np.where(flowing, r_in, r_out)
+        if not np.all(flowing):
+            still = ~flowing
+            k_int[still] = length[still] * rheo._flow_index(q_use[still], r_out[still])
+        g_in = rheo._pressure_gradient(q_use, r_in)
+        g_out = rheo._pressure_gradient(q_use, r_out)
+        with np.errstate(divide="ignore", over="ignore"):
+            slope = g_in * (k_int / q_use)
+            return slope, q_use / (g_in * k_int), -q_use / (g_out * k_int)
 
     def refined(self) -> Coupler | None:
         """A finer version of this coupler for an a-posteriori error check, or None (no check).

@@ -44,6 +44,7 @@ from .._numerics import EPS, integrate_graded, solve_increasing
 from .._quadrature import adaptive_to_pole, quiet, warn_unconverged
 from ..errors import NoSteadyStateError
 from ..scene import Points, Scene, State
+from ._tables import SeparatedTable, fit_chebyshev
 from .base import Coupler
 
 __all__ = ["SeparatedVariables", "MAX_LOG_STRETCH"]
@@ -198,11 +199,55 @@ class SeparatedVariables(Coupler):
             return _rigid_state(scene, flow_rate=q)
         index = np.arange(q.size)
         pts = scene.at(index)
-        v, ok = self.solve_log_stretch(scene, np.where(q == 0, 0.0, self.target(pts, q)), index, q)
-        if not np.all(ok):
-            self._raise_runaway(scene, q, ok)
-        dp = self.pressure_rise(scene, v, index)
+        target = np.where(q == 0, 0.0, self.target(pts, q))
+        v = np.zeros(q.shape)
+        dp = np.full(q.shape, np.nan)
+        direct = target > 0
+        table = self._table(scene, build=q.size >= _TABLE_MIN_POINTS or _seen_again(scene))
+        if table is not None:                # the points whose target the table serves
+            with np.errstate(divide="ignore"):
+                x = np.log(target / table.norm)
+            served = direct & (x >= table.x_lo) & (x <= table.x_hi)
+            if np.any(served):
+                y = table.inverse(x[served])
+                v[served] = np.exp(y)
+                dp[served] = table.rise(y, v[served])
+                direct &= ~served
+        if np.any(direct):
+            sub = np.flatnonzero(direct)
+            v_d, ok = self.solve_log_stretch(scene, target[sub], sub, q[sub])
+            if not np.all(ok):
+                self._raise_runaway(scene, q[sub], ok, sub)
+            v[sub] = v_d
+            dp[sub] = self.pressure_rise(scene, v_d, sub)
+        dp[target == 0] = 0.0
         return State(q, dp, self.strain_at(pts, v) + 0.0 * v, v)
+
+    # --------------------------------------------------------------- tables
+    def _table(self, scene: Scene, build=True):
+        """The :class:`~tubefsi.couplers._tables.SeparatedTable` of a scene of shared quantities, a
+        power-law fluid and an unloaded outlet (cached per wall shape, t/a and n), or None
+        (``build=False``: only if already cached)."""
+        rheo, wall = scene.rheology, scene.wall
+        if (scene.size != 1 or rheo.radius_exponent is None or not rheo.separable
+                or np.ndim(scene.outlet_pressure) or scene.outlet_pressure != 0.0):
+            return None
+        try:
+            key = (type(wall), wall._shape_key(), float(scene.tb), float(rheo.radius_exponent))
+            hash(key)
+        except TypeError:
+            return None
+        cached = _TABLES.get(key)
+        if cached is None and not build:
+            return None
+        if cached is None:
+            with quiet():
+                cached = _TABLES[key] = _build_table(self, scene)
+            while len(_TABLES) > 128:
+                _TABLES.pop(next(iter(_TABLES)))
+        if cached is False:
+            return None
+        return cached.for_scene(scene)
 
     def solve_log_stretch(self, scene: Scene, target, index, q=None, upper=None, *, check=True):
         r"""Log-stretch :math:`v` with :math:`J(v; q) = ` ``target`` at the points ``index``;
@@ -281,13 +326,39 @@ class SeparatedVariables(Coupler):
         pts = scene.at(index)
         p_in = pts.outlet_pressure + dp
         pts.wall._check_pressure(p_in, pts.tb)
-        v = self._inlet_log_stretch(scene, dp, index)
+        v = np.zeros(dp.shape)
+        q = np.zeros(dp.shape)
+        direct = dp > 0
+        table = self._table(scene, build=dp.size >= _TABLE_MIN_POINTS or _seen_again(scene))
+        if table is not None and table.table.pressure_inverse is not None:
+            with np.errstate(divide="ignore"):
+                w = np.log(dp / table.scale)
+            inv = table.table.pressure_inverse
+            served = direct & (w >= inv.lo) & (w <= inv.hi)
+            if np.any(served):
+                y = inv(w[served])
+                x = table.table.forward(y)
+                v[served] = np.exp(y)
+                q[served] = scene.rheology._flow_factor_inverse(np.exp(x) * table.norm / pts.length)
+                direct &= ~served
+        if np.any(direct):
+            sub = np.flatnonzero(direct)
+            v[sub] = self._inlet_log_stretch(scene, dp[sub], sub)
+            sp = scene.at(sub)
+            if scene.rheology.separable:
+                j = np.full(sub.size, np.nan)
+                if table is not None:          # the forward table gives J at the inlet stretch
+                    with np.errstate(divide="ignore"):
+                        y = np.log(v[sub])
+                    inside = (y >= table.table.y_lo) & (y <= table.table.y_hi)
+                    j[inside] = np.exp(table.table.forward(y[inside])) * table.norm
+                rest = np.isnan(j)
+                if np.any(rest):
+                    j[rest] = self._J(scene, v[sub][rest], sub[rest])
+                q[sub] = sp.rheology._flow_factor_inverse(j / sp.length)
+            else:
+                q[sub] = self._solve_flow_rate(scene, v[sub], dp[sub], sub)
         e_in = self.strain_at(pts, v) + 0.0 * v
-        if scene.rheology.separable:
-            q = pts.rheology._flow_factor_inverse(self._J(scene, v, index) / pts.length)
-        else:
-            q = self._solve_flow_rate(scene, v, dp, index)
-        q = np.where(dp == 0, 0.0, q)
         return State(q, dp, e_in, v)
 
     def _inlet_log_stretch(self, scene, dp, index):
@@ -382,14 +453,61 @@ class SeparatedVariables(Coupler):
             return np.zeros(q.shape) + pts.outlet_strain, (L - z) * gradient
         frac = (L - z) / L
         target = np.where(q == 0, 0.0, frac * self.target(pts, q))
-        v, _ = self.solve_log_stretch(scene, target, index, q, upper=v_in * (1 + 1e-12) + 1e-300)
-        v = np.where(frac == 1.0, v_in, v)
-        return self.strain_at(pts, v) + 0.0 * v, self.pressure_rise(scene, v, index)
+        v = np.where(frac == 1.0, v_in, 0.0)
+        rise = np.full(q.shape, np.nan)
+        direct = (target > 0) & (frac < 1.0)
+        table = self._table(scene, build=q.size >= _TABLE_MIN_POINTS)
+        if table is not None:
+            with np.errstate(divide="ignore"):
+                x = np.log(target / table.norm)
+            served = direct & (x >= table.x_lo) & (x <= table.x_hi)
+            if np.any(served):
+                y = table.inverse(x[served])
+                v[served] = np.minimum(np.exp(y), v_in[served] if np.ndim(v_in) else v_in)
+                rise[served] = table.rise(y, v[served])
+                direct &= ~served
+        if np.any(direct):
+            sub = np.flatnonzero(direct)
+            upper = (v_in[sub] if np.ndim(v_in) else v_in) * (1 + 1e-12) + 1e-300
+            v[sub], _ = self.solve_log_stretch(scene, target[sub], sub, _pick(q, sub) if np.ndim(q) else q,
+                                               upper=upper)
+            rise[sub] = self.pressure_rise(scene, v[sub], sub)
+        rest = np.isnan(rise)
+        if np.any(rest):                     # the inlet itself and zero flow
+            sub = np.flatnonzero(rest)
+            rise[sub] = self.pressure_rise(scene, v[sub], sub)
+        return self.strain_at(pts, v) + 0.0 * v, rise
+
+    def index_integral(self, scene: Scene, state: State):
+        r""":math:`K = \int_0^L k\,dz`: :math:`kL` for a separable rheology (:math:`k` does not depend
+        on R) or a rigid wall; otherwise, with :math:`dz = -sP'(s)/G\,du`, the separated integral
+        weighted by :math:`k(q, as)`, :math:`\int_0^{v_{in}} k\,sP'(s)/G(q, as)\,du` (same
+        adaptive, error-controlled quadrature as :math:`H`)."""
+        q = np.asarray(state.flow_rate, dtype=float)
+        index = np.arange(q.size)
+        pts = scene.at(index)
+        rheo = pts.rheology
+        if rheo.separable or scene.wall.is_rigid:
+            return pts.length * rheo._flow_index(q, pts.radius * pts.outlet_stretch) + 0.0 * q
+        v_in = np.asarray(state.log_stretch, dtype=float) + 0.0 * q
+
+        def f(u, i):
+            points = scene.at(index[i], column=True)
+            r = points.radius * self.stretch_at(points, u)
+            qq = np.broadcast_to(q[i, None], np.shape(u))
+            return self.integrand(points, u, qq) * rheo._flow_index(qq, r)
+
+        return self.integrate(scene, f, v_in, index)
 
     def max_flow_rate(self, scene: Scene):
         """Largest flow rate with a steady state at each point of a flat scene (a float for a
         scene of shared quantities; ``inf`` where there is none)."""
         n = scene.size
+        table = self._table(scene, build=False)
+        if table is not None:                    # J(inf) per unit modulus is in the table
+            with np.errstate(over="ignore"):
+                q = scene.rheology._flow_factor_inverse(np.float64(table.table.j_inf) * table.norm / scene.tube.length)
+            return float(q) if np.isfinite(q) else math.inf
         index = np.arange(n)
         pts = scene.at(index)
         limited = np.isfinite(np.asarray(pts.wall._limit_pressure(pts.tb), dtype=float) + np.zeros(n))
@@ -449,10 +567,11 @@ class SeparatedVariables(Coupler):
                 return math.inf
         return math.exp(optimize.brentq(excess, lo, hi, xtol=1e-15, rtol=4 * np.finfo(float).eps))
 
-    def _raise_runaway(self, scene, q, ok):
-        """The NoSteadyStateError of the first point whose solve ran away."""
+    def _raise_runaway(self, scene, q, ok, index=None):
+        """The NoSteadyStateError of the first point whose solve ran away (``index``: the points
+        ``q`` and ``ok`` refer to)."""
         bad = int(np.flatnonzero(~np.asarray(ok).ravel())[0])
-        one = scene.point(bad)
+        one = scene.point(bad if index is None else int(np.asarray(index)[bad]))
         q_max = float(self.max_flow_rate(one))
         q_bad = float(q.ravel()[bad])
         if math.isfinite(q_max) and q_bad >= q_max:
@@ -489,3 +608,113 @@ def _rigid_state(scene: Scene, *, flow_rate=None, pressure_drop=None) -> State:
         q = np.where(dp == 0, 0.0, rheo._flow_rate(a + 0.0 * dp, np.where(dp == 0, 1.0, dp) / L))
     zero = np.zeros_like(q)
     return State(q, dp, zero + scene.outlet_strain, zero)
+
+
+#: Curves at least this long build a table; shorter calls build one when their key comes back.
+_TABLE_MIN_POINTS = 64
+_SEEN: dict = {}
+
+
+def _seen_again(scene) -> bool:
+    """Whether a short call of this table key was made before (a loop of scalar solves): then
+    the table pays for itself."""
+    try:
+        key = (type(scene.wall), scene.wall._shape_key(), float(scene.tb), float(scene.rheology.radius_exponent))
+        count = _SEEN[key] = _SEEN.get(key, 0) + 1
+    except (TypeError, ValueError):
+        return False
+    if len(_SEEN) > 4096:
+        _SEEN.clear()
+    return count >= 2
+#: (wall class, shape key, t/a, radius exponent) -> SeparatedTable, or False where none can be built.
+_TABLES: dict = {}
+
+
+def _newton_inverse(function, slope, grid_values, grid_points, lo, hi):
+    """The inverse of an increasing interpolant on [lo, hi]: linear interpolation on a grid of
+    its values, then Newton steps on the interpolant itself to ~1e-15."""
+    def inverse(value):
+        y = np.interp(value, grid_values, grid_points)
+        for _ in range(8):
+            step = (function(y) - value) / slope(y)
+            y = np.clip(y - step, lo, hi)
+            if np.all(np.abs(step) <= 1e-15 * np.maximum(1.0, np.abs(y))):
+                break
+        return y
+
+    return inverse
+
+
+def _build_table(engine, scene):
+    """Build the table of ``scene`` (shared quantities, power law, unloaded outlet); False if the
+    a-posteriori checks fail (the direct path then serves every point)."""
+    rheo, wall = scene.rheology, scene.wall
+    k = float(rheo.radius_exponent)
+    scale = float(wall._pressure_scale())
+    norm = float(scene.tube.radius) ** k * scale
+    zero = np.zeros(1, dtype=int)
+
+    def j_hat(v):
+        v = np.asarray(v, dtype=float)
+        return engine._J(scene, v, np.zeros(v.size, dtype=int)) / norm
+
+    cap = float(engine._log_stretch_cap(scene, zero))
+    v_lo, v_hi = 1e-9, min(math.log(1e4), 0.999 * cap)
+    y_lo, y_hi = math.log(v_lo), math.log(v_hi)
+    forward, err_f = fit_chebyshev(lambda y: np.log(j_hat(np.exp(y))), y_lo, y_hi, panels=4)
+    if forward is None:
+        return False
+    x_lo, x_hi = float(forward(np.array([y_lo]))[0]), float(forward(np.array([y_hi]))[0])
+    slope = forward.derivative()
+    grid_y = np.linspace(y_lo, y_hi, 2049)
+    grid_x = forward(grid_y)
+
+    inverse_of_forward = _newton_inverse(forward, slope, grid_x, grid_y, y_lo, y_hi)
+
+    inverse, err_i = fit_chebyshev(inverse_of_forward, x_lo, x_hi, panels=4)
+    if inverse is None:
+        return False
+    # a-posteriori check of the whole chain against fresh quadratures at points not tabulated
+    x_check = x_lo + (x_hi - x_lo) * (np.arange(64) + 0.37) / 64
+    y_check = inverse(x_check)
+    miss_x = np.abs(np.log(j_hat(np.exp(y_check))) - x_check)
+    miss_y = miss_x / np.abs(slope(y_check))                   # the error of ln v
+    error = float(max(err_f, err_i, np.max(miss_y)))
+    # the pressure per unit modulus (for the scalar path, and for curves where the wall needs a
+    # quadrature for it; a cheap closed form is evaluated directly on arrays)
+    def log_rise(y):
+        return np.log(wall._pressure_at_strain(np.expm1(np.exp(y)), scene.tb) / scale)
+
+    pressure, err_p = fit_chebyshev(log_rise, y_lo, y_hi, panels=4, tol=5e-14)
+    if pressure is None:
+        return False
+    error = max(error, err_p)
+    # its inverse (the inlet log-stretch of a pressure drop), by Newton on the pressure table
+    p_slope = pressure.derivative()
+    grid_w = pressure(grid_y)
+    # where the pressure saturates (a limit pressure) its inverse is ill-conditioned: serve only
+    # the part where it still rises by more than 1e-3 per unit of ln v (the direct path does the rest)
+    rising = np.flatnonzero((np.diff(grid_w) <= 0) | (p_slope(grid_y[1:]) < 1e-3))
+    top = grid_y[rising[0]] if rising.size else y_hi
+    keep = grid_y <= top
+    grid_y_p, grid_w = grid_y[keep], grid_w[keep]
+    w_lo, w_hi = float(grid_w[0]), float(grid_w[-1])
+
+    inverse_of_pressure = _newton_inverse(pressure, p_slope, grid_w, grid_y_p, y_lo, top)
+
+    pressure_inverse = None
+    if grid_w.size > 16 and np.all(np.diff(grid_w) > 0):
+        pressure_inverse, err_pi = fit_chebyshev(inverse_of_pressure, w_lo, w_hi, panels=4)
+        if pressure_inverse is not None:
+            w_check = w_lo + (w_hi - w_lo) * (np.arange(64) + 0.41) / 64
+            y_check = pressure_inverse(w_check)
+            # the backward error: the answers are exact for pressure drops this close (relative)
+            backward = float(np.max(np.abs(log_rise(y_check) - w_check)))
+            if not (backward <= 1e-13 and err_pi <= 1e-13):
+                pressure_inverse = None
+    if not error <= 1e-13:
+        return False
+    j_inf = float(engine._J_infinity(scene, zero)[0]) / norm
+    return SeparatedTable(forward, inverse, pressure, x_lo=x_lo, x_hi=x_hi, y_lo=y_lo, y_hi=y_hi,
+                          j_inf=j_inf, error=error, k=k, wall_type=type(wall),
+                          tabulate_pressure=wall._pressure_needs_quadrature(), pressure_inverse=pressure_inverse)

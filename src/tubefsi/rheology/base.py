@@ -32,16 +32,13 @@ import math
 from typing import ClassVar
 
 import numpy as np
-from scipy.optimize import elementwise
 
 from .._numerics import as_output
 from .._validation import as_array
 from ..errors import InvalidParameterError
-from ._flow_table import _T, _W, flow_table
+from ._flow_table import check, flow_table, rate_natural_rate, stress_natural_rate, unit_integral
 
 __all__ = ["Rheology"]
-
-_TOL = dict(xrtol=4 * np.finfo(float).eps, xatol=1e-300)
 
 
 def _overrides(obj, name) -> bool:
@@ -60,12 +57,14 @@ class Rheology(abc.ABC):
     ``_stress(shear_rate)``          natural hook, or the inverse of ``_shear_rate`` (a root solve)
     ``_shear_rate(stress)``          natural hook, or the inverse of ``_stress``
     ``_apparent_shear_rate``         ``(wall_stress, excess=None)``: :math:`\Gamma = 4q/(\pi R^3)` by the
-                                     Rabinowitsch–Mooney integral (a fixed rule graded toward zero stress)
+                                     Rabinowitsch–Mooney integral (error-controlled adaptive quadrature)
     ``_flow_rate``                   ``(radius, pressure_gradient)``: :math:`\pi R^3\Gamma(GR/2)/4`
-    ``_pressure_gradient``           ``(flow_rate, radius)``: the inverse, from a cached Chebyshev table of
-                                     :math:`\ln\Gamma`
+    ``_pressure_gradient``           ``(flow_rate, radius)``: the inverse, from a cached, error-checked
+                                     table of :math:`\ln(\tau_w - \tau_y)` against :math:`\ln\Gamma`
     ``_velocity``                    ``(r, radius, pressure_gradient)``:
-                                     :math:`\int_r^R \dot\gamma(G\rho/2)\,d\rho` by quadrature
+                                     :math:`\int_r^R \dot\gamma(G\rho/2)\,d\rho` by adaptive quadrature
+    ``_flow_index``                  ``(flow_rate, radius)``: :math:`\partial\ln G/\partial\ln q`, from the
+                                     wall shear rate (for the sensitivities)
     ``_flow_factor``                 separable rheologies only: :math:`\phi(q)` in :math:`G = \phi(q)\psi(R)`,
     ``_flow_factor_inverse``         its inverse,
     ``_radius_factor``               and :math:`\psi(R)`
@@ -143,13 +142,10 @@ class Rheology(abc.ABC):
         if not _overrides(self, "_shear_rate"):
             raise TypeError(f"{type(self).__name__} must implement _stress or _shear_rate")
         g = np.asarray(shear_rate, dtype=float)
-
-        def f(t, g):
-            return self._shear_rate(t) - g
-
-        lo = np.full_like(g, 1e-300)
-        b = elementwise.bracket_root(f, lo, np.maximum(g, 1.0), xmin=0.0, args=(g,))
-        return elementwise.find_root(f, b.bracket, args=(g,), tolerances=_TOL).x
+        tau_y = float(self.yield_stress)
+        scale = float(np.asarray(self._shear_rate(np.asarray([tau_y + 1.0]))).ravel()[0])
+        guess = tau_y + (g / scale if scale > 0 else g)        # the Newtonian law through tau_y + 1
+        return _solve_increasing(self._shear_rate, g, guess, 0.0, lower=tau_y)
 
     def _shear_rate(self, stress):
         if not _overrides(self, "_stress"):
@@ -157,13 +153,13 @@ class Rheology(abc.ABC):
         t = np.asarray(stress, dtype=float)
         tau_y = float(self.yield_stress)
         flowing = t > tau_y
-        tt = np.where(flowing, t, tau_y + 1.0)
-
-        def f(g, t):
-            return self._stress(g) - t
-
-        b = elementwise.bracket_root(f, np.full_like(tt, 1e-300), np.maximum(tt, 1.0), xmin=0.0, args=(tt,))
-        return np.where(flowing, elementwise.find_root(f, b.bracket, args=(tt,), tolerances=_TOL).x, 0.0)
+        out = np.zeros(t.shape)
+        if np.any(flowing):
+            tt = t[flowing]
+            scale = float(np.asarray(self._stress(np.ones(1))).ravel()[0]) - tau_y
+            guess = (tt - tau_y) / scale if scale > 0 else tt
+            out[flowing] = _solve_increasing(self._stress, tt, guess, tau_y)
+        return out
 
     def _flow_rate(self, radius, pressure_gradient):
         if self.separable:
@@ -181,54 +177,118 @@ class Rheology(abc.ABC):
         cancellation (the flow table passes it): near the yield point the flow depends on it,
         not on :math:`\tau_w`. Overrides must accept it.
 
-        :math:`\Gamma = 4\int_0^1 t^2\dot\gamma(\tau_w t)\,dt` (a fixed rule graded toward t = 0,
-        ``_flow_table.graded_rule``) when the shear rate is natural; else, integrating by parts
-        in the shear rate,
-        :math:`\Gamma = \tfrac43\dot\gamma_w\left[1 - \int_0^1 (\tau(\dot\gamma_w t)/\tau_w)^3 dt\right]`.
-        With a yield stress the first rule runs over the yielded part
-        :math:`\tau_y/\tau_w < t < 1` only (0 when :math:`\tau_w \le \tau_y`). Closed forms
-        (Buckingham–Reiner for Bingham, ...) may override it.
+        :math:`\Gamma = 4\int_0^1 t^2\dot\gamma(\tau_w t)\,dt` when the shear rate is natural;
+        else, integrating by parts in the shear rate,
+        :math:`\Gamma = \tfrac43\dot\gamma_w\int_0^1 \bigl[1 - (\tau(\dot\gamma_w t)/\tau_w)^3\bigr]dt`.
+        With a yield stress the first runs over the yielded part
+        :math:`\tau_y/\tau_w < t < 1` only (0 when :math:`\tau_w \le \tau_y`). Both by adaptive
+        Gauss–Kronrod quadrature graded toward :math:`t = 0`
+        (:func:`tubefsi.rheology._flow_table.unit_integral`), to a relative error estimate of 1e-14
+        per point: a kinked law is resolved by bisection at its kink; a point that misses the
+        tolerance is an ``AccuracyWarning`` stating its estimate. Closed forms (Buckingham–Reiner
+        for Bingham, ...) may override it.
         """
         tau_w = np.asarray(wall_stress, dtype=float)
-        tau_y = float(self.yield_stress)
         if _overrides(self, "_shear_rate"):
-            if tau_y == 0.0:
-                return 4.0 * (self._shear_rate(tau_w[..., None] * _T) * _T * _T) @ _W
-            excess = np.maximum(tau_w - tau_y, 0.0) if excess is None else np.asarray(excess, dtype=float)
-            tau = tau_y + excess[..., None] * _T           # the yielded stresses, tau_y .. tau_w
-            safe_w = np.where(excess > 0, tau_w, 1.0)
-            mean = (self._shear_rate(np.where(excess[..., None] > 0, tau, 2.0 * tau_y + 1.0)) * tau * tau) @ _W
-            return np.where(excess > 0, 4.0 * excess * mean / safe_w**3, 0.0)
-        rate_w = self._shear_rate(tau_w)
-        ratio = self._stress(rate_w[..., None] * _T) / tau_w[..., None]
-        return (4.0 / 3.0) * rate_w * (1.0 - (ratio**3) @ _W)
+            gamma, res = rate_natural_rate(self, tau_w, excess if float(self.yield_stress) > 0 else None)
+        else:
+            flowing = tau_w > float(self.yield_stress)
+            rate_w = np.zeros(tau_w.shape)
+            if np.any(flowing):
+                rate_w[flowing] = self._shear_rate(tau_w[flowing])
+            gamma, res = stress_natural_rate(self, rate_w, tau_w)
+        check("the Rabinowitsch–Mooney integral", res)
+        return gamma
 
     def _pressure_gradient(self, flow_rate, radius):
         r""":math:`G(q, R)`; at ``q = 0`` the limit :math:`q \to 0^+`: 0, or the yield gradient
         :math:`2\tau_y/R` of a yield-stress fluid (non-separable rheologies)."""
         if self.separable:
             return self._flow_factor(flow_rate) * self._radius_factor(radius)
-        return 2.0 * flow_table(self).wall_stress(4.0 * flow_rate / (math.pi * radius**3)) / radius
+        q = np.asarray(flow_rate, dtype=float)
+        r = np.asarray(radius, dtype=float)
+        rate = np.multiply(r, r)                   # 4 q / (pi R^3), in place: few temporaries
+        rate *= r
+        if isinstance(rate, np.ndarray) and rate.ndim and rate.shape == np.broadcast_shapes(q.shape, r.shape):
+            np.divide(q, rate, out=rate)
+        else:
+            rate = q / rate
+        rate *= 4.0 / math.pi
+        out = flow_table(self).wall_stress(rate)
+        out *= 2.0
+        out /= r
+        return out
 
     def _velocity(self, r, radius, pressure_gradient):
         return self._velocity_generic(r, radius, pressure_gradient)
 
     def _velocity_generic(self, r, radius, pressure_gradient):
-        r""":math:`v(r) = \int_r^R \dot\gamma(G\rho/2)\,d\rho` by the same graded rule; for a
-        stress-natural law, by parts: :math:`\frac{2}{G}\big([\tau\dot\gamma] - \int \tau\,d\dot\gamma\big)`."""
-        r, radius, g = (np.asarray(x, dtype=float) for x in (r, radius, pressure_gradient))
+        r""":math:`v(r) = \int_r^R \dot\gamma(G\rho/2)\,d\rho` by adaptive quadrature graded toward
+        the lower end (the plug radius of a yield-stress fluid, where the shear rate behaves as a
+        power of the distance); for a stress-natural law, by parts in the shear rate,
+        :math:`\frac{2}{G}\bigl[\int_{\dot\gamma_r}^{\dot\gamma_w}(\tau_w - \tau(g))\,dg
+        + \dot\gamma_r(\tau_w - \tau_r)\bigr]` (positive terms: no cancellation)."""
+        r, radius, g = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (r, radius, pressure_gradient)))
+        shape = r.shape
+        r, radius, g = r.ravel(), radius.ravel(), g.ravel()
+        out = np.zeros(r.shape)
+        tau_y = float(self.yield_stress)
         if _overrides(self, "_shear_rate"):
-            tau_y = float(self.yield_stress)
-            if tau_y > 0.0:  # integrate over the yielded annulus only: the plug moves rigidly
-                r = np.maximum(r, np.minimum(radius, 2.0 * tau_y / g))
-            rho = r[..., None] + (radius - r)[..., None] * _T
-            return (radius - r) * (self._shear_rate(0.5 * g[..., None] * rho) @ _W)
+            lower = np.maximum(r, np.minimum(radius, 2.0 * tau_y / g)) if tau_y > 0.0 else r
+            width = radius - lower       # the yielded annulus only: the plug moves rigidly
+            live = np.flatnonzero(width > 0)
+            if live.size:
+                lo, wd, kk = lower[live], width[live], 0.5 * g[live]
+
+                def f(u, idx):
+                    return self._shear_rate(_positive(kk[idx, None] * (lo[idx, None] + wd[idx, None] * u)))
+
+                rounding = None
+                if tau_y > 0.0:      # near the plug the law resolves tau - tau_y only to eps tau_y
+                    def rounding(u, idx):
+                        return 4.0 * np.finfo(float).eps * tau_y / _positive(kk[idx, None] * wd[idx, None] * u)
+
+                res = unit_integral(f, live.size, relative_rounding=rounding)
+                out[live] = wd * res.value
+                check("the velocity integral", (res, live))
+            return out.reshape(shape)
         tau_r, tau_w = 0.5 * g * r, 0.5 * g * radius
-        rate_r = np.where(tau_r > 0, self._shear_rate(np.where(tau_r > 0, tau_r, 1.0)), 0.0)
+        live = np.flatnonzero(radius > r)
+        if live.size:
+            tr, tw = tau_r[live], tau_w[live]
+            rate_r = np.zeros(live.size)
+            moving = tr > tau_y
+            if np.any(moving):
+                rate_r[moving] = self._shear_rate(tr[moving])
+            rate_w = self._shear_rate(tw)
+            span = rate_w - rate_r
+
+            def f(u, idx):
+                return tw[idx, None] - self._stress(_positive(rate_r[idx, None] + span[idx, None] * u))
+
+            # tau_w - tau(g) is rounded to a few eps tau_w: near the wall that is all there is of it
+            res = unit_integral(f, live.size, rounding=lambda idx: 4.0 * np.finfo(float).eps * tw[idx])
+            gap = 0.5 * g[live] * (radius[live] - r[live])          # tau_w - tau_r, exactly
+            out[live] = (2.0 / g[live]) * (span * res.value + rate_r * gap)
+            check("the velocity integral", (res, live))
+        return out.reshape(shape)
+
+    def _flow_index(self, flow_rate, radius):
+        r"""The local flow index :math:`k = \partial\ln G/\partial\ln q` at fixed radius (1 for a
+        Newtonian fluid, n for a power law): the sensitivities of a solve are built from it
+        (``docs/theory.md``, section "Sensitivities").
+
+        From the Rabinowitsch–Mooney integral,
+        :math:`d\ln\Gamma/d\ln\tau_w = 4\dot\gamma(\tau_w)/\Gamma - 3`, so
+        :math:`k = \Gamma/(4\dot\gamma_w - 3\Gamma)`; at ``q = 0`` the limit
+        :math:`q \to 0^+` (taken at an apparent shear rate of 1e-30/s)."""
+        q = np.asarray(flow_rate, dtype=float)
+        r = np.asarray(radius, dtype=float)
+        rate = 4.0 * q / (math.pi * r**3)
+        rate = np.where(rate > 0, rate, 1e-30)
+        tau_w = 0.5 * r * self._pressure_gradient(0.25 * math.pi * r**3 * rate, r)
         rate_w = self._shear_rate(tau_w)
-        nodes = rate_r[..., None] + (rate_w - rate_r)[..., None] * _T
-        mean_stress = self._stress(np.maximum(nodes, 1e-300)) @ _W
-        return (2.0 / g) * (tau_w * rate_w - tau_r * rate_r - (rate_w - rate_r) * mean_stress)
+        return rate / (4.0 * rate_w - 3.0 * rate)
 
     # separable rheologies implement these three
     def _flow_factor(self, flow_rate):
@@ -239,6 +299,81 @@ class Rheology(abc.ABC):
 
     def _radius_factor(self, radius):
         raise NotImplementedError
+
+
+def _positive(x):
+    return np.maximum(x, np.finfo(float).tiny)
+
+
+def _solve_increasing(law, target, guess, floor, lower=0.0):
+    r"""``x > lower`` with ``law(x) = target`` elementwise, for an increasing law with
+    ``law(lower+) = floor < target``: a bracket by steps doubling in :math:`\ln(x - lower)` from
+    ``guess``, geometric bisection down to a ratio of 2, then Illinois (regula falsi) steps to a
+    relative width of 4 eps. Vectorized; about a dozen law evaluations per point."""
+    target = np.asarray(target, dtype=float)
+    shape = target.shape
+    t = target.ravel()
+    n = t.size
+    if n == 0:
+        return np.zeros(shape)
+    big, tiny = 1e300, 1e-300
+
+    def f(x, idx=None):
+        with np.errstate(over="ignore", invalid="ignore"):
+            v = np.asarray(law(lower + x), dtype=float) - (t if idx is None else t[idx])
+        return np.where(np.isnan(v), np.inf, v)
+
+    d = np.clip(np.broadcast_to(np.asarray(guess, dtype=float), shape).ravel() - lower, tiny, big)
+    fd = f(d)
+    lo = np.where(fd < 0, d, 0.0)
+    flo = np.where(fd < 0, fd, floor - t)
+    hi = np.where(fd >= 0, d, np.inf)
+    fhi = np.where(fd >= 0, fd, np.inf)
+    for k in range(11):                       # expand: factors e^1, e^2, e^4, ... (up to e^1024)
+        up = np.flatnonzero(~np.isfinite(hi))
+        down = np.flatnonzero((lo == 0.0) & (d > tiny) & np.isfinite(hi))
+        if not up.size and not down.size:
+            break
+        if up.size:
+            with np.errstate(over="ignore"):
+                x = np.minimum(np.maximum(lo[up], d[up]) * math.exp(2.0**k), big)
+            v = f(x, up)
+            below = v < 0
+            lo[up[below]], flo[up[below]] = x[below], v[below]
+            hi[up[~below]], fhi[up[~below]] = x[~below], v[~below]
+            at_top = up[below & (x >= big)]
+            hi[at_top], fhi[at_top] = big, np.inf          # beyond the representable range
+        if down.size:
+            x = np.maximum(np.minimum(hi[down], d[down]) * math.exp(-(2.0**k)), tiny)
+            v = f(x, down)
+            below = v < 0
+            lo[down[below]], flo[down[below]] = x[below], v[below]
+            hi[down[~below]], fhi[down[~below]] = x[~below], v[~below]
+            d[down[~below & (x <= tiny)]] = tiny
+    side = np.zeros(n, dtype=int)             # the end kept last time: -1 low, +1 high (Illinois)
+    for _ in range(200):
+        live = np.flatnonzero((hi - lo > 4.0 * np.finfo(float).eps * hi) & (flo < 0) & (fhi > 0))
+        if not live.size:
+            break
+        a, b, fa, fb = lo[live], hi[live], flo[live], fhi[live]
+        wide = (a <= 0.5 * b) | ~np.isfinite(fb)
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            x = np.where(wide, np.where(a > 0, np.sqrt(a) * np.sqrt(b), 0.5 * b), a - fa * (b - a) / (fb - fa))
+        x = np.where((x > a) & (x < b), x, 0.5 * (a + b))
+        v = f(x, live)
+        below = v < 0
+        hit = v == 0
+        # Illinois: halve the value at the end that stays twice in a row
+        keep_hi = below & (side[live] == 1) & ~wide
+        keep_lo = ~below & (side[live] == -1) & ~wide
+        fhi[live[keep_hi]] *= 0.5
+        flo[live[keep_lo]] *= 0.5
+        lo[live[below]], flo[live[below]] = x[below], v[below]
+        hi[live[~below]], fhi[live[~below]] = x[~below], v[~below]
+        side[live] = np.where(below, 1, -1)
+        lo[live[hit]] = hi[live[hit]] = x[hit]
+    x = np.where(np.abs(flo) < np.abs(fhi), lo, hi)
+    return (lower + x).reshape(shape)
 
 
 def _invalid(name, admissible, value):

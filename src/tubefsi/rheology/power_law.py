@@ -46,6 +46,9 @@ class _PowerLawForms(Rheology):
         """:math:`3n+1`: :math:`G \\propto R^{-(3n+1)}` at fixed flow rate."""
         return 3.0 * self.index + 1.0
 
+    def _flow_index(self, flow_rate, radius):
+        return np.zeros(np.broadcast_shapes(np.shape(flow_rate), np.shape(radius))) + self.index
+
     def _velocity(self, r, radius, pressure_gradient):
         n = self.index
         k = 1.0 + 1.0 / n

@@ -14,7 +14,20 @@ run on each. A plugin's tests subclass the suites and provide fixtures::
 
 Suites: :class:`WallContract`, :class:`HyperelasticWallContract`,
 :class:`RheologyContract`, :class:`CouplerContract` (whose ``case`` fixture
-:func:`coupler_cases` fills: every registered coupler that supports each pair).
+:func:`coupler_cases` fills: every registered coupler that supports each pair). Those compare a
+model's paths with each other. :class:`AccuracyContract` (``case`` fixture: ``(rheology, wall)``,
+filled by :func:`accuracy_cases`) compares the *default answers* of ``tubefsi.solve`` — pressure
+drop, flow rate, inlet displacement, profiles — with :func:`brute_force`, an independent
+evaluation by a different algorithm (tanh–sinh quadrature of the separated identity in the
+pressure, bracketing roots of the forward tube law) that calls only the models' public methods,
+to ``1e-11 max(1, kappa)``; a law the default path gets wrong fails there::
+
+    from tubefsi.testing import AccuracyContract, accuracy_cases, examples
+
+    class TestMyWallsAccuracy(AccuracyContract):
+        @pytest.fixture(params=accuracy_cases(examples("walls", "thick-gent")))
+        def case(self, request):
+            return request.param
 
 Independent references live in the subpackage :mod:`tubefsi.testing.reference`, which this
 module does not import (its mpmath modules need ``mpmath``, from the ``test`` extra); import its
@@ -33,10 +46,12 @@ modules directly:
 Nothing there calls tubefsi's numerics.
 """
 
-from .contracts import CouplerContract, HyperelasticWallContract, RheologyContract, WallContract
+from .contracts import (AccuracyContract, BruteForce, CouplerContract, HyperelasticWallContract, RheologyContract,
+                        WallContract, accuracy_cases, brute_force)
 from .strategies import coupler_cases, examples, flow_rates, reduced_thicknesses, strains
 
 __all__ = [
-    "WallContract", "HyperelasticWallContract", "RheologyContract", "CouplerContract",
-    "examples", "coupler_cases", "strains", "reduced_thicknesses", "flow_rates",
+    "WallContract", "HyperelasticWallContract", "RheologyContract", "CouplerContract", "AccuracyContract",
+    "brute_force", "BruteForce", "examples", "coupler_cases", "accuracy_cases", "strains", "reduced_thicknesses",
+    "flow_rates",
 ]

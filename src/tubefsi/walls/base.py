@@ -18,6 +18,7 @@ import abc
 import math
 from typing import ClassVar
 
+import attrs
 import numpy as np
 from scipy import differentiate
 from scipy.optimize import elementwise
@@ -62,6 +63,9 @@ class WallModel(abc.ABC):
                                                             of a power-law fluid (with
                                                             ``closed_form_integral = True``)
     ``_power_law_integral_inverse(integral, ...)``          None; its explicit inverse, where there is one
+    ``_pressure_scale()``, ``_shape_key()``                 1 and every parameter: ``P = scale * P_hat(key)``
+                                                            lets a curve table serve every modulus
+    ``_pressure_needs_quadrature()``                        False (True for a generic thick wall)
     ======================================================  ==============================================
 
     Class attributes: ``is_rigid`` (True only for :class:`~tubefsi.walls.Rigid`) and
@@ -218,6 +222,21 @@ class WallModel(abc.ABC):
 
     def _max_stretch(self, tb):
         return math.inf
+
+    # -- for the tables of whole curves (``tubefsi.couplers._tables``): P = scale * P_hat(shape)
+    def _pressure_scale(self):
+        """The modulus the tube law is proportional to (``P = scale * P_hat``); 1 unless overridden."""
+        return 1.0
+
+    def _shape_key(self):
+        """What the tube law depends on besides ``_pressure_scale`` (hashable); all parameters
+        unless overridden."""
+        return tuple((f.name, getattr(self, f.name)) for f in attrs.fields(type(self))) if attrs.has(type(self)) \
+            else ()
+
+    def _pressure_needs_quadrature(self) -> bool:
+        """Whether evaluating the tube law costs a quadrature (the tables then tabulate it too)."""
+        return False
 
     # ------------------------------------------------------------------ generic inverses
     def _invert_pressure(self, pressure, tb):

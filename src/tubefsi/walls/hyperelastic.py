@@ -46,7 +46,7 @@ import attrs
 import numpy as np
 from scipy import differentiate
 
-from .._quadrature import adaptive_to_pole, warn_unconverged
+from .._quadrature import adaptive, adaptive_to_pole, warn_unconverged
 from ..fields import choice, evaluate, flat_points, model_at, take
 from .base import WallModel
 
@@ -147,10 +147,40 @@ class ThinWall(HyperelasticWall):
     thickness_convention: str = choice(THICKNESS_CONVENTIONS, default="reference",
                                        doc="hoop stress with the reference or current thickness")
 
+    #: Below this hoop strain, :math:`\hat W'(1 + \varepsilon)` is integrated from the strain itself.
+    _SMALL_STRAIN = 0.1
+
     def _pressure_at_strain(self, strain, tb):
         lam = 1.0 + strain
-        p = tb * self._dW(lam)
+        p = tb * self._dW_at_strain(strain)
         return p if self.thickness_convention == "reference" else p / lam
+
+    def _dW_at_strain(self, strain):
+        r""":math:`\hat W'(1+\varepsilon)` without rounding :math:`1 + \varepsilon` where it matters.
+
+        Forming the stretch :math:`1 + \varepsilon` rounds the strain to the spacing of doubles
+        near 1, a relative error :math:`\epsilon_{mach}/\varepsilon` in :math:`\hat W'` (which
+        vanishes at 1). Below ``_SMALL_STRAIN`` the derivative is therefore integrated,
+        :math:`\hat W'(1+\varepsilon) = \varepsilon\int_0^1 \hat W''(1+t\varepsilon)\,dt`, by adaptive
+        Gauss–Kronrod quadrature (``_d2W`` is smooth and non-zero at 1, so rounding its argument
+        costs nothing).
+        """
+        shape, wall, (e,) = flat_points(self, strain)
+        e = np.broadcast_to(e, (max(1, e.size),))
+        out = wall._dW(1.0 + e)
+        small = np.flatnonzero(np.abs(e) < self._SMALL_STRAIN)
+        if small.size:
+            es = e[small]
+
+            def f(t, i):
+                return model_at(wall, small[i], column=True)._d2W(1.0 + t * es[i, None])
+
+            result = adaptive(f, 0.0, 1.0 + 0.0 * es, rtol=1e-14)
+            if not np.all(result.converged):
+                warn_unconverged("the thin-wall law at small strain", result)
+            out = np.array(out, dtype=float) + 0.0 * e
+            out[small] = es * result.value
+        return out.reshape(shape)
 
     def _stiffness(self, stretch, tb):
         if self.thickness_convention == "reference":
@@ -192,6 +222,9 @@ class ThickWall(HyperelasticWall):
         if not np.all(result.converged):
             warn_unconverged("the thick-wall (Lamé) integral", result)
         return result.value.reshape(shape)
+
+    def _pressure_needs_quadrature(self) -> bool:
+        return type(self)._pressure_at_strain is ThickWall._pressure_at_strain
 
     def _stiffness(self, stretch, tb):
         lam = np.asarray(stretch, dtype=float)

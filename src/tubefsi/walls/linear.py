@@ -24,6 +24,12 @@ class _LinearWall(WallModel):
 
     closed_form_integral = True
 
+    def _pressure_scale(self):
+        return self.youngs_modulus
+
+    def _shape_key(self):
+        return tuple((f.name, getattr(self, f.name)) for f in attrs.fields(type(self)) if f.name != "youngs_modulus")
+
     def _compliance(self, tb):
         """:math:`d\\lambda/dp` (1/Pa)."""
         return self._factor(tb) / (self.youngs_modulus * tb)

@@ -32,6 +32,12 @@ class _NeoHookeanLaw:
 
     __slots__ = ()
 
+    def _pressure_scale(self):
+        return self.shear_modulus
+
+    def _shape_key(self):
+        return (getattr(self, "thickness_convention", "thick"),)
+
     def _dW(self, stretch):
         return self.shear_modulus * (stretch - stretch**-3)
 

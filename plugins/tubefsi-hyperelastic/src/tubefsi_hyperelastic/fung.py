@@ -28,6 +28,12 @@ class Fung(HyperelasticWall):
     shear_modulus: float = positive(unit="Pa", doc="small-strain shear modulus mu")
     stiffening: float = positive(doc="stiffening exponent b")
 
+    def _pressure_scale(self):                  # P = mu * P_hat(b): a curve table serves every mu
+        return self.shear_modulus
+
+    def _shape_key(self):
+        return (self.stiffening, getattr(self, "thickness_convention", "thick"))
+
     def _max_stretch(self, tb):
         x = (600.0 / self.stiffening) ** 0.5          # lam - 1/lam where exp(b x^2) = e^600
         return 0.5 * (x + (x * x + 4.0) ** 0.5)

@@ -26,6 +26,12 @@ class Gent(HyperelasticWall):
     shear_modulus: float = positive(unit="Pa", doc="small-strain shear modulus mu")
     locking_parameter: float = positive(doc="J_m, the largest I1 - 3")
 
+    def _pressure_scale(self):                  # P = mu * P_hat(J_m): a curve table serves every mu
+        return self.shear_modulus
+
+    def _shape_key(self):
+        return (self.locking_parameter, getattr(self, "thickness_convention", "thick"))
+
     def _locking_stretch(self):
         jm = self.locking_parameter
         return 0.5 * (jm**0.5 + (jm + 4.0) ** 0.5)

@@ -60,6 +60,13 @@ class Ogden(LimitPoint, HyperelasticWall):
             raise InvalidParameterError("moduli", "sum(moduli) > 0", self.moduli,
                                         "the small-strain shear modulus must be positive")
 
+    def _pressure_scale(self):                  # P is linear in the moduli
+        return sum(self.moduli)
+
+    def _shape_key(self):
+        total = sum(self.moduli)
+        return (tuple(m / total for m in self.moduli), self.exponents, getattr(self, "thickness_convention", "thick"))
+
     def _terms(self):
         return zip((2.0 * m / a for m, a in zip(self.moduli, self.exponents)), self.exponents)
 

@@ -31,6 +31,12 @@ class Yeoh(LimitPoint, HyperelasticWall):
     c2: float = real(unit="Pa", doc="c2 (may be negative)")
     c3: float = nonnegative(unit="Pa", doc="c3 >= 0")
 
+    def _pressure_scale(self):                  # P is linear in (c1, c2, c3): c1 * P_hat(c2/c1, c3/c1)
+        return self.c1
+
+    def _shape_key(self):
+        return (self.c2 / self.c1, self.c3 / self.c1, getattr(self, "thickness_convention", "thick"))
+
     def _f(self, y):  # dW/d lam = f(y) (lam - lam^-3), f = 2 dW/dI1
         return 2.0 * (self.c1 + y * (2.0 * self.c2 + 3.0 * self.c3 * y))
 

@@ -20,6 +20,14 @@ from tubefsi.rheology import Rheology
 __all__ = ["Carreau", "CarreauYasuda", "Cross", "Ellis"]
 
 
+def _log1p_power(x, a):
+    r""":math:`\ln(1 + x^a)` for :math:`x > 0` without overflow: :math:`a\ln x + \ln(1 + x^{-a})` where
+    :math:`x^a > 1` (so the stress keeps increasing up to the largest representable shear rate)."""
+    with np.errstate(divide="ignore"):
+        la = a * np.log(x)
+    return np.where(la > 0, la + np.log1p(np.exp(-np.abs(la))), np.log1p(np.exp(np.minimum(la, 0.0))))
+
+
 class _ViscosityRange(Rheology):
     """Shared check: ``0 <= infinite_shear_viscosity <= zero_shear_viscosity``."""
 
@@ -57,7 +65,7 @@ class CarreauYasuda(_ViscosityRange):
     def _stress(self, shear_rate):
         a = self.transition
         x = self.relaxation_time * shear_rate
-        shape = np.exp((self.index - 1.0) / a * np.log1p(x**a))
+        shape = np.exp((self.index - 1.0) / a * _log1p_power(x, a))
         return shear_rate * (self.infinite_shear_viscosity
                              + (self.zero_shear_viscosity - self.infinite_shear_viscosity) * shape)
 
@@ -78,7 +86,7 @@ class Carreau(_ViscosityRange):
 
     def _stress(self, shear_rate):
         x = self.relaxation_time * shear_rate
-        shape = np.exp(0.5 * (self.index - 1.0) * np.log1p(x * x))
+        shape = np.exp(0.5 * (self.index - 1.0) * _log1p_power(x, 2.0))
         return shear_rate * (self.infinite_shear_viscosity
                              + (self.zero_shear_viscosity - self.infinite_shear_viscosity) * shape)
 
@@ -114,8 +122,8 @@ class Cross(_ViscosityRange):
 
     def _stress(self, shear_rate):
         x = self.relaxation_time * shear_rate
-        return shear_rate * (self.infinite_shear_viscosity
-                             + (self.zero_shear_viscosity - self.infinite_shear_viscosity) / (1.0 + x**self.exponent))
+        return shear_rate * (self.infinite_shear_viscosity + (self.zero_shear_viscosity - self.infinite_shear_viscosity)
+                             * np.exp(-_log1p_power(x, self.exponent)))
 
 
 @attrs.frozen(kw_only=True)

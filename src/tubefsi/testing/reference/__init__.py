@@ -20,7 +20,8 @@ tubefsi.testing`` does not need mpmath. Import the modules directly:
   slopes, and the laws of any material given by its three-dimensional strain energy
   (neo-Hookean, Mooney–Rivlin, Gent, Fung, Yeoh, Ogden) by quadrature and Leibniz's rule; the
   table :data:`~.tube_laws.WALLS` of the built-in walls the accuracy tests use; the stretch at a
-  given pressure.
+  given pressure; :class:`~.tube_laws.HoopFibre`, a strain-stiffening user law (a neo-Hookean
+  matrix with circumferential exponential fibres) written as the wall-law tutorial teaches.
 * :mod:`.power_law` — power-law flow (Newtonian included) in such a wall, separated:
   :math:`\phi(q)` and its inverse, :math:`\hat J(\lambda) = \int_1^\lambda P'(s)s^k ds` (by parts,
   in :math:`\ln s`, or directly), its tail, :math:`J_\infty` and the maximum flow rate for limit

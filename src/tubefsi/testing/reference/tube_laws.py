@@ -9,7 +9,8 @@ Materials
 ---------
 A hyperelastic material is its three-dimensional strain energy :math:`W(\lambda_1, \lambda_2,
 \lambda_3)` (:class:`NeoHookean`, :class:`MooneyRivlin`, :class:`Gent`, :class:`Fung`,
-:class:`Yeoh`, :class:`Ogden`). In the clamped (plane-strain) tube a point at the hoop stretch
+:class:`Yeoh`, :class:`Ogden`; :class:`HoopFibre`, an anisotropic one: a neo-Hookean matrix with
+exponential fibres along the hoop direction). In the clamped (plane-strain) tube a point at the hoop stretch
 :math:`s` has principal stretches :math:`(1/s, s, 1)`, so :math:`\hat W(s) = W(1/s, s, 1)`
 (:meth:`Material.W_hat`), and the reduced derivative :math:`\hat W'(s)` (:meth:`Material.dW`) is
 written by hand from it (checked against ``mpmath.diff`` of :math:`\hat W` by the tests).
@@ -53,7 +54,7 @@ from collections.abc import Mapping
 from mpmath import mp, mpf
 
 __all__ = [
-    "Material", "NeoHookean", "MooneyRivlin", "Gent", "Fung", "Yeoh", "Ogden", "Linear",
+    "Material", "NeoHookean", "MooneyRivlin", "Gent", "Fung", "HoopFibre", "Yeoh", "Ogden", "Linear",
     "material_from_params", "RefWall", "KINDS", "LIMIT_KINDS", "WALLS", "stretch_at_pressure",
 ]
 
@@ -143,6 +144,31 @@ class Fung(Material):
 
     def dW(self, s):
         return self.mu * (s - s**-3) * mp.exp(self.b * (s - 1 / s) ** 2)
+
+
+class HoopFibre(Material):
+    """A neo-Hookean matrix with one family of exponential fibres along the hoop direction:
+    W = (mu/2)(I1 - 3) + k1/(2 k2) (exp(k2 (I4 - 1)^2) - 1), with I4 = l2^2 the squared hoop
+    stretch (Holzapfel–Gasser–Ogden type, fibres at 0 degrees to the circumference).
+
+    On the plane-strain path (1/s, s, 1): dW = mu (s - s^-3) + 2 k1 s (s^2 - 1) exp(k2 (s^2 - 1)^2),
+    and dW / (s^2 - 1) = mu (s^2 + 1) / s^3 + 2 k1 s exp(k2 (s^2 - 1)^2), free of the cancellation
+    at s -> 1.
+    """
+
+    def __init__(self, shear_modulus, k1, k2):
+        self.mu, self.k1, self.k2 = mpf(shear_modulus), mpf(k1), mpf(k2)
+        self._repr = f"HoopFibre({shear_modulus!r}, {k1!r}, {k2!r})"
+
+    def W(self, l1, l2, l3):
+        fibre = self.k1 / (2 * self.k2) * (mp.exp(self.k2 * (l2**2 - 1) ** 2) - 1)
+        return self.mu / 2 * (l1**2 + l2**2 + l3**2 - 3) + fibre
+
+    def dW(self, s):
+        return self.mu * (s - s**-3) + 2 * self.k1 * s * (s * s - 1) * mp.exp(self.k2 * (s * s - 1) ** 2)
+
+    def lame_integrand(self, s):   # dW(s) / (s^2 - 1), simplified
+        return self.mu * (s * s + 1) / s**3 + 2 * self.k1 * s * mp.exp(self.k2 * (s * s - 1) ** 2)
 
 
 class Yeoh(Material):

@@ -1,0 +1,168 @@
+r"""Error-controlled tables of the separated identity, for whole curves and repeated scalar calls.
+
+For a power-law fluid, :math:`G(q, R) = \phi(q)R^{-k}`, and a wall whose tube law scales with one
+modulus, :math:`P = \mu\hat P(\lambda)`, the separated identity (``docs/theory.md``, section
+"Coupling without an ODE") reads :math:`\hat J(v) = L\phi(q)/(\mu a^k)` with
+
+.. math:: \hat J(v) = \int_0^v s^{k+1}\,\hat P'(s)\,du, \qquad s = e^u,
+
+which depends only on the wall's shape, :math:`\bar t` and :math:`n`: not on :math:`q`,
+:math:`\mu`, :math:`m`, :math:`a` or :math:`L`. A :class:`SeparatedTable` holds, for one such
+key, piecewise-Chebyshev interpolants of
+
+* :math:`x(y) = \ln\hat J(e^y)` (the forward map, :math:`y = \ln v`),
+* :math:`y(x)` (its inverse: the inlet log-stretch of a target), and
+* :math:`\ln\hat P(e^{e^y})` (the pressure drop), where the wall's pressure needs a quadrature,
+
+each refined panel by panel until its Chebyshev tail is below the tolerance, then checked a
+posteriori at points that were not interpolated: the forward map and the pressure against
+fresh error-controlled quadratures, the inverse against the forward map's exact value at its
+answer. A table whose check fails is not used (its points go to the direct solver), so a table
+never makes an answer less accurate than the direct path; the estimate is kept in
+:attr:`SeparatedTable.error`.
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+
+import numpy as np
+
+__all__ = ["Chebyshev", "SeparatedTable", "fit_chebyshev"]
+
+_DEGREE = 10
+_NODES = np.cos(np.pi * (np.arange(_DEGREE + 1) + 0.5) / (_DEGREE + 1))[::-1]     # ascending, in (-1, 1)
+_FIT = np.polynomial.chebyshev.chebvander(_NODES, _DEGREE)
+_FIT_INV = np.linalg.inv(_FIT)
+_CHECK = np.array([-0.97, -0.81, -0.55, -0.23, 0.11, 0.43, 0.71, 0.93])              # not nodes
+_AT_CHECK = np.polynomial.chebyshev.chebvander(_CHECK, _DEGREE)
+
+
+class Chebyshev:
+    """A piecewise Chebyshev interpolant: degree-20 series on the panels ``breaks[j] .. breaks[j+1]``."""
+
+    def __init__(self, breaks, coef):
+        self.breaks = np.asarray(breaks, dtype=float)
+        self.coef = np.asarray(coef, dtype=float)
+        self._breaks = self.breaks.tolist()
+        self._coef = [row.tolist() for row in self.coef]
+        self.lo, self.hi = float(self.breaks[0]), float(self.breaks[-1])
+        self._width = np.diff(self.breaks)
+        self._coefT = np.ascontiguousarray(self.coef.T)
+
+    def __call__(self, x):
+        """Values at ``x`` (an array inside ``[lo, hi]``), one gather and one Clenshaw sweep."""
+        x = np.asarray(x, dtype=float)
+        j = np.searchsorted(self.breaks, x, side="right") - 1
+        np.clip(j, 0, len(self.breaks) - 2, out=j)
+        a, width = self.breaks[j], self._width[j]
+        t2 = (x - a) * (4.0 / width) - 2.0                    # 2 t, t in [-1, 1] on the panel
+        c = self._coefT[:, j]                                  # (degree + 1, n), rows contiguous
+        b1 = c[_DEGREE].copy()
+        b2 = np.zeros_like(b1)
+        tmp = np.empty_like(b1)
+        for k in range(_DEGREE - 1, 0, -1):
+            np.multiply(t2, b1, out=tmp)
+            tmp -= b2
+            tmp += c[k]
+            b1, b2, tmp = tmp, b1, b2
+        np.multiply(t2, b1, out=tmp)
+        tmp *= 0.5
+        tmp -= b2
+        tmp += c[0]
+        return tmp
+
+    def scalar(self, x: float) -> float:
+        """The value at one float ``x``, in plain Python (the scalar path)."""
+        j = min(max(bisect.bisect_right(self._breaks, x) - 1, 0), len(self._breaks) - 2)
+        a, b = self._breaks[j], self._breaks[j + 1]
+        t = (2.0 * x - a - b) / (b - a)
+        c = self._coef[j]
+        t2, b1, b2 = 2.0 * t, 0.0, 0.0
+        for k in range(_DEGREE, 0, -1):
+            b1, b2 = t2 * b1 - b2 + c[k], b1
+        return t * b1 - b2 + c[0]
+
+    def derivative(self):
+        """The interpolant of the derivative (on the same panels)."""
+        scale = 2.0 / np.diff(self.breaks)
+        d = np.polynomial.chebyshev.chebder(self.coef.T, axis=0).T * scale[:, None]
+        return Chebyshev(self.breaks, np.pad(d, ((0, 0), (0, 1))))
+
+
+def fit_chebyshev(f, lo, hi, *, panels=4, tol=1e-14, max_panels=256):
+    """``(Chebyshev, error)``: ``f`` (vectorized) interpolated on ``[lo, hi]``, panels split until
+    each one's tail and its check points are within ``tol`` (absolute, relative to ``max(1, |f|)``).
+
+    ``error`` is the largest check-point discrepancy seen on the accepted panels (``inf`` if some
+    panel could not be accepted within ``max_panels``).
+    """
+    pending = list(zip(np.linspace(lo, hi, panels + 1)[:-1], np.linspace(lo, hi, panels + 1)[1:]))
+    done, worst = [], 0.0
+    while pending:
+        if len(done) + len(pending) > max_panels:
+            return None, math.inf
+        a = np.array([p[0] for p in pending])
+        b = np.array([p[1] for p in pending])
+        mid, half = 0.5 * (a + b), 0.5 * (b - a)
+        x_nodes = mid[:, None] + half[:, None] * _NODES
+        x_check = mid[:, None] + half[:, None] * _CHECK
+        values = np.asarray(f(np.concatenate([x_nodes, x_check], axis=1).ravel()), dtype=float).reshape(len(a), -1)
+        y_nodes, y_check = values[:, :_DEGREE + 1], values[:, _DEGREE + 1:]
+        coef = y_nodes @ _FIT_INV.T
+        interp = coef @ _AT_CHECK.T
+        scale = np.maximum(1.0, np.max(np.abs(y_nodes), axis=1))
+        miss = np.max(np.abs(interp - y_check), axis=1) / scale
+        tail = np.max(np.abs(coef[:, -3:]), axis=1) / scale
+        ok = np.isfinite(miss) & (miss <= tol) & (tail <= tol)
+        nxt = []
+        for i in range(len(a)):
+            if ok[i]:
+                done.append((a[i], b[i], coef[i]))
+                worst = max(worst, float(miss[i]))
+            else:
+                nxt += [(a[i], mid[i]), (mid[i], b[i])]
+        pending = nxt
+    done.sort(key=lambda p: p[0])
+    breaks = [p[0] for p in done] + [done[-1][1]]
+    return Chebyshev(breaks, np.array([p[2] for p in done])), worst
+
+
+class SeparatedTable:
+    r"""The tables of one (wall shape, t/a, n) key; see the module docstring.
+
+    ``forward(y)`` is :math:`\ln\hat J(e^y)`, ``inverse(x)`` its inverse, ``pressure(y)`` the log of
+    the pressure per unit modulus (None where the wall's pressure is cheap to evaluate directly).
+    ``x_lo .. x_hi`` is the range of targets served; ``j_inf`` is :math:`\hat J(\infty)` (or ``inf``);
+    ``error`` the a-posteriori estimate of the error of :math:`\ln v` (and of the log pressure).
+    """
+
+    def __init__(self, forward, inverse, pressure, *, x_lo, x_hi, y_lo, y_hi, j_inf, error, k, wall_type,
+                 tabulate_pressure, pressure_inverse=None):
+        self.forward, self.inverse, self.pressure = forward, inverse, pressure
+        self.pressure_inverse = pressure_inverse
+        self.x_lo, self.x_hi, self.y_lo, self.y_hi = x_lo, x_hi, y_lo, y_hi
+        self.j_inf, self.error, self.k, self.wall_type = j_inf, error, k, wall_type
+        self.tabulate_pressure = tabulate_pressure
+
+    def for_scene(self, scene):
+        """The table bound to a scene of its key: the target normalization and the pressure."""
+        return _Bound(self, scene)
+
+
+class _Bound:
+    __slots__ = ("table", "norm", "scale", "wall", "tb", "x_lo", "x_hi", "inverse")
+
+    def __init__(self, table, scene):
+        self.table = table
+        self.wall, self.tb = scene.wall, scene.tb
+        self.scale = float(scene.wall._pressure_scale())
+        self.norm = float(scene.tube.radius) ** table.k * self.scale
+        self.x_lo, self.x_hi, self.inverse = table.x_lo, table.x_hi, table.inverse
+
+    def rise(self, y, v):
+        """The pressure rise (Pa) at ``y = ln v`` (arrays)."""
+        if self.table.tabulate_pressure:
+            return self.scale * np.exp(self.table.pressure(y))
+        return self.wall._pressure_at_strain(np.expm1(v), self.tb)

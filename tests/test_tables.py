@@ -1,0 +1,142 @@
+"""The curve tables (tubefsi.couplers._tables) and the lean scalar path they serve.
+
+References: the direct, error-controlled path of the same engine with the tables switched off
+(the tables must reproduce it to its own accuracy, 1e-13), and closed forms for the Chebyshev
+fitter. The direct path itself is checked against mpmath in test_accuracy_contract.py and
+against an independent brute force in the contract suites.
+"""
+
+from __future__ import annotations
+
+import importlib
+
+import numpy as np
+import pytest
+
+import tubefsi
+import tubefsi.couplers.separated as engine
+from tubefsi.couplers._tables import fit_chebyshev
+from tubefsi.registry import rheologies, walls
+
+TUBE = tubefsi.Tube(radius=1e-4, thickness=3e-5, length=1e-2)
+FLUID = rheologies["power-law"](consistency=0.017, index=0.7)
+
+WALLS = [
+    walls["thick-neo-hookean"](shear_modulus=2e3),
+    walls["thin-neo-hookean"](shear_modulus=2e3),
+    walls["thick-mooney-rivlin"](c1=1.5e3, c2=-0.5e3),
+    walls["thick-fung"](shear_modulus=2e3, stiffening=2.0),
+    walls["thin-fung"](shear_modulus=1e3, stiffening=20.0),
+    walls["thick-gent"](shear_modulus=2e3, locking_parameter=3.0),
+    walls["thick-yeoh"](c1=1e3, c2=50.0, c3=2.0),
+]
+
+
+def _curve(wall):
+    q_max = tubefsi.max_flow_rate(FLUID, wall, TUBE)
+    top = 0.95 * q_max if np.isfinite(q_max) else 5e-9
+    return np.concatenate([[0.0], np.geomspace(1e-6 * top, top, 400)])
+
+
+@pytest.mark.parametrize("wall", WALLS, ids=repr)
+def test_table_reproduces_the_direct_path(wall, monkeypatch):
+    q = _curve(wall)
+    engine._TABLES.clear()
+    tabled = tubefsi.solve(FLUID, wall, TUBE, flow_rate=q)
+    assert any(t for t in engine._TABLES.values()), "no table was built for this curve"
+    z = np.array([0.0, 0.3, 0.7, 1.0])[:, None] * TUBE.length
+    p_tabled = tabled.pressure(z)
+    back_tabled = tubefsi.solve(FLUID, wall, TUBE, pressure_drop=tabled.pressure_drop)
+    monkeypatch.setattr(engine, "_TABLE_MIN_POINTS", 10**9)
+    monkeypatch.setattr(engine, "_seen_again", lambda scene: False)
+    engine._TABLES.clear()
+    direct = tubefsi.solve(FLUID, wall, TUBE, flow_rate=q)
+    np.testing.assert_allclose(tabled.pressure_drop, direct.pressure_drop, rtol=1e-13, atol=0)
+    np.testing.assert_allclose(tabled.inlet_displacement, direct.inlet_displacement, rtol=1e-13, atol=0)
+    np.testing.assert_allclose(p_tabled, direct.pressure(z), rtol=1e-13, atol=1e-300)
+    back_direct = tubefsi.solve(FLUID, wall, TUBE, pressure_drop=direct.pressure_drop)
+    # near a limit pressure the flow rate is ill-conditioned in the pressure drop: kappa = dln q/dln dp
+    kappa = np.ones(q.size)
+    kappa[1:] = np.maximum(1.0, np.abs(np.gradient(np.log(q[1:]), np.log(direct.pressure_drop[1:]))))
+    assert np.all(np.abs(back_tabled.flow_rate - back_direct.flow_rate) <= 1e-12 * kappa * q)
+    assert np.all(np.abs(back_tabled.flow_rate - q) <= 1e-11 * kappa * q)
+
+
+def test_scalar_path_equals_the_general_path(monkeypatch):
+    """A loop of scalar solves (a fresh wall each call) takes the lean path once its key repeats;
+    its answers are those of the general path, as floats, with working profiles."""
+    solve_module = importlib.import_module("tubefsi.solve")     # the module (tubefsi.solve is the function)
+    cases = ((2e3, 1e-9), (3e3, 3e-9), (2.5e3, 1e-12))
+    with monkeypatch.context() as off:          # the references: no table at all
+        off.setattr(engine, "_TABLE_MIN_POINTS", 10**9)
+        off.setattr(engine, "_seen_again", lambda scene: False)
+        off.setattr(solve_module, "_scalar_flow", lambda *args: None)
+        direct = [tubefsi.solve(FLUID, walls["thick-neo-hookean"](shear_modulus=mu), TUBE, flow_rate=q)
+                  for mu, q in cases]
+    engine._TABLES.clear()
+    engine._SEEN.clear()
+    served = []
+    real = solve_module._scalar_flow
+
+    def counting(*args):
+        out = real(*args)
+        served.append(out is not None)
+        return out
+
+    monkeypatch.setattr(solve_module, "_scalar_flow", counting)
+    for _ in range(3):                      # the second call of the key builds the table
+        fast = [tubefsi.solve(FLUID, walls["thick-neo-hookean"](shear_modulus=mu), TUBE, flow_rate=q)
+                for mu, q in cases]
+    assert served[:1] == [False] and all(served[-3:]), served
+    for f, d in zip(fast, direct):
+        assert isinstance(f.pressure_drop, float)
+        assert f.pressure_drop == pytest.approx(d.pressure_drop, rel=1e-13)
+        assert f.inlet_displacement == pytest.approx(d.inlet_displacement, rel=1e-13)
+        assert f.pressure(0.4 * TUBE.length) == pytest.approx(d.pressure(0.4 * TUBE.length), rel=1e-12)
+        assert f.coupler_name == d.coupler_name == "quadrature"
+
+
+def test_a_table_that_fails_its_check_is_not_used(monkeypatch):
+    """If the a-posteriori check of a table fails, every point goes to the direct path."""
+    import tubefsi.couplers._tables as tables
+
+    real = tables.fit_chebyshev
+
+    def sloppy(f, lo, hi, **kw):                 # an interpolant that is off by 1e-9
+        cheb, err = real(f, lo, hi, **kw)
+        if cheb is not None:
+            cheb.coef[:, 0] += 1e-9
+            cheb._coefT[0] += 1e-9
+        return cheb, err
+
+    monkeypatch.setattr(engine, "fit_chebyshev", sloppy)
+    engine._TABLES.clear()
+    wall = walls["thick-neo-hookean"](shear_modulus=2e3)
+    q = _curve(wall)
+    sol = tubefsi.solve(FLUID, wall, TUBE, flow_rate=q)
+    assert list(engine._TABLES.values()) == [False]
+    monkeypatch.setattr(engine, "fit_chebyshev", real)
+    monkeypatch.setattr(engine, "_TABLE_MIN_POINTS", 10**9)
+    engine._TABLES.clear()
+    np.testing.assert_allclose(sol.pressure_drop, tubefsi.solve(FLUID, wall, TUBE, flow_rate=q).pressure_drop,
+                               rtol=1e-14, atol=0)
+
+
+@pytest.mark.parametrize("fn, lo, hi", [(np.sin, 0.0, 10.0), (np.exp, -5.0, 5.0), (np.log1p, 0.0, 100.0)])
+def test_chebyshev_fit_meets_its_tolerance(fn, lo, hi):
+    cheb, err = fit_chebyshev(fn, lo, hi)
+    x = np.linspace(lo, hi, 10001)
+    scale = np.maximum(1.0, np.abs(fn(x)))
+    assert np.max(np.abs(cheb(x) - fn(x)) / scale) < 1e-14
+    assert err < 1e-14
+    for xi in x[::997]:
+        assert abs(cheb.scalar(float(xi)) - fn(xi)) <= 1e-14 * max(1.0, abs(fn(xi)))
+    d = cheb.derivative()
+    if fn is np.sin:
+        np.testing.assert_allclose(d(x), np.cos(x), atol=1e-12)
+
+
+def test_chebyshev_fit_gives_up_honestly():
+    """A function it cannot resolve (an infinite slope inside) gives no interpolant, not a wrong one."""
+    cheb, err = fit_chebyshev(lambda x: np.sqrt(np.abs(x - 0.3)), 0.0, 1.0, max_panels=64)
+    assert cheb is None and err == np.inf
