@@ -151,3 +151,51 @@ def test_broadcast_equals_scalars():
             one = tubefsi.solve(rheologies["power-law"](consistency=0.01, index=n),
                                 walls["thick-neo-hookean"](shear_modulus=m), TUBE, flow_rate=1e-9)
             assert d[i, j] == pytest.approx(one.dpressure_drop_dflow_rate, rel=1e-13)
+
+
+PARAMETER_CASES = [
+    ("power-law", {"consistency": 0.02, "index": 0.75}, "thick-neo-hookean", {"shear_modulus": 5e3},
+     ["rheology.consistency", "rheology.index", "wall.shear_modulus"]),
+    ("carreau", rheologies["carreau"]._examples[0], "thin-neo-hookean", {"shear_modulus": 5e3},
+     ["rheology.zero_shear_viscosity", "rheology.relaxation_time", "rheology.index", "wall.shear_modulus"]),
+    ("newtonian", {"viscosity": 1e-3}, "thin-linear", {"youngs_modulus": 5e4, "poisson_ratio": 0.45},
+     ["rheology.viscosity", "wall.youngs_modulus"]),
+]
+
+
+@pytest.mark.parametrize("case", PARAMETER_CASES, ids=lambda c: f"{c[0]}-{c[2]}")
+def test_parameter_derivatives_match_differences(case):
+    """dDp/dtheta at fixed q (the fit's Jacobian) against Richardson differences of solves with
+    the parameter perturbed (an independent computation: the solver run twice per step)."""
+    import attrs
+
+    rname, rpar, wname, wpar, names = case
+    rheo, wall = rheologies[rname](**rpar), walls[wname](**wpar)
+    q = np.array([1e-10, 1e-9])
+    sol = tubefsi.solve(rheo, wall, TUBE, flow_rate=q)
+    for name in names:
+        owner, field = name.split(".")
+        model = rheo if owner == "rheology" else wall
+
+        def drop(x, owner=owner, field=field, model=model):
+            changed = attrs.evolve(model, **{field: float(x)})
+            return tubefsi.solve(changed if owner == "rheology" else rheo, changed if owner == "wall" else wall,
+                                 TUBE, flow_rate=q).pressure_drop
+
+        value = float(getattr(model, field))
+        reference = _richardson(drop, value, H)
+        np.testing.assert_allclose(sol.dpressure_drop_dparameter(name), reference, rtol=1e-8, err_msg=name)
+
+
+def test_parameter_derivative_rejects_what_it_cannot_do():
+    rheo = rheologies["power-law"](consistency=0.02, index=0.75)
+    sol = tubefsi.solve(rheo, walls["thin-linear"](youngs_modulus=5e4, poisson_ratio=0.45), TUBE, flow_rate=1e-9)
+    with pytest.raises(tubefsi.InvalidParameterError, match="poisson_ratio"):
+        sol.dpressure_drop_dparameter("wall.poisson_ratio")
+    with pytest.raises(tubefsi.InvalidParameterError, match="rheology.nothing"):
+        sol.dpressure_drop_dparameter("rheology.nothing")
+    loaded = tubefsi.solve(rheo, walls["thick-neo-hookean"](shear_modulus=5e3), TUBE, flow_rate=1e-9,
+                           outlet_pressure=100.0)
+    with pytest.raises(tubefsi.InvalidParameterError, match="shear_modulus"):
+        loaded.dpressure_drop_dparameter("wall.shear_modulus")
+    assert loaded.dpressure_drop_dparameter("rheology.index") > 0

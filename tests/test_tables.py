@@ -48,7 +48,7 @@ def test_table_reproduces_the_direct_path(wall, monkeypatch):
     p_tabled = tabled.pressure(z)
     back_tabled = tubefsi.solve(FLUID, wall, TUBE, pressure_drop=tabled.pressure_drop)
     monkeypatch.setattr(engine, "_TABLE_MIN_POINTS", 10**9)
-    monkeypatch.setattr(engine, "_seen_again", lambda scene: False)
+    monkeypatch.setattr(engine, "_worth_building", lambda scene: False)
     engine._TABLES.clear()
     direct = tubefsi.solve(FLUID, wall, TUBE, flow_rate=q)
     np.testing.assert_allclose(tabled.pressure_drop, direct.pressure_drop, rtol=1e-13, atol=0)
@@ -69,12 +69,12 @@ def test_scalar_path_equals_the_general_path(monkeypatch):
     cases = ((2e3, 1e-9), (3e3, 3e-9), (2.5e3, 1e-12))
     with monkeypatch.context() as off:          # the references: no table at all
         off.setattr(engine, "_TABLE_MIN_POINTS", 10**9)
-        off.setattr(engine, "_seen_again", lambda scene: False)
+        off.setattr(engine, "_worth_building", lambda scene: False)
         off.setattr(solve_module, "_scalar_flow", lambda *args: None)
         direct = [tubefsi.solve(FLUID, walls["thick-neo-hookean"](shear_modulus=mu), TUBE, flow_rate=q)
                   for mu, q in cases]
     engine._TABLES.clear()
-    engine._SEEN.clear()
+    engine._SPENT.clear()
     served = []
     real = solve_module._scalar_flow
 
@@ -84,7 +84,9 @@ def test_scalar_path_equals_the_general_path(monkeypatch):
         return out
 
     monkeypatch.setattr(solve_module, "_scalar_flow", counting)
-    for _ in range(3):                      # the second call of the key builds the table
+    # the table is built once the direct solves of the key have cost as much as a build would
+    monkeypatch.setattr(engine, "_BUILD_SECONDS", [0.0])
+    for _ in range(3):
         fast = [tubefsi.solve(FLUID, walls["thick-neo-hookean"](shear_modulus=mu), TUBE, flow_rate=q)
                 for mu, q in cases]
     assert served[:1] == [False] and all(served[-3:]), served

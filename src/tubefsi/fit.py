@@ -2,7 +2,10 @@ r"""Calibrate wall and rheology parameters from measured (flow rate, pressure dr
 
 :func:`fit` minimizes the sum of squared *relative* residuals
 :math:`r_i = \ln(\Delta p_{model}(q_i;\theta)/\Delta p_i)` with
-:func:`scipy.optimize.least_squares`; parameters whose admissible range is
+:func:`scipy.optimize.least_squares`, with the analytic Jacobian of the separated identity
+(``docs/theory.md``, section "Sensitivities": one weighted quadrature per rheology parameter,
+none for the wall's modulus; a forward difference of two solves for other parameters);
+parameters whose admissible range is
 :math:`(0, \infty)` are fitted through their logarithm, so they stay positive. Standard
 errors come from the Gauss–Newton covariance :math:`s^2 (J^T J)^{-1}`,
 :math:`s^2 = \sum r_i^2/(m - k)`, mapped back by the delta method.
@@ -18,7 +21,7 @@ from scipy import optimize
 
 from .errors import InvalidParameterError, TubefsiError
 from .scene import make_scene
-from .solve import max_flow_rate, solve
+from .solve import solve
 
 __all__ = ["fit", "FitResult"]
 
@@ -106,29 +109,66 @@ def fit(flow_rate, pressure_drop, rheology, wall, tube, *, parameters, outlet_pr
                 new[owner] = attrs.evolve(new[owner], **changes)
         return new
 
-    def model_drop(m):
-        # beyond the maximum flow rate the drop is continued by its supremum, the limit
-        # pressure rise, so trial parameters with no steady state still steer the fit
-        q_max = max_flow_rate(m["rheology"], m["wall"], tube, outlet_pressure=outlet_pressure)
-        ok = q < q_max
-        out = np.empty_like(q)
-        if np.any(ok):
-            out[ok] = solve(m["rheology"], m["wall"], tube, flow_rate=q[ok], outlet_pressure=outlet_pressure,
-                            coupler=coupler).pressure_drop
-        if not np.all(ok):
-            out[~ok] = m["wall"].limit_pressure(tube.reduced_thickness) - outlet_pressure
-        return out
+    def evaluate(theta):
+        """Models, model drops and the solution at ``theta`` (cached: the Jacobian reuses them)."""
+        key = theta.tobytes()
+        if key not in cache:
+            m = build(theta)
+            # beyond the maximum flow rate the drop is continued by its supremum, the limit
+            # pressure rise, so trial parameters with no steady state still steer the fit
+            sol = solve(m["rheology"], m["wall"], tube, flow_rate=q, outlet_pressure=outlet_pressure,
+                        coupler=coupler, on_infeasible="nan")
+            out = np.array(sol.pressure_drop, dtype=float)
+            ok = np.isfinite(out)
+            if not np.all(ok):
+                out[~ok] = m["wall"].limit_pressure(tube.reduced_thickness) - outlet_pressure
+            cache.clear()
+            cache[key] = (m, sol, ok, out)
+        return cache[key]
 
     def residuals(theta):
         try:
-            return np.log(model_drop(build(theta)) / dp)
+            return np.log(evaluate(theta)[3] / dp)
         except (TubefsiError, ArithmeticError, FloatingPointError):
             return np.full(q.size, 10.0)   # outside the models' admissible range
 
+    def jacobian(theta):
+        r"""``d r_i / d theta_j``, :math:`r = \ln\Delta p`: the solution's analytic parameter
+        derivatives (``Solution.dpressure_drop_dparameter``) where it has them, a forward
+        difference of two solves otherwise."""
+        try:
+            m, sol, ok, drop = evaluate(theta)
+        except (TubefsiError, ArithmeticError, FloatingPointError):
+            return np.zeros((q.size, theta.size))
+        jac = np.empty((q.size, theta.size))
+        values = natural(theta)
+        for j, name in enumerate(names):
+            column = None
+            if np.all(ok):
+                try:
+                    column = np.asarray(sol.dpressure_drop_dparameter(name), dtype=float) / drop
+                    column = column * (values[j] if logs[j] else 1.0)
+                except InvalidParameterError:
+                    column = None
+            if column is None or not np.all(np.isfinite(column)):
+                h = 1e-7 * max(1.0, abs(theta[j]))
+                shifted = theta.copy()
+                shifted[j] += h
+                saved = dict(cache)
+                try:
+                    column = (np.log(evaluate(shifted)[3]) - np.log(drop)) / h
+                except (TubefsiError, ArithmeticError, FloatingPointError):
+                    column = np.zeros(q.size)
+                cache.clear()
+                cache.update(saved)
+            jac[:, j] = column
+        return jac
+
+    cache: dict = {}
     # log parameters may move by a factor of up to 1e4 from their starting values
     start = np.array(start)
     span = np.where(logs, math.log(1e4), np.inf)
-    res = optimize.least_squares(residuals, start, bounds=(start - span, start + span), x_scale="jac",
+    res = optimize.least_squares(residuals, start, jac=jacobian, bounds=(start - span, start + span), x_scale="jac",
                                  xtol=1e-12, ftol=1e-12, gtol=1e-12)
     dof = max(q.size - len(names), 1)
     s2 = 2.0 * res.cost / dof

@@ -161,6 +161,65 @@ class Solution:
         the tube inflates with the outlet pressure."""
         return self._sensitivities()[2]
 
+    def dpressure_drop_dparameter(self, parameter: str):
+        r""":math:`\partial\Delta p/\partial\theta` at fixed flow rate and outlet pressure, for a model
+        parameter named ``"rheology.<field>"`` or ``"wall.<field>"`` (Pa per unit of the field).
+
+        From the separated identity (``docs/theory.md``, section "Sensitivities"): for a rheology
+        parameter, :math:`G_{in}\int_0^L \partial_\theta\ln G\,dz` (closed forms for the power
+        law and the Newtonian fluid, a central difference of :math:`G` otherwise); for the
+        modulus that the tube law is proportional to (``P = \mu\hat P``: the shear modulus of a
+        neo-Hookean wall, Young's modulus of a linear one) with an unloaded outlet,
+        :math:`(\Delta p - L G_{in})/\mu`. Other wall parameters raise
+        ``InvalidParameterError`` (difference two solves). 0 where ``q = 0``.
+        """
+        owner, _, field = parameter.partition(".")
+        model = {"rheology": self.rheology, "wall": self.wall}.get(owner)
+        if model is None or not attrs.has(type(model)) or field not in attrs.fields_dict(type(model)):
+            raise InvalidParameterError("parameter", "'rheology.<field>' or 'wall.<field>' of the solved models",
+                                        parameter)
+        if owner == "wall" and not self._is_pressure_scale(field):
+            raise InvalidParameterError(
+                "parameter", "a rheology field, or the wall's modulus with an unloaded outlet (others: "
+                "difference two solves)", parameter)
+        shape = np.shape(self.state.flow_rate)
+        out = np.full(int(np.prod(shape, dtype=int)), np.nan)
+        fields, parts = self._parts(shape)
+        for idx, chunk, sub in parts:
+            q = np.asarray(sub.flow_rate)
+            value = np.zeros(idx.size)
+            live = np.flatnonzero(q > 0)
+            if live.size:
+                part = chunk if live.size == idx.size else chunk.take(live)
+                state = State(**{k: np.asarray(getattr(sub, k))[live] for k in ("flow_rate", "pressure_drop",
+                                                                                  "inlet_strain", "log_stretch")})
+                pts = part.at(np.arange(live.size))
+                r_in = pts.radius * (1.0 + state.inlet_strain)
+                g_in = pts.rheology._pressure_gradient(state.flow_rate, r_in)
+                if owner == "rheology":
+                    def weight(rheology, flow_rate, radius):
+                        return rheology._log_gradient_derivative(field, flow_rate, radius)
+
+                    value[live] = g_in * self.coupler.length_integral(part, state, weight)
+                else:
+                    modulus = np.asarray(getattr(pts.wall, field), dtype=float)
+                    value[live] = (state.pressure_drop - pts.length * g_in) / modulus
+            out[idx] = value
+        return as_output(out.reshape(shape), self.scalar)
+
+    def _is_pressure_scale(self, field) -> bool:
+        """Whether the wall's tube law is proportional to ``field`` (and the outlet unloaded)."""
+        wall = self.wall
+        if np.any(np.asarray(self.outlet_pressure) != 0) or wall.is_rigid:
+            return False
+        try:
+            value = np.asarray(getattr(wall, field), dtype=float)
+            doubled = attrs.evolve(wall, **{field: 2.0 * value})
+            return bool(np.all(np.asarray(doubled._pressure_scale()) == 2.0 * np.asarray(wall._pressure_scale()))
+                        and doubled._shape_key() == wall._shape_key())
+        except (TypeError, ValueError):
+            return False
+
     def _out(self, value, *arguments):
         return as_output(value, self.scalar and all(np.ndim(a) == 0 for a in arguments))
 

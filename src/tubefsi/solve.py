@@ -18,7 +18,7 @@ from ._validation import as_load
 from .couplers.base import Coupler
 from .couplers.checked import checked
 from .errors import InvalidParameterError, NoSteadyStateError
-from .couplers.separated import _TABLES
+from .couplers.separated import _TABLES, SeparatedVariables
 from .geometry import Tube
 from .rheology.base import Rheology
 from .scene import Scene, State, _resolve, make_scene
@@ -124,10 +124,23 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
     n = values.size
     out = {f.name: np.full(n, np.nan) for f in attrs.fields(State)}
     feasible = np.ones(n, dtype=bool)
+    optimistic = controlled == "flow_rate" and _is(type(chosen), SeparatedVariables)
     for index, part in flat.split(np.arange(n)):
         for start in range(0, index.size, CHUNK):
             idx = index[start:start + CHUNK]
             chunk = part if part.size == 1 or idx.size == index.size else part.take(np.arange(start, start + idx.size))
+            if optimistic:
+                # the engine detects a point beyond the limit itself (its inlet stretch runs away):
+                # solve first, and look for the limit (a quadrature to infinity) only if one did
+                try:
+                    state = method(chunk, values[idx])
+                except NoSteadyStateError as error:
+                    if _feasible(runner, chunk, values[idx], controlled, raise_=on_infeasible == "raise") is None:
+                        raise error
+                else:
+                    for name in out:
+                        out[name][idx] = np.broadcast_to(np.asarray(getattr(state, name), dtype=float), idx.shape)
+                    continue
             ok = _feasible(runner, chunk, values[idx], controlled, raise_=on_infeasible == "raise")
             go = np.arange(idx.size) if ok is None else np.flatnonzero(ok)
             if ok is not None:

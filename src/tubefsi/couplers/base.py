@@ -15,9 +15,9 @@ hook                                           returns
 ``profile(scene, state, z)``                   the hoop strain and pressure rise at positions z
 =============================================  ===================================================
 
-and, optionally, ``index_integral(scene, state)`` (:math:`K = \int_0^L k\,dz`, the flow index
-along the tube, from which :meth:`Coupler.sensitivities` builds the derivatives of a solve;
-the default integrates it over the coupler's own profile). Class attributes ``cost_rank`` (lower is cheaper; ``coupler="auto"`` takes the
+and, optionally, ``length_integral(scene, state, weight)`` (:math:`\int_0^L w\,dz` of a
+weight along the tube, from which :meth:`Coupler.sensitivities` and :func:`tubefsi.fit` build
+the derivatives of a solve; the default integrates it over the coupler's own profile). Class attributes ``cost_rank`` (lower is cheaper; ``coupler="auto"`` takes the
 cheapest that supports the pair) and ``meets_accuracy_contract`` (whether ``auto`` may pick
 it). A coupler that can estimate its own error by solving again at a finer setting returns
 that finer version from :meth:`Coupler.refined`; :class:`~tubefsi.couplers.Checked` then
@@ -39,6 +39,10 @@ import numpy as np
 from .._quadrature import adaptive, warn_unconverged
 
 __all__ = ["Coupler"]
+
+
+def _flow_index(rheology, flow_rate, radius):
+    return rheology._flow_index(flow_rate, radius)
 
 
 class Coupler(abc.ABC):
@@ -82,18 +86,26 @@ class Coupler(abc.ABC):
         ``pressure_rise`` is :math:`p(z) - p_{out}`.
         """
 
-    def index_integral(self, scene, state):
-        r""":math:`K = \int_0^L k(q, R(z))\,dz` per point of a flat scene (m), :math:`k` the flow
-        index :math:`\partial\ln G/\partial\ln q` (``docs/theory.md``, section "Sensitivities").
+    def length_integral(self, scene, state, weight, *, uniform=False):
+        r""":math:`\int_0^L w(q, R(z))\,dz` per point of a flat scene (m times ``w``), for a weight
+        ``w = weight(rheology, flow_rate, radius)`` (arrays; ``rheology`` the points' own, whose
+        parameters are aligned with them); ``uniform``: ``w`` does not depend on R.
 
-        The default integrates :math:`k` over this coupler's :meth:`profile` by adaptive
-        Gauss–Kronrod quadrature in :math:`z` (relative tolerance 1e-12, a warning otherwise);
-        couplers with a cheaper form override it. Points with ``q = 0`` are not asked for.
+        With :math:`w = k = \partial\ln G/\partial\ln q` it is the :math:`K` of
+        :meth:`sensitivities`; with :math:`w = \partial_\theta\ln G` the derivative of a solve
+        with respect to a rheology parameter (:func:`tubefsi.fit`; ``docs/theory.md``, section
+        "Sensitivities"). The default integrates ``w`` over this coupler's :meth:`profile` by
+        adaptive Gauss–Kronrod quadrature in :math:`z` (relative tolerance 1e-12, a warning
+        otherwise); couplers with a cheaper form override it. Points with ``q = 0`` are not
+        asked for.
         """
         q = np.asarray(state.flow_rate, dtype=float)
         n = q.size
         length = np.broadcast_to(np.asarray(scene.tube.length, dtype=float), (n,))
         radius = np.broadcast_to(np.asarray(scene.tube.radius, dtype=float), (n,))
+        if uniform:
+            r_out = radius * np.broadcast_to(np.asarray(scene.outlet_stretch, dtype=float), (n,))
+            return length * weight(scene.rheology, q, r_out)
         fields = {name: np.broadcast_to(np.asarray(getattr(state, name), dtype=float), (n,))
                   for name in ("flow_rate", "pressure_drop", "inlet_strain", "log_stretch")}
         kind = type(state)
@@ -103,11 +115,11 @@ class Coupler(abc.ABC):
             part = scene.take(rows) if scene.size != 1 else scene
             strain, _ = self.profile(part, kind(**{k: v[rows] for k, v in fields.items()}), z.ravel())
             r = radius[rows] * (1.0 + np.asarray(strain))
-            return np.asarray(scene.rheology._flow_index(fields["flow_rate"][rows], r)).reshape(z.shape)
+            return np.asarray(weight(part.rheology, fields["flow_rate"][rows], r)).reshape(z.shape)
 
         result = adaptive(f, np.zeros(n), length, rtol=1e-12)
         if not np.all(result.converged):
-            warn_unconverged("the flow-index integral of the sensitivities", result)
+            warn_unconverged("a length integral of the sensitivities", result)
         return result.value
 
     def sensitivities(self, scene, state):
@@ -115,7 +127,7 @@ class Coupler(abc.ABC):
         dflow_rate_dinlet_pressure, dflow_rate_doutlet_pressure)``.
 
         With :math:`F(q, p_{in}, p_{out}) = \int_{p_{out}}^{p_{in}} dp/G(q, R(p)) - L = 0` and
-        :math:`\partial_q F = -K/q` (:meth:`index_integral`):
+        :math:`\partial_q F = -K/q`, :math:`K = \int_0^L k\,dz` (:meth:`length_integral`):
         :math:`d\Delta p/dq = G_{in} K/q`, :math:`\partial q/\partial p_{in} = q/(G_{in}K)`,
         :math:`\partial q/\partial p_{out} = -q/(G_{out}K)`, :math:`G_{in}, G_{out}` the pressure
         gradients at the ends. At ``q = 0`` the limit :math:`q \to 0^+` (the tube uniform).
@@ -134,7 +146,7 @@ class Coupler(abc.ABC):
             part = scene if live.size == n else scene.take(live)
             sub = type(state)(**{name: np.broadcast_to(np.asarray(getattr(state, name), dtype=float), (n,))[live]
                                  for name in ("flow_rate", "pressure_drop", "inlet_strain", "log_stretch")})
-            k_int[live] = self.index_integral(part, sub)
+            k_int[live] = self.length_integral(part, sub, _flow_index, uniform=rheo.separable)
         # q = 0: the tube is uniform at the outlet radius; the limit at an apparent shear rate 1e-30/s
         q_use = np.where(flowing, q, 0.25e-30 * math.pi * r_out**3)
         r_in = np.where(flowing, r_in, r_out)

@@ -35,6 +35,7 @@ from __future__ import annotations
 import abc
 import functools
 import math
+import time
 
 import numpy as np
 from scipy import interpolate, optimize
@@ -83,7 +84,7 @@ class SeparatedVariables(Coupler):
         """Hoop strain at log-stretch ``u``, without cancellation."""
         return points.outlet_strain + points.outlet_stretch * np.expm1(u)
 
-    def integrate(self, scene: Scene, f, upper, index, *, order=None, panel_width=2.0):
+    def integrate(self, scene: Scene, f, upper, index, *, order=None, panel_width=2.0, rtol=None):
         r"""``∫_0^upper f(u, i) du`` for the points ``index`` (``upper`` one per point; ``f`` gets
         positions ``i`` into ``index``).
 
@@ -102,7 +103,8 @@ class SeparatedVariables(Coupler):
         pole = np.where(locks, v_max, np.inf)
         if order is not None:
             return integrate_graded(f, upper, pole, order=order, panel_width=panel_width)
-        result = adaptive_to_pole(f, 0.0, upper, pole, rtol=self._RTOL, panel_width=panel_width)
+        result = adaptive_to_pole(f, 0.0, upper, pole, rtol=self._RTOL if rtol is None else rtol,
+                                  panel_width=panel_width)
         if not np.all(result.converged):
             warn_unconverged("the separated-variables integral", result)
         return result.value
@@ -203,7 +205,7 @@ class SeparatedVariables(Coupler):
         v = np.zeros(q.shape)
         dp = np.full(q.shape, np.nan)
         direct = target > 0
-        table = self._table(scene, build=q.size >= _TABLE_MIN_POINTS or _seen_again(scene))
+        table = self._table(scene, build=q.size >= _TABLE_MIN_POINTS or _worth_building(scene))
         if table is not None:                # the points whose target the table serves
             with np.errstate(divide="ignore"):
                 x = np.log(target / table.norm)
@@ -214,12 +216,15 @@ class SeparatedVariables(Coupler):
                 dp[served] = table.rise(y, v[served])
                 direct &= ~served
         if np.any(direct):
+            start = time.perf_counter()
             sub = np.flatnonzero(direct)
             v_d, ok = self.solve_log_stretch(scene, target[sub], sub, q[sub])
             if not np.all(ok):
                 self._raise_runaway(scene, q[sub], ok, sub)
             v[sub] = v_d
             dp[sub] = self.pressure_rise(scene, v_d, sub)
+            if table is None:
+                _charge(scene, time.perf_counter() - start)
         dp[target == 0] = 0.0
         return State(q, dp, self.strain_at(pts, v) + 0.0 * v, v)
 
@@ -228,21 +233,18 @@ class SeparatedVariables(Coupler):
         """The :class:`~tubefsi.couplers._tables.SeparatedTable` of a scene of shared quantities, a
         power-law fluid and an unloaded outlet (cached per wall shape, t/a and n), or None
         (``build=False``: only if already cached)."""
-        rheo, wall = scene.rheology, scene.wall
-        if (scene.size != 1 or rheo.radius_exponent is None or not rheo.separable
-                or np.ndim(scene.outlet_pressure) or scene.outlet_pressure != 0.0):
-            return None
-        try:
-            key = (type(wall), wall._shape_key(), float(scene.tb), float(rheo.radius_exponent))
-            hash(key)
-        except TypeError:
+        key = _table_key(scene)
+        if key is None:
             return None
         cached = _TABLES.get(key)
         if cached is None and not build:
             return None
         if cached is None:
+            start = time.perf_counter()
             with quiet():
                 cached = _TABLES[key] = _build_table(self, scene)
+            _BUILD_SECONDS[0] = 0.5 * (_BUILD_SECONDS[0] + time.perf_counter() - start)
+            _SPENT.pop(key, None)
             while len(_TABLES) > 128:
                 _TABLES.pop(next(iter(_TABLES)))
         if cached is False:
@@ -329,7 +331,8 @@ class SeparatedVariables(Coupler):
         v = np.zeros(dp.shape)
         q = np.zeros(dp.shape)
         direct = dp > 0
-        table = self._table(scene, build=dp.size >= _TABLE_MIN_POINTS or _seen_again(scene))
+        table = self._table(scene, build=dp.size >= _TABLE_MIN_POINTS or _worth_building(scene))
+        start = time.perf_counter()
         if table is not None and table.table.pressure_inverse is not None:
             with np.errstate(divide="ignore"):
                 w = np.log(dp / table.scale)
@@ -358,6 +361,8 @@ class SeparatedVariables(Coupler):
                 q[sub] = sp.rheology._flow_factor_inverse(j / sp.length)
             else:
                 q[sub] = self._solve_flow_rate(scene, v[sub], dp[sub], sub)
+            if table is None:
+                _charge(scene, time.perf_counter() - start)
         e_in = self.strain_at(pts, v) + 0.0 * v
         return State(q, dp, e_in, v)
 
@@ -478,26 +483,29 @@ class SeparatedVariables(Coupler):
             rise[sub] = self.pressure_rise(scene, v[sub], sub)
         return self.strain_at(pts, v) + 0.0 * v, rise
 
-    def index_integral(self, scene: Scene, state: State):
-        r""":math:`K = \int_0^L k\,dz`: :math:`kL` for a separable rheology (:math:`k` does not depend
-        on R) or a rigid wall; otherwise, with :math:`dz = -sP'(s)/G\,du`, the separated integral
-        weighted by :math:`k(q, as)`, :math:`\int_0^{v_{in}} k\,sP'(s)/G(q, as)\,du` (same
-        adaptive, error-controlled quadrature as :math:`H`)."""
+    def length_integral(self, scene: Scene, state: State, weight, *, uniform=False):
+        r""":math:`\int_0^L w(q, R(z))\,dz`: :math:`L\,w` where ``w`` does not depend on R (or the wall
+        is rigid); otherwise, with :math:`dz = -sP'(s)/G\,du`, the separated integral weighted by
+        :math:`w(q, as)`: :math:`\int_0^{v_{in}} w\,sP'(s)/G(q, as)\,du` (the adaptive,
+        error-controlled quadrature of :math:`J`, to 1e-12)."""
         q = np.asarray(state.flow_rate, dtype=float)
         index = np.arange(q.size)
         pts = scene.at(index)
         rheo = pts.rheology
-        if rheo.separable or scene.wall.is_rigid:
-            return pts.length * rheo._flow_index(q, pts.radius * pts.outlet_stretch) + 0.0 * q
+        if uniform or scene.wall.is_rigid:
+            return pts.length * weight(rheo, q, pts.radius * pts.outlet_stretch) + 0.0 * q
         v_in = np.asarray(state.log_stretch, dtype=float) + 0.0 * q
 
         def f(u, i):
             points = scene.at(index[i], column=True)
-            r = points.radius * self.stretch_at(points, u)
             qq = np.broadcast_to(q[i, None], np.shape(u))
-            return self.integrand(points, u, qq) * rheo._flow_index(qq, r)
+            return self.integrand(points, u, None if rheo.separable else qq) * weight(
+                points.rheology, qq, points.radius * self.stretch_at(points, u))
 
-        return self.integrate(scene, f, v_in, index)
+        # a derivative needs no more than 1e-12 (and a differenced weight has no more)
+        value = self.integrate(scene, f, v_in, index, rtol=1e-12)
+        # a separable integrand omits phi(q): dz = -sP'/(phi psi) du
+        return value / rheo._flow_factor(q) if rheo.separable else value
 
     def max_flow_rate(self, scene: Scene):
         """Largest flow rate with a steady state at each point of a flat scene (a float for a
@@ -610,22 +618,46 @@ def _rigid_state(scene: Scene, *, flow_rate=None, pressure_drop=None) -> State:
     return State(q, dp, zero + scene.outlet_strain, zero)
 
 
-#: Curves at least this long build a table; shorter calls build one when their key comes back.
+#: Curves at least this long build a table at once; shorter calls build one once the time spent
+#: solving their key directly has reached the time a build takes (a ski-rental rule: never more
+#: than twice the cost of the better choice in hindsight, whatever the sequence of calls).
 _TABLE_MIN_POINTS = 64
-_SEEN: dict = {}
+_SPENT: dict = {}
+_BUILD_SECONDS = [0.1]          # running estimate of a build's cost, updated by every build
 
 
-def _seen_again(scene) -> bool:
-    """Whether a short call of this table key was made before (a loop of scalar solves): then
-    the table pays for itself."""
+def _table_key(scene):
+    """The cache key of a scene's table (wall class, shape key, t/a, radius exponent), or None
+    where no table applies (parameters per point, a fluid not of power-law form, a loaded
+    outlet, an unhashable shape)."""
+    rheo, wall = scene.rheology, scene.wall
+    if (scene.size != 1 or rheo.radius_exponent is None or not rheo.separable
+            or np.ndim(scene.outlet_pressure) or scene.outlet_pressure != 0.0):
+        return None
     try:
-        key = (type(scene.wall), scene.wall._shape_key(), float(scene.tb), float(scene.rheology.radius_exponent))
-        count = _SEEN[key] = _SEEN.get(key, 0) + 1
+        key = (type(wall), wall._shape_key(), float(scene.tb), float(rheo.radius_exponent))
+        hash(key)
     except (TypeError, ValueError):
-        return False
-    if len(_SEEN) > 4096:
-        _SEEN.clear()
-    return count >= 2
+        return None
+    return key
+
+
+def _worth_building(scene) -> bool:
+    """Whether the direct solves of this key have cost as much as building its table."""
+    key = _table_key(scene)
+    return key is not None and _SPENT.get(key, 0.0) >= _BUILD_SECONDS[0]
+
+
+def _charge(scene, seconds) -> None:
+    """Account ``seconds`` of direct solving to the scene's table key."""
+    key = _table_key(scene)
+    if key is None or key in _TABLES:
+        return
+    _SPENT[key] = _SPENT.get(key, 0.0) + seconds
+    if len(_SPENT) > 4096:
+        _SPENT.clear()
+
+
 #: (wall class, shape key, t/a, radius exponent) -> SeparatedTable, or False where none can be built.
 _TABLES: dict = {}
 

@@ -31,6 +31,7 @@ import abc
 import math
 from typing import ClassVar
 
+import attrs
 import numpy as np
 
 from .._numerics import as_output
@@ -65,6 +66,8 @@ class Rheology(abc.ABC):
                                      :math:`\int_r^R \dot\gamma(G\rho/2)\,d\rho` by adaptive quadrature
     ``_flow_index``                  ``(flow_rate, radius)``: :math:`\partial\ln G/\partial\ln q`, from the
                                      wall shear rate (for the sensitivities)
+    ``_log_gradient_derivative``     ``(parameter, flow_rate, radius)``: :math:`\partial\ln G/\partial\theta`
+                                     (a central difference; for :func:`tubefsi.fit`)
     ``_flow_factor``                 separable rheologies only: :math:`\phi(q)` in :math:`G = \phi(q)\psi(R)`,
     ``_flow_factor_inverse``         its inverse,
     ``_radius_factor``               and :math:`\psi(R)`
@@ -289,6 +292,22 @@ class Rheology(abc.ABC):
         tau_w = 0.5 * r * self._pressure_gradient(0.25 * math.pi * r**3 * rate, r)
         rate_w = self._shear_rate(tau_w)
         return rate / (4.0 * rate_w - 3.0 * rate)
+
+    def _log_gradient_derivative(self, parameter: str, flow_rate, radius):
+        r""":math:`\partial\ln G/\partial\theta` at fixed flow rate and radius, for the field
+        ``parameter`` :math:`\theta` (the derivatives of a fit: ``docs/theory.md``, section
+        "Sensitivities"). The default: central differences of :math:`\ln G` at relative steps
+        1e-3 and 5e-4, Richardson-extrapolated (truncation :math:`O(10^{-12})`, rounding
+        :math:`\sim 10^{-13}|\ln G|`); closed forms override it."""
+        value = np.asarray(getattr(self, parameter), dtype=float)
+        step = 1e-3 * np.where(value == 0, 1.0, np.abs(value))
+
+        def central(h):
+            up = attrs.evolve(self, **{parameter: value + h})._pressure_gradient(flow_rate, radius)
+            down = attrs.evolve(self, **{parameter: value - h})._pressure_gradient(flow_rate, radius)
+            return (np.log(up) - np.log(down)) / (2.0 * h)
+
+        return (4.0 * central(0.5 * step) - central(step)) / 3.0
 
     # separable rheologies implement these three
     def _flow_factor(self, flow_rate):

@@ -49,6 +49,18 @@ class _PowerLawForms(Rheology):
     def _flow_index(self, flow_rate, radius):
         return np.zeros(np.broadcast_shapes(np.shape(flow_rate), np.shape(radius))) + self.index
 
+    def _log_gradient_derivative(self, parameter, flow_rate, radius):
+        # ln G = ln 2m + n ln(Gamma (3n+1)/(4n)) - ln R... with Gamma = 4q/(pi R^3):
+        # d/dm = 1/m; d/dn = ln(Gamma (3n+1)/(4n)) - 1/(3n+1)
+        shape = np.broadcast_shapes(np.shape(flow_rate), np.shape(radius))
+        if parameter in ("consistency", "viscosity"):
+            return np.zeros(shape) + 1.0 / self.consistency
+        if parameter == "index":
+            n = self.index
+            rate = 4.0 * np.asarray(flow_rate) / (math.pi * np.asarray(radius) ** 3)
+            return np.log(rate * (3.0 * n + 1.0) / (4.0 * n)) - 1.0 / (3.0 * n + 1.0) + np.zeros(shape)
+        return super()._log_gradient_derivative(parameter, flow_rate, radius)
+
     def _velocity(self, r, radius, pressure_gradient):
         n = self.index
         k = 1.0 + 1.0 / n
