@@ -142,3 +142,38 @@ def test_chebyshev_fit_gives_up_honestly():
     """A function it cannot resolve (an infinite slope inside) gives no interpolant, not a wrong one."""
     cheb, err = fit_chebyshev(lambda x: np.sqrt(np.abs(x - 0.3)), 0.0, 1.0, max_panels=64)
     assert cheb is None and err == np.inf
+
+
+CURVE_CASES = [
+    (rheologies["carreau-yasuda"](**rheologies["carreau-yasuda"]._examples[0]),
+     walls["thick-neo-hookean"](shear_modulus=2e3), 0.0),
+    (rheologies["bingham"](**rheologies["bingham"]._examples[0]), walls["thick-mooney-rivlin"](c1=1.5e3, c2=-0.5e3),
+     0.0),
+    (FLUID, walls["thick-fung"](shear_modulus=2e3, stiffening=2.0), 300.0),     # separable, loaded outlet
+]
+
+
+@pytest.mark.parametrize("case", CURVE_CASES, ids=lambda c: f"{type(c[0]).__name__}-{type(c[1]).__name__}-{c[2]:g}")
+def test_curve_interpolation_reproduces_the_direct_path(case, monkeypatch):
+    """A long curve with no table (non-separable fluid, loaded outlet) interpolates ln v(ln q)
+    between direct solves: it must agree with the direct path point by point (1e-13)."""
+    fluid, wall, p_out = case
+    q_max = tubefsi.max_flow_rate(fluid, wall, TUBE, outlet_pressure=p_out)
+    top = 0.9 * q_max if np.isfinite(q_max) else 3e-9
+    q = np.geomspace(1e-4 * top, top, 300)
+    calls = []
+    real = engine.SeparatedVariables._curve_by_interpolation
+
+    def spy(self, scene, flow):
+        out = real(self, scene, flow)
+        calls.append(out is not None)
+        return out
+
+    monkeypatch.setattr(engine.SeparatedVariables, "_curve_by_interpolation", spy)
+    curve = tubefsi.solve(fluid, wall, TUBE, flow_rate=q, outlet_pressure=p_out)
+    assert calls == [True]
+    sample = q[::23]
+    monkeypatch.setattr(engine, "_TABLE_MIN_POINTS", 10**9)
+    direct = tubefsi.solve(fluid, wall, TUBE, flow_rate=sample, outlet_pressure=p_out)
+    np.testing.assert_allclose(curve.pressure_drop[::23], direct.pressure_drop, rtol=1e-13, atol=0)
+    np.testing.assert_allclose(curve.inlet_displacement[::23], direct.inlet_displacement, rtol=1e-13, atol=0)

@@ -222,6 +222,13 @@ class Points:
                  "outlet_pressure", "log_stretch_max")
 
     def __init__(self, scene, index, column):
+        if scene.shape == ():                 # every quantity shared: nothing to gather (a curve)
+            self.wall, self.rheology = scene.wall, scene.rheology
+            self.radius, self.length, self.tb = scene.tube.radius, scene.tube.length, scene.tb
+            self.outlet_stretch, self.outlet_strain = scene.outlet_stretch, scene.outlet_strain
+            self.outlet_pressure, self.log_stretch_max = scene.outlet_pressure, scene.log_stretch_max
+            return
+
         def pick(value):
             if np.ndim(value) == 0:
                 return value

@@ -215,6 +215,13 @@ class SeparatedVariables(Coupler):
                 v[served] = np.exp(y)
                 dp[served] = table.rise(y, v[served])
                 direct &= ~served
+        if scene.size == 1 and np.count_nonzero(direct) >= _TABLE_MIN_POINTS:
+            sub = np.flatnonzero(direct)
+            v_c = self._curve_by_interpolation(scene, q[sub])
+            if v_c is not None:
+                v[sub] = v_c
+                dp[sub] = self.pressure_rise(scene, v_c, sub)
+                direct[sub] = False
         if np.any(direct):
             start = time.perf_counter()
             sub = np.flatnonzero(direct)
@@ -227,6 +234,36 @@ class SeparatedVariables(Coupler):
                 _charge(scene, time.perf_counter() - start)
         dp[target == 0] = 0.0
         return State(q, dp, self.strain_at(pts, v) + 0.0 * v, v)
+
+    def _curve_by_interpolation(self, scene: Scene, q):
+        r"""The inlet log-stretches of a long curve through one scene that has no table (a
+        non-separable fluid, a loaded outlet): :math:`\ln v` as a function of :math:`\ln q` is
+        smooth, so it is interpolated by piecewise Chebyshev series whose nodes are direct
+        solves, refined until each panel's tail and its check points (direct solves between the
+        nodes) agree to 1e-13 in :math:`\ln v` (:func:`~tubefsi.couplers._tables.fit_chebyshev`). A few hundred
+        direct solves then serve any number of points. None where it cannot be accepted (the
+        direct path then serves every point)."""
+        log_q = np.log(q)
+        lo, hi = float(log_q.min()), float(log_q.max())
+        if not hi > lo:
+            return None
+        length = float(scene.tube.length)
+        separable = scene.rheology.separable
+        pts = scene.at(np.zeros(1, dtype=int))
+
+        def log_v(x):
+            flow = np.exp(x)
+            ids = np.zeros(flow.size, dtype=int)
+            target = self.target(pts, flow) if separable else np.full(flow.size, length)
+            with quiet():
+                v, ok = self.solve_log_stretch(scene, np.broadcast_to(target, flow.shape), ids,
+                                               None if separable else flow, check=False)
+            return np.where(ok & (v > 0), np.log(np.where(v > 0, v, 1.0)), np.nan)
+
+        interpolant, error = fit_chebyshev(log_v, lo, hi, panels=2, max_panels=64, tol=_CURVE_TOL)
+        if interpolant is None or not math.isfinite(error):
+            return None
+        return np.exp(interpolant(np.clip(log_q, lo, hi)))
 
     # --------------------------------------------------------------- tables
     def _table(self, scene: Scene, build=True):
@@ -622,6 +659,9 @@ def _rigid_state(scene: Scene, *, flow_rate=None, pressure_drop=None) -> State:
 #: solving their key directly has reached the time a build takes (a ski-rental rule: never more
 #: than twice the cost of the better choice in hindsight, whatever the sequence of calls).
 _TABLE_MIN_POINTS = 64
+#: Tolerance of a curve interpolated between direct solves, in ln v: the direct solves' own
+#: accuracy (the quadrature's 1e-14, a little more near a yield point), not tighter.
+_CURVE_TOL = 1e-13
 _SPENT: dict = {}
 _BUILD_SECONDS = [0.1]          # running estimate of a build's cost, updated by every build
 
