@@ -50,12 +50,34 @@ class Chebyshev:
         self.lo, self.hi = float(self.breaks[0]), float(self.breaks[-1])
         self._width = np.diff(self.breaks)
         self._coefT = np.ascontiguousarray(self.coef.T)
+        # panel lookup by equal buckets as narrow as the narrowest panel (the panels come from
+        # bisection, so a bucket holds at most two of them): one multiply and a gather instead
+        # of a binary search; a bucket keeps its first panel and the break inside it
+        count = int(max(1, math.ceil((self.hi - self.lo) / self._width.min() - 1e-9)))
+        self._search = count > 1 << 16          # panels too uneven for buckets: binary search
+        count = min(count, 1 << 16)
+        self._bucket_scale = count / (self.hi - self.lo)
+        edges = self.lo + np.arange(count) / self._bucket_scale
+        first = np.clip(np.searchsorted(self.breaks, edges, side="right") - 1, 0, len(self.breaks) - 2)
+        self._bucket_panel = first
+        self._bucket_break = self.breaks[np.minimum(first + 1, len(self.breaks) - 1)]
+        self._buckets = count
+
+    def _panel(self, x):
+        """The panel index of each ``x``."""
+        if self._search:
+            return np.clip(np.searchsorted(self.breaks, x, side="right") - 1, 0, len(self.breaks) - 2)
+        b = ((x - self.lo) * self._bucket_scale).astype(np.intp)
+        np.clip(b, 0, self._buckets - 1, out=b)
+        j = self._bucket_panel[b]
+        j += x >= self._bucket_break[b]           # the second panel of a bucket that holds two
+        np.clip(j, 0, len(self.breaks) - 2, out=j)
+        return j
 
     def __call__(self, x):
         """Values at ``x`` (an array inside ``[lo, hi]``), one gather and one Clenshaw sweep."""
         x = np.asarray(x, dtype=float)
-        j = np.searchsorted(self.breaks, x, side="right") - 1
-        np.clip(j, 0, len(self.breaks) - 2, out=j)
+        j = self._panel(x)
         a, width = self.breaks[j], self._width[j]
         t2 = (x - a) * (4.0 / width) - 2.0                    # 2 t, t in [-1, 1] on the panel
         c = self._coefT[:, j]                                  # (degree + 1, n), rows contiguous
