@@ -9,7 +9,7 @@ pressure. Each generation's radius is its parent's times ``2^(-1/3)`` (Murray's 
 random factor in [0.85, 1.15]; lengths are 40 radii times a random factor in [0.7, 1.3]; the wall
 thickness is 0.3 radii times [0.8, 1.2]; the shear modulus of each thick neo-Hookean wall is
 4 kPa times [0.5, 2]. The fluid is one power law (m = 0.01 Pa s^n, n = 0.8). The inlet pressure
-is 60 % of the smallest limit pressure of the tree, so the tubes inflate strongly.
+is 85 % of the smallest limit pressure of the tree, so the tubes near the root inflate strongly.
 
 The two timed solves, side by side in alternating passes in one process (median of the passes):
 
@@ -65,7 +65,7 @@ def build_network(depth, seed=0):
         net.add_tube(int(parent[i]), int(child[i]), walls["thick-neo-hookean"](shear_modulus=float(modulus[i])),
                      tubefsi.Tube(radius=float(radius[i]), thickness=float(thickness[i]), length=float(length[i])))
     limit = np.min(modulus * np.log1p(thickness / radius))
-    p_in = 0.6 * limit
+    p_in = 0.85 * limit
     net.set_pressure(0, p_in)
     leaves = set(child.tolist()) - set(parent.tolist())
     for leaf in leaves:
@@ -111,9 +111,11 @@ def measure(depth, passes):
     table = result.node_table()
     balance = max(abs(x) for x, fixed in zip(table["inflow"], table["fixed"]) if not fixed)
     through = result.flow_rate[(0, 1)]
+    tubes = result.tube_table()
+    strain = float(np.max(np.maximum(tubes["radius_u"], tubes["radius_v"]) / radius - 1))
     return {"tubes": int(child.size), "nonlinear_s": statistics.median(t_non), "linear_s": statistics.median(t_lin),
             "ratio": statistics.median(t_non) / statistics.median(t_lin), "iterations": result.iterations,
-            "mass_balance": balance / through}
+            "mass_balance": balance / through, "max_strain": strain}
 
 
 def main(argv=None):
@@ -124,10 +126,10 @@ def main(argv=None):
     depths, passes = ((6, 8), 1) if args.quick else ((12, 15), 5)
     rows = [measure(d, passes if d < 15 else 3) for d in depths]
     print(f"{'tubes':>7} {'nonlinear (s)':>14} {'linear (s)':>11} {'ratio':>7} {'Newton its':>10} "
-          f"{'mass balance':>12}")
+          f"{'mass balance':>12} {'max strain':>10}")
     for r in rows:
         print(f"{r['tubes']:7d} {r['nonlinear_s']:14.4f} {r['linear_s']:11.5f} {r['ratio']:7.1f} "
-              f"{r['iterations']:10d} {r['mass_balance']:12.1e}")
+              f"{r['iterations']:10d} {r['mass_balance']:12.1e} {r['max_strain']:10.3f}")
     print(f"target: ratio <= {TARGET:g} at 4095 tubes" + (" (quick run: sizes too small to judge)" if args.quick else ""))
     if args.json:
         with open(args.json, "w", encoding="utf-8") as fh:
