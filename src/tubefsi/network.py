@@ -35,6 +35,7 @@ throughput (the total flow that enters the network); otherwise :class:`Convergen
 
 from __future__ import annotations
 
+import copy
 import csv
 import functools
 import json
@@ -225,8 +226,24 @@ class Network:
             A tube reaches its limit pressure (no steady state carries the inflows), naming it.
         ConvergenceError
             Newton's method did not bring the mass balance below ``rtol`` times the throughput.
+
+        Warns
+        -----
+        AccuracyWarning
+            When rounding alone (pressures close to a limit pressure) keeps the mass balance above
+            ``rtol`` times the throughput; the warning gives the balance reached.
         """
-        return _Solver(self).run(rtol, max_iterations)
+        rtol = float(as_array("rtol", rtol, "[1e-15, 1)", lambda a: (a >= 1e-15) & (a < 1)))
+        if isinstance(max_iterations, bool) or not isinstance(max_iterations, int) or max_iterations < 1:
+            raise InvalidParameterError("max_iterations", "the integers >= 1", max_iterations)
+        return _Solver(self._snapshot()).run(rtol, max_iterations)
+
+    def _snapshot(self):
+        """A copy that later changes to this network do not reach (the solution keeps it)."""
+        new = copy.copy(self)
+        for name in ("_tubes", "_nodes", "_pressure", "_inflow", "positions"):
+            setattr(new, name, dict(getattr(self, name)))
+        return new
 
 
 class _Groups:
