@@ -37,6 +37,7 @@ test: $(STAMP)
 docs: $(STAMP)
 	MPLBACKEND=Agg $(PY) examples/demo.py docs/_generated/demo
 	MPLBACKEND=Agg $(PY) examples/fit_synthetic.py docs/_generated/fit
+	MPLBACKEND=Agg $(PY) examples/network.py docs/_generated/network
 	$(PY) -m sphinx -W --keep-going -q -b html docs docs/_build/html
 
 # the same tests against the newest releases of everything (not the lock), in their own venv
@@ -44,7 +45,7 @@ test-latest:
 	test -x $(LATEST)/bin/python || $(PYTHON) -m venv $(LATEST)
 	$(LATEST)/bin/python -m pip install --quiet --upgrade pip setuptools wheel
 	$(LATEST)/bin/python -m pip install --quiet --upgrade --upgrade-strategy eager \
-	  -e '.[test,verify,docs]' $(foreach p,$(PLUGINS),-e $(dir $(p)))
+	  -e '.[test,verify,docs,network]' $(foreach p,$(PLUGINS),-e $(dir $(p)))
 	MPLBACKEND=Agg $(LATEST)/bin/python -m pytest -q -p no:cacheprovider
 
 # uv, at a fixed version in a throw-away venv, writes the lock from PyPI (not pip's indexes)

@@ -188,3 +188,21 @@ def test_fem_refinement_quick(tmp_path, capsys):
             assert rate == pytest.approx(2 * order, abs=0.2)
     walls = numbers(r"stretches up to FLOAT: max relative error FLOAT", text)
     assert len(walls) >= 1 and all(top > 1 and err < 1e-4 for top, err in walls)
+
+
+# ---------------------------------------------------------------------------- network.py
+def test_network_writes_its_plot_and_tables(tmp_path, capsys):
+    assert load("network").main([str(tmp_path), "--depth", "3"]) == 0
+    text = capsys.readouterr().out
+    assert_pngs(tmp_path, ["network.png"])
+    (iterations, imbalance), = numbers(r"Newton iterations: FLOAT; largest mass imbalance / throughput: FLOAT", text)
+    assert iterations >= 1 and imbalance <= 1e-13
+    (soft, rigid, inflow), = numbers(r"inlet pressure: soft FLOAT Pa, rigid FLOAT Pa \(outlet 100 Pa, inflow FLOAT", text)
+    assert 100.0 < soft < rigid          # the inflated vessels need less pressure than rigid ones
+    rows = numbers(r"arteriole\s+FLOAT\s+FLOAT\s+FLOAT\s+FLOAT", text)
+    for g, count, q, strain in rows:     # each generation of the tree carries the whole inflow
+        assert count == 2**g and q * count == pytest.approx(inflow, rel=1e-12) and strain > 0
+    with open(tmp_path / "network_tubes.csv", newline="") as fh:
+        tubes = list(csv.DictReader(fh))
+    assert len(tubes) == 2 * (2**4 - 1) + 2**3
+    assert all(float(t["radius_u"]) > 0 and math.isfinite(float(t["flow_rate"])) for t in tubes)

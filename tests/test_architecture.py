@@ -4,7 +4,7 @@ Models → scene → couplers → Solution → solve → the user-facing modules
 tubefsi module (module-level *and* inside functions, read from the source with ``ast``) goes
 to the same or a lower layer, and the import graph has no cycle. The only exceptions are the
 documented accessors that reach an upper layer on purpose, at call time
-(``WallModel.plot``, ``Solution.plot``, ``Solution.diagnostics``).
+(``WallModel.plot``, ``Solution.plot``, ``Solution.diagnostics``, ``NetworkSolution.plot``).
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ LAYERS = [
     {"tubefsi.couplers"},
     {"tubefsi.solution"},
     {"tubefsi.solve"},
-    {"tubefsi.advise", "tubefsi.fit", "tubefsi.dimensionless"},
+    {"tubefsi.advise", "tubefsi.fit", "tubefsi.dimensionless", "tubefsi.network"},
     {"tubefsi.chapter", "tubefsi.plotting"},
     {"tubefsi.cli", "tubefsi.testing", "tubefsi"},
 ]
@@ -35,6 +35,7 @@ ACCESSORS = {
     ("tubefsi.walls.base", "tubefsi.plotting"),       # WallModel.plot
     ("tubefsi.solution", "tubefsi.plotting"),         # Solution.plot
     ("tubefsi.solution", "tubefsi.advise"),           # Solution.diagnostics
+    ("tubefsi.network", "tubefsi.plotting"),          # NetworkSolution.plot
 }
 
 

@@ -72,3 +72,17 @@ def test_chapter_baseline_agrees_with_tubefsi(name, baseline):
         got_dp, got_u = baseline(qi, 0.7, 0.017, 2e3, TUBE)
         assert type(got_dp) is float and type(got_u) is float
         assert got_dp == pytest.approx(dp, rel=1e-5) and got_u == pytest.approx(u, rel=1e-5), qi
+
+
+def test_network_benchmark_quick_prints_finite_ratios(tmp_path, capsys):
+    """``benchmarks/network.py --quick``: a row per tree size with finite positive times (no
+    threshold: timings on a shared machine are noise) and a converged mass balance."""
+    network = load("network")
+    out = tmp_path / "network.json"
+    assert network.main(["--quick", "--json", str(out)]) == 0
+    data = json.loads(out.read_text())
+    assert [r["tubes"] for r in data["rows"]] == [63, 255]
+    for r in data["rows"]:
+        assert r["nonlinear_s"] > 0 and r["linear_s"] > 0 and math.isfinite(r["ratio"])
+        assert r["mass_balance"] <= 1e-12 and r["iterations"] >= 1
+    assert "ratio" in capsys.readouterr().out

@@ -14,7 +14,7 @@ API = Path(__file__).resolve().parents[1] / "docs" / "api.rst"
 
 PUBLIC_MODULES = [
     "tubefsi", "tubefsi.fields", "tubefsi.scene", "tubefsi.couplers", "tubefsi.walls", "tubefsi.rheology",
-    "tubefsi.registry", "tubefsi.errors", "tubefsi.advise", "tubefsi.fit", "tubefsi.dimensionless",
+    "tubefsi.registry", "tubefsi.errors", "tubefsi.advise", "tubefsi.fit", "tubefsi.network", "tubefsi.dimensionless",
     "tubefsi.chapter", "tubefsi.plotting", "tubefsi.cli", "tubefsi.testing",
 ]
 

@@ -27,7 +27,7 @@ from .errors import AccuracyWarning, ConvergenceError, InvalidParameterError, No
 
 __all__ = [
     "dimensionless", "fields", "Tube", "solve", "max_flow_rate", "select_coupler", "Solution", "registry",
-    "advise", "Advice", "Diagnostics", "ModelValidityWarning", "fit", "FitResult",
+    "advise", "Advice", "Diagnostics", "ModelValidityWarning", "fit", "FitResult", "Network", "NetworkSolution",
     "TubefsiError", "InvalidParameterError", "NoSteadyStateError", "ConvergenceError", "AccuracyWarning",
 ]
 
@@ -40,6 +40,7 @@ _LAZY = {
     "solve": "solve", "max_flow_rate": "solve", "select_coupler": "solve",
     "advise": "advise", "Advice": "advise", "Diagnostics": "advise", "ModelValidityWarning": "advise",
     "fit": "fit", "FitResult": "fit",
+    "Network": "network", "NetworkSolution": "network",
 }
 
 

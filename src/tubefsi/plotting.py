@@ -13,7 +13,9 @@ is called.
 * :func:`plot_profiles` — pressure :math:`p(z)` and radius :math:`R(z)/a` (Figure);
 * :func:`plot_deformed_tube` — the inflated tube in :math:`(z, r)`, lumen coloured by
   pressure (Axes);
-* :func:`plot_velocity_profiles` — axial velocity :math:`v(r)` at a few sections (Axes).
+* :func:`plot_velocity_profiles` — axial velocity :math:`v(r)` at a few sections (Axes);
+* :func:`plot_network` — a solved :class:`~tubefsi.Network`, coloured by pressure, tubes as
+  wide as their deformed radius (Axes).
 
 ``WallModel.plot`` and ``Solution.plot`` are shortcuts for :func:`plot_tube_law`
 and :func:`plot_profiles`. Quantities are SI except lengths on the axes of
@@ -50,6 +52,7 @@ __all__ = [
     "plot_profiles",
     "plot_deformed_tube",
     "plot_velocity_profiles",
+    "plot_network",
 ]
 
 _MM = 1e3            # metres -> millimetres
@@ -556,4 +559,63 @@ def plot_velocity_profiles(solution, z_sections=None, *, ax=None, n=101):
         ax.set_title(f"Velocity profiles, $q$ = {_fmt(q, 'm³/s')}", fontsize=10)
     ax.grid(True, alpha=0.25)
     ax.legend(frameon=False, fontsize=8, loc="upper right")
+    return ax
+
+
+# ---------------------------------------------------------------------------- networks
+def plot_network(result, *, positions=None, ax=None, cmap="viridis", max_width=8.0, layout_seed=0):
+    r"""Draw a solved network: nodes coloured by pressure, each tube a segment coloured by its
+    mean pressure and as wide as its mean deformed inner radius.
+
+    Parameters
+    ----------
+    result : NetworkSolution
+        What :meth:`tubefsi.Network.solve` returns.
+    positions : mapping node -> (x, y), optional
+        Node coordinates; by default those of :meth:`~tubefsi.Network.set_position` (or the
+        ``pos`` node attribute of a networkx graph), else a networkx spring layout (seeded by
+        ``layout_seed``; needs networkx).
+    ax : matplotlib Axes, optional
+    cmap : str or Colormap
+    max_width : float
+        Line width (points) of the widest tube; the others in proportion to their radius.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    from matplotlib.collections import LineCollection
+    from matplotlib.colors import Normalize
+
+    nodes = result.nodes
+    pos = dict(result.net.positions if positions is None else positions)
+    if any(node not in pos for node in nodes):
+        try:
+            import networkx as nx
+        except ImportError:
+            raise InvalidParameterError("positions", "(x, y) for every node", None,
+                                        "give positions= or set_position(), or install networkx for a layout") from None
+        pos = {**nx.spring_layout(result.net.to_networkx().to_undirected(as_view=True), seed=layout_seed), **pos}
+    table = result.tube_table()
+    p = result.pressure
+    xy = np.array([[pos[u], pos[v]] for u, v in zip(table["u"], table["v"])], dtype=float)
+    radius = 0.5 * (np.asarray(table["radius_u"]) + np.asarray(table["radius_v"]))
+    widths = max_width * radius / radius.max()
+    mean_p = 0.5 * (np.asarray(table["pressure_u"]) + np.asarray(table["pressure_v"]))
+    values = np.array([p[n] for n in nodes])
+    norm = Normalize(vmin=float(values.min()), vmax=float(values.max()) if values.max() > values.min() else
+                     float(values.min()) + 1.0)
+    ax = _new_axes(ax, (7.0, 5.0))
+    lines = LineCollection(xy, linewidths=np.maximum(widths, 0.4), cmap=cmap, norm=norm, capstyle="round", zorder=1)
+    lines.set_array(mean_p)
+    ax.add_collection(lines)
+    pts = np.array([pos[n] for n in nodes], dtype=float)
+    ax.scatter(pts[:, 0], pts[:, 1], c=values, cmap=cmap, norm=norm, s=14, edgecolors="k", linewidths=0.4, zorder=2)
+    ax.autoscale_view()
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_axis_off()
+    ax.figure.colorbar(lines, ax=ax, label="pressure $p$ (Pa)", shrink=0.8)
+    if not ax.get_title():
+        ax.set_title(f"{len(nodes)} nodes, {len(table['name'])} tubes; width ~ deformed radius "
+                     f"(widest {_fmt(float(radius.max()) * _MM, 'mm')})", fontsize=10)
     return ax

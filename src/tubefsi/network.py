@@ -1,0 +1,712 @@
+r"""Steady flow through a network of soft tubes (``docs/network.md``).
+
+Nodes carry pressures :math:`p_i` (transmural, gauge); a tube :math:`e = (u, v)` carries the
+flow :math:`q_e = Q_e(p_u, p_v)` of the pressure-controlled single-tube problem, solved from the
+higher-pressure end, so that the edge law is odd in :math:`p_u - p_v`:
+:math:`Q_e = \operatorname{sign}(p_u - p_v)\,Q(|p_u - p_v|;\ \min(p_u, p_v))`. At every node
+without a fixed pressure Kirchhoff's law holds,
+
+.. math::  F_i(p) = \sum_{e:\,v_e = i} q_e - \sum_{e:\,u_e = i} q_e + s_i = 0,
+
+with :math:`s_i` the injected flow rate. The free pressures solve :math:`F = 0` by Newton's
+method: the Jacobian is assembled from the analytic derivatives :math:`\partial q/\partial p_{in}`
+and :math:`\partial q/\partial p_{out}` of each tube (``docs/theory.md``, section
+"Sensitivities") and factorized by :func:`scipy.sparse.linalg.splu`. Every tube of a network is
+evaluated in one broadcast :func:`tubefsi.solve` per iteration and per group of tubes that
+share their wall and fluid classes (their parameters stacked into arrays).
+
+Globalization: the start is the rigid Newtonian network (each tube a Hagen–Poiseuille
+conductance :math:`\pi a^4/(8\mu L)` at the fluid's apparent viscosity, refined by three
+Picard sweeps); every Newton step is cut to stay inside :math:`0 \le p_i < p_{lim}` (a step goes
+at most 90 % of the way to a tube's limit pressure or to zero) and then halved until the
+residual norm :math:`\|F\|_2` decreases (Armijo). The derivative of a tube without flow is
+degenerate — :math:`\partial q/\partial p \to 0` for a shear-thinning fluid, :math:`\infty` for a
+shear-thickening one, as :math:`\Delta p \to 0` — so a tube whose pressure drop is below
+:math:`10^{-8}` of the largest pressure enters the Jacobian with its secant conductance
+:math:`q/\Delta p` (which zeroes the flow into a dead end in one step; the rigid start
+conductance at :math:`\Delta p = 0`), and no conductance goes below :math:`10^{-8}` of the rigid
+start one. That changes the step only, never the residual, so the converged pressures are those
+of the exact edge laws. (A drop below :math:`10^{-30}` of the largest pressure is taken as
+zero; the flow it would carry is below :math:`10^{-30/n}` of the network's.)
+
+Converged means that the mass balance of every free node is below ``rtol`` times the
+throughput (the total flow that enters the network); otherwise :class:`ConvergenceError`.
+"""
+
+from __future__ import annotations
+
+import copy
+import csv
+import functools
+import json
+import math
+
+import attrs
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse import csgraph
+from scipy.sparse import linalg as spla
+
+from ._validation import as_array
+from .errors import AccuracyWarning, ConvergenceError, InvalidParameterError, NoSteadyStateError, warn_user
+from .fields import _array_fields, parameter_shape
+from .geometry import Tube
+from .scene import resolve
+from .solution import Solution
+from .solve import max_flow_rate as tubefsi_max_flow
+from .solve import solve
+
+__all__ = ["Network", "NetworkSolution"]
+
+#: Jacobian conductances are clipped to [_CLIP, 1/_CLIP] times the rigid start conductance
+_CLIP = 1e-8
+#: fraction of the way to a bound (a limit pressure, zero) that one Newton step may go
+_TO_BOUND = 0.9
+#: a tube whose pressure drop is below this times the largest pressure counts as without flow
+#: (its Jacobian entry is the secant); below _TINY times it the drop is zero
+_STILL = 1e-8
+_TINY = 1e-30
+#: a node this close (relative) to its bound with the step still pushing outward is at the bound
+_AT_BOUND = 1e-12
+
+
+@attrs.define(eq=False)
+class _Tube:
+    name: object
+    u: object
+    v: object
+    wall: object
+    tube: Tube
+    rheology: object
+
+
+class Network:
+    """A graph of soft tubes between named nodes.
+
+    Parameters
+    ----------
+    rheology : model instance, class or registered name, optional
+        The fluid of every tube that does not name its own.
+
+    Example::
+
+        net = tubefsi.Network(rheology=fluid)
+        net.add_tube("in", "j", wall, tube)
+        net.add_tube("j", "a", wall, tube)
+        net.add_tube("j", "b", wall, tube)
+        net.set_inflow("in", 1e-9)
+        net.set_pressure("a", 0.0)
+        net.set_pressure("b", 50.0)
+        result = net.solve()
+        result.pressure["j"], result.flow_rate[("j", "a")]
+    """
+
+    def __init__(self, rheology=None):
+        self.rheology = None if rheology is None else resolve("rheology", rheology)
+        self._tubes: dict = {}
+        self._nodes: dict = {}
+        self._pressure: dict = {}
+        self._inflow: dict = {}
+        #: node -> (x, y), for :meth:`NetworkSolution.plot`
+        self.positions: dict = {}
+
+    # ------------------------------------------------------------------ building
+    def add_tube(self, u, v, wall, tube, *, name=None, rheology=None):
+        """Add a tube from node ``u`` to node ``v`` (positive flow runs from ``u`` to ``v``).
+
+        ``name`` (any hashable) defaults to ``(u, v)``; two tubes between the same nodes need
+        names. ``rheology`` overrides the network's fluid for this tube. Parameters are scalars.
+        """
+        name = (u, v) if name is None else name
+        if u == v:
+            raise InvalidParameterError("v", "a node other than u", v, "a tube joins two distinct nodes")
+        if name in self._tubes:
+            raise InvalidParameterError("name", "a name no other tube has", name,
+                                        "tubes between the same two nodes need distinct names")
+        wall = resolve("wall", wall)
+        fluid = self.rheology if rheology is None else resolve("rheology", rheology)
+        if fluid is None:
+            raise InvalidParameterError("rheology", "a fluid, here or in Network(rheology=...)", None)
+        if not isinstance(tube, Tube):
+            raise InvalidParameterError("tube", "a tubefsi.Tube", tube)
+        for label, model in (("wall", wall), ("rheology", fluid), ("tube", tube)):
+            if parameter_shape(model) != ():
+                raise InvalidParameterError(label, "scalar parameters (one tube per add_tube)", model)
+        for node in (u, v):
+            self._nodes.setdefault(node, len(self._nodes))
+        self._tubes[name] = _Tube(name, u, v, wall, tube, fluid)
+        return self
+
+    def set_pressure(self, node, pressure):
+        """Fix the (transmural, gauge) pressure of ``node`` (Pa, >= 0)."""
+        if node in self._inflow:
+            raise InvalidParameterError("node", "a node with a pressure or an inflow, not both", node,
+                                        "it has an inflow already")
+        self._pressure[node] = float(as_array("pressure", pressure, "[0, inf)", lambda a: a >= 0))
+        return self
+
+    def set_inflow(self, node, flow_rate):
+        """Inject ``flow_rate`` (m^3/s; negative: withdraw) at ``node``."""
+        if node in self._pressure:
+            raise InvalidParameterError("node", "a node with a pressure or an inflow, not both", node,
+                                        "it has a fixed pressure already")
+        self._inflow[node] = float(as_array("flow_rate", flow_rate, "(-inf, inf)", np.isfinite))
+        return self
+
+    def set_position(self, node, xy):
+        """Place ``node`` at ``xy = (x, y)`` for the plot."""
+        self.positions[node] = (float(xy[0]), float(xy[1]))
+        return self
+
+    @property
+    def nodes(self) -> list:
+        return list(self._nodes)
+
+    @property
+    def tube_names(self) -> list:
+        return list(self._tubes)
+
+    # ------------------------------------------------------------------ networkx
+    @classmethod
+    def from_networkx(cls, graph, *, rheology=None, wall="wall", tube="tube", fluid="rheology",
+                      pressure="pressure", inflow="inflow", pos="pos"):
+        """A network from a networkx graph whose edges hold a ``wall`` and a ``tube`` attribute
+        (and optionally ``fluid``); nodes may hold ``pressure``, ``inflow`` and ``pos``.
+
+        Edges run from the first node to the second as networkx lists them; a multigraph's
+        tubes are named ``(u, v, key)``.
+        """
+        net = cls(rheology=rheology)
+        multi = graph.is_multigraph()
+        edges = graph.edges(keys=True, data=True) if multi else ((u, v, None, d) for u, v, d in graph.edges(data=True))
+        for u, v, key, data in edges:
+            for attr in (wall, tube):
+                if attr not in data:
+                    raise InvalidParameterError(f"edge ({u!r}, {v!r})", f"an edge with a {attr!r} attribute", data)
+            net.add_tube(u, v, data[wall], data[tube], name=(u, v, key) if multi else None,
+                         rheology=data.get(fluid))
+        for node, data in graph.nodes(data=True):
+            if pressure in data:
+                net.set_pressure(node, data[pressure])
+            if inflow in data:
+                net.set_inflow(node, data[inflow])
+            if pos in data:
+                net.set_position(node, data[pos])
+        return net
+
+    def to_networkx(self):
+        """A ``networkx.MultiDiGraph`` (keys: the tube names) with the same attributes that
+        :meth:`from_networkx` reads."""
+        import networkx as nx
+
+        graph = nx.MultiDiGraph()
+        for node in self._nodes:
+            data = {}
+            if node in self._pressure:
+                data["pressure"] = self._pressure[node]
+            if node in self._inflow:
+                data["inflow"] = self._inflow[node]
+            if node in self.positions:
+                data["pos"] = self.positions[node]
+            graph.add_node(node, **data)
+        for t in self._tubes.values():
+            graph.add_edge(t.u, t.v, key=t.name, wall=t.wall, tube=t.tube, rheology=t.rheology)
+        return graph
+
+    # ------------------------------------------------------------------ solving
+    def solve(self, *, rtol=1e-13, max_iterations=100) -> NetworkSolution:
+        """The steady state: node pressures and tube flow rates (a :class:`NetworkSolution`).
+
+        Raises
+        ------
+        InvalidParameterError
+            An empty network, a fixed node that is in no tube, a part of the network without a
+            fixed pressure, or inflows that would need a negative pressure somewhere.
+        NoSteadyStateError
+            A tube reaches its limit pressure (no steady state carries the inflows), naming it.
+        ConvergenceError
+            Newton's method did not bring the mass balance below ``rtol`` times the throughput.
+
+        Warns
+        -----
+        AccuracyWarning
+            When rounding alone (pressures close to a limit pressure) keeps the mass balance above
+            ``rtol`` times the throughput; the warning gives the balance reached.
+        """
+        rtol = float(as_array("rtol", rtol, "[1e-15, 1)", lambda a: (a >= 1e-15) & (a < 1)))
+        if isinstance(max_iterations, bool) or not isinstance(max_iterations, int) or max_iterations < 1:
+            raise InvalidParameterError("max_iterations", "the integers >= 1", max_iterations)
+        return _Solver(self._snapshot()).run(rtol, max_iterations)
+
+    def _snapshot(self):
+        """A copy that later changes to this network do not reach (the solution keeps it)."""
+        new = copy.copy(self)
+        for name in ("_tubes", "_nodes", "_pressure", "_inflow", "positions"):
+            setattr(new, name, dict(getattr(self, name)))
+        return new
+
+
+class _Groups:
+    """The tubes grouped by (wall class, fluid class, non-array parameters), each group's
+    parameters stacked into arrays, and one broadcast solve per group."""
+
+    def __init__(self, tubes, subset):
+        groups: dict = {}
+        for i, t in enumerate(tubes):
+            if not subset[i]:
+                continue
+            key = (type(t.wall), _fixed(t.wall), type(t.rheology), _fixed(t.rheology))
+            groups.setdefault(key, []).append(i)
+        self.parts = []
+        for index in groups.values():
+            members = [tubes[i] for i in index]
+            wall = _stack([m.wall for m in members])
+            fluid = _stack([m.rheology for m in members])
+            tube = Tube(**{f: _column([getattr(m.tube, f) for m in members]) for f in ("radius", "thickness", "length")})
+            self.parts.append((np.asarray(index), fluid, wall, tube))
+        n = len(tubes)
+        self.limit = np.zeros(n)
+        self.radius = np.zeros(n)
+        for index, fluid, wall, tube in self.parts:
+            self.limit[index] = np.broadcast_to(wall.limit_pressure(tube.reduced_thickness), index.shape)
+            self.radius[index] = np.broadcast_to(tube.radius, index.shape)
+
+    def evaluate(self, drop, outlet):
+        """Flow rates and the derivatives by the inlet and outlet pressures of the tubes (pressure-
+        controlled; zeros for the tubes of no group)."""
+        q, d_in, d_out, radius_in, radius_out = (np.zeros(drop.size) for _ in range(5))
+        for index, fluid, wall, tube in self.parts:
+            sol = solve(fluid, wall, tube, pressure_drop=drop[index], outlet_pressure=outlet[index])
+            q[index] = sol.flow_rate
+            _, d_in[index], d_out[index] = sol._sensitivities()
+            radius_in[index] = sol.inlet_radius
+            radius_out[index] = np.broadcast_to(tube.radius * sol.scene.outlet_stretch, index.shape)
+        return q, d_in, d_out, radius_in, radius_out
+
+    def inlet(self, q, outlet, tubes):
+        """Flow-controlled: the inlet pressure and the inlet and outlet radii of the tubes carrying
+        ``q > 0`` with ``outlet`` pressure; a flow rate beyond a tube's maximum raises, naming it."""
+        p_in, radius_in, radius_out = (np.zeros(q.size) for _ in range(3))
+        for index, fluid, wall, tube in self.parts:
+            sol = solve(fluid, wall, tube, flow_rate=q[index], outlet_pressure=outlet[index], on_infeasible="nan")
+            if sol.feasible is not None:
+                j = int(np.flatnonzero(~sol.feasible)[0])
+                limit = np.broadcast_to(tubefsi_max_flow(fluid, wall, tube, outlet_pressure=outlet[index]), index.shape)[j]
+                raise NoSteadyStateError("flow_rate", float(limit), float(q[index][j]),
+                                         f"the inflow into tube {tubes[index[j]].name!r} reaches its maximum flow rate "
+                                         f"at the outlet pressure {outlet[index][j]:.10g} Pa")
+            p_in[index] = sol.inlet_pressure
+            radius_in[index] = sol.inlet_radius
+            radius_out[index] = np.broadcast_to(tube.radius * sol.scene.outlet_stretch, index.shape)
+        return p_in, radius_in, radius_out
+
+    def apparent_viscosity(self, q, mu):
+        """Per tube, the Newtonian viscosity with the fluid's pressure gradient at ``|q|`` in the
+        undeformed tube (``mu`` where q = 0)."""
+        out = mu.copy()
+        for index, fluid, wall, tube in self.parts:
+            qi = np.abs(q[index])
+            ok = qi > 0
+            if np.any(ok):
+                a = np.broadcast_to(tube.radius, index.shape)
+                g = np.asarray(fluid.pressure_gradient(np.where(ok, qi, 1.0), tube.radius), dtype=float)
+                g = np.broadcast_to(g, index.shape)
+                value = g * math.pi * a**4 / (8 * np.where(ok, qi, 1.0))
+                out[index] = np.where(ok & np.isfinite(value) & (value > 0), value, mu[index])
+        return out
+
+    def nominal_viscosity(self, n):
+        mu = np.empty(n)
+        for index, fluid, wall, tube in self.parts:
+            mu[index] = np.broadcast_to(np.asarray(fluid.apparent_viscosity(1.0), dtype=float), index.shape)
+        return mu
+
+
+def _fixed(model):
+    """The values of a model's parameters that cannot be arrays (they split groups)."""
+    return tuple(getattr(model, name) for name in _scalar_fields(type(model)))
+
+
+@functools.cache
+def _scalar_fields(cls):
+    arrays = set(_array_fields(cls))
+    return tuple(f.name for f in attrs.fields(cls) if f.init and f.name not in arrays) if attrs.has(cls) else ()
+
+
+def _column(values):
+    a = np.asarray(values, dtype=float)
+    return float(a[0]) if np.all(a == a[0]) else a
+
+
+def _stack(models):
+    """One model whose array parameters hold the members' values (a scalar where all agree)."""
+    first = models[0]
+    if len(models) == 1 or all(m is first for m in models):
+        return first
+    arrays = {f: _column([getattr(m, f) for m in models]) for f in _array_fields(type(first))}
+    return attrs.evolve(first, **arrays)
+
+
+class _Solver:
+    def __init__(self, net: Network):
+        if not net._tubes:
+            raise InvalidParameterError("network", "at least one tube", 0)
+        for node in list(net._pressure) + list(net._inflow):
+            if node not in net._nodes:
+                raise InvalidParameterError("node", "a node of some tube", node, "it has a pressure or an inflow "
+                                            "but no tube")
+        self.net = net
+        self.tubes = list(net._tubes.values())
+        self.nodes = list(net._nodes)
+        index = net._nodes
+        self.U = np.array([index[t.u] for t in self.tubes])
+        self.V = np.array([index[t.v] for t in self.tubes])
+        n_nodes, n_tubes = len(self.nodes), len(self.tubes)
+        self.fixed = np.zeros(n_nodes, dtype=bool)
+        self.p_fixed = np.zeros(n_nodes)
+        for node, p in net._pressure.items():
+            self.fixed[index[node]], self.p_fixed[index[node]] = True, p
+        self.source = np.zeros(n_nodes)
+        for node, s in net._inflow.items():
+            self.source[index[node]] = s
+        self._check_connected(n_nodes)
+        # a feeder: a node with an inflow and one tube; that tube's flow is known, so it is solved
+        # flow-controlled after the rest (no pressure unknown near a limit pressure at the inlet)
+        degree = np.bincount(self.U, minlength=n_nodes) + np.bincount(self.V, minlength=n_nodes)
+        feeds = ~self.fixed & (self.source > 0) & (degree == 1)
+        self.feeder = feeds[self.U] | feeds[self.V]
+        self.feed_node = np.where(feeds[self.U], self.U, self.V)
+        self.feeds = feeds
+        self.groups = _Groups(self.tubes, ~self.feeder)
+        self.feed_groups = _Groups(self.tubes, self.feeder)
+        self.limit = np.where(self.feeder, self.feed_groups.limit, self.groups.limit)
+        self.radius = np.where(self.feeder, self.feed_groups.radius, self.groups.radius)
+        # a node's bound: the smallest limit pressure of its tubes (an inlet must stay below it)
+        self.p_limit = np.full(n_nodes, np.inf)
+        np.minimum.at(self.p_limit, self.U, self.limit)
+        np.minimum.at(self.p_limit, self.V, self.limit)
+        over = self.fixed & (self.p_fixed >= self.p_limit)
+        if np.any(over):
+            i = int(np.flatnonzero(over)[0])
+            raise NoSteadyStateError("pressure", self.p_limit[i], self.p_fixed[i],
+                                     f"node {self.nodes[i]!r} is fixed at or beyond the limit pressure of tube "
+                                     f"{self._limiting_tube(i)!r}")
+        self.n_tubes = n_tubes
+        self._unknowns(~self.fixed)
+
+    def _check_connected(self, n):
+        graph = sp.coo_matrix((np.ones(self.U.size), (self.U, self.V)), shape=(n, n))
+        count, labels = csgraph.connected_components(graph, directed=False)
+        if not np.any(self.fixed):
+            raise InvalidParameterError("network", "at least one node with a fixed pressure", None,
+                                        "set_pressure(node, p) on an outlet")
+        anchored = np.zeros(count, dtype=bool)
+        anchored[labels[self.fixed]] = True
+        if not np.all(anchored):
+            c = int(np.flatnonzero(~anchored)[0])
+            members = [self.nodes[i] for i in np.flatnonzero(labels == c)]
+            raise InvalidParameterError("network", "every node connected to a node of fixed pressure",
+                                        members[0], f"a component of {len(members)} node(s), disconnected "
+                                        f"from every fixed pressure: {members[:5]!r}")
+
+    def _unknowns(self, mask):
+        """Make the nodes of ``mask`` the unknowns (the rigid start: every free node; Newton: the
+        free nodes but the feeders)."""
+        self.unknown = mask
+        self.free = np.flatnonzero(mask)
+        self.where = np.full(mask.size, -1)
+        self.where[self.free] = np.arange(self.free.size)
+
+    def _limiting_tube(self, i):
+        at = np.flatnonzero((self.U == i) | (self.V == i))
+        return self.tubes[int(at[np.argmin(self.limit[at])])].name
+
+    # ------------------------------------------------------------------ linear algebra
+    def _jacobian(self, gu, gv):
+        """dF/dp over the free nodes from dq_e/dp_u = gu, dq_e/dp_v = gv."""
+        U, V = self.U, self.V
+        rows = np.concatenate([U, U, V, V])
+        cols = np.concatenate([U, V, U, V])
+        vals = np.concatenate([-gu, -gv, gu, gv])
+        keep = self.unknown[rows] & self.unknown[cols]
+        m = self.free.size
+        return sp.csc_matrix((vals[keep], (self.where[rows[keep]], self.where[cols[keep]])), shape=(m, m))
+
+    def _balance(self, q):
+        """Net inflow at every node: sum of q into it - sum out of it + injection."""
+        n = len(self.nodes)
+        return (np.bincount(self.V, q, n) - np.bincount(self.U, q, n)) + self.source
+
+    def _rigid_start(self):
+        """Pressures of the rigid Newtonian network (apparent viscosities, three Picard sweeps)."""
+        a = self.radius
+        length = np.array([t.tube.length for t in self.tubes])
+        mu = np.where(self.feeder, self.feed_groups.nominal_viscosity(self.n_tubes),
+                      self.groups.nominal_viscosity(self.n_tubes))
+        p = self.p_fixed.copy()
+        for sweep in range(4):
+            c = math.pi * a**4 / (8 * mu * length)
+            rhs = self.source.copy()
+            # K p = s with K the weighted Laplacian; move the fixed columns to the right
+            known = np.where(self.fixed, self.p_fixed, 0.0)
+            flow = c * (known[self.U] - known[self.V])
+            rhs += np.bincount(self.V, flow, len(self.nodes)) - np.bincount(self.U, flow, len(self.nodes))
+            jac = self._jacobian(c, -c)
+            p[self.free] = spla.spsolve(jac, -rhs[self.free]) if self.free.size else p[self.free]
+            q = c * (p[self.U] - p[self.V])
+            if sweep < 3:
+                mu = self.feed_groups.apparent_viscosity(q, self.groups.apparent_viscosity(q, mu))
+        self._unknowns(~self.fixed & ~self.feeds)
+        return p, c
+
+    # ------------------------------------------------------------------ Newton
+    def _edges(self, p):
+        du = p[self.U] - p[self.V]
+        forward = du >= 0
+        drop = np.abs(du)
+        drop[drop <= _TINY * float(np.max(p))] = 0.0      # flow ~ (1e-30)^(1/n) of the network's
+        outlet = np.where(forward, p[self.V], p[self.U])
+        q, d_in, d_out, r_in, r_out = self.groups.evaluate(drop, outlet)
+        if self.feed_groups.parts:         # the feeders' known flows (their nodes are no unknowns)
+            forward = np.where(self.feeder, self.feed_node == self.U, forward)
+            q = np.where(self.feeder, self.source[self.feed_node], q)
+            d_in, d_out, drop = (np.where(self.feeder, 0.0, x) for x in (d_in, d_out, drop))
+        sign = np.where(forward, 1.0, -1.0)
+        gu = np.where(forward, d_in, -d_out)
+        gv = np.where(forward, d_out, -d_in)
+        # a tube (almost) without flow: dq/dp -> 0 (shear-thinning) or inf (shear-thickening); the
+        # secant q/dp instead (it zeroes a dead end in one step), the rigid start conductance at dp = 0
+        still = (drop <= _STILL * float(np.max(p))) & ~self.feeder
+        if np.any(still):
+            with np.errstate(divide="ignore", invalid="ignore"):
+                secant = np.where(drop[still] > 0, q[still] / drop[still], self.c[still])
+            secant = np.where(np.isfinite(secant) & (secant > 0), secant, self.c[still])
+            gu[still], gv[still] = secant, -secant
+        r_u, r_v = np.where(forward, r_in, r_out), np.where(forward, r_out, r_in)
+        return sign * q, gu, gv, r_u, r_v
+
+    def _linear_solve(self, jac, rhs):
+        try:
+            return spla.splu(jac).solve(rhs)
+        except RuntimeError as exc:          # an exactly singular Jacobian
+            raise ConvergenceError(f"network: singular Jacobian ({exc})") from None
+
+    def run(self, rtol, max_iterations):
+        p, c = self._rigid_start()
+        self.c = c
+        free = self.free
+        room = np.where(np.isfinite(self.p_limit), self.p_limit, np.inf)
+        p[free] = np.clip(p[free], 0.0, np.where(np.isfinite(room[free]), _TO_BOUND * room[free], np.inf))
+        q, gu, gv, r_u, r_v = self._edges(p)
+        balance = self._balance(q)
+        for iteration in range(max_iterations + 1):
+            F = balance[free]
+            through = self._throughput(balance)
+            worst = float(np.max(np.abs(F), initial=0.0))
+            if worst <= rtol * through or through == 0.0 and worst == 0.0:
+                return self._result(p, q, r_u, r_v, iteration, worst / through if through else 0.0)
+            if iteration == max_iterations:
+                break
+            ju = np.maximum(np.nan_to_num(gu, nan=c, posinf=c / _CLIP), _CLIP * c)
+            jv = -np.maximum(np.nan_to_num(-gv, nan=c, posinf=c / _CLIP), _CLIP * c)
+            step = self._linear_solve(self._jacobian(ju, jv), -F)
+            alpha = self._to_bound(p, step)
+            norm = float(np.linalg.norm(F))
+            while True:
+                trial = p.copy()
+                trial[free] = np.clip(p[free] + alpha * step, 0.0, None)
+                t_q, t_gu, t_gv, t_ru, t_rv = self._edges(trial)
+                t_balance = self._balance(t_q)
+                if np.linalg.norm(t_balance[free]) <= (1 - 1e-4 * alpha) * norm:
+                    break
+                alpha *= 0.5
+                if alpha < 1e-10 and np.all(np.abs(F) <= 10 * self._noise(p, q, gu, gv)):
+                    warn_user(f"network: mass balance to {worst / through:.1e} of the throughput, not rtol = "
+                              f"{rtol:g}: pressures close to a limit pressure amplify the rounding of the "
+                              f"pressures into the flows beyond that", AccuracyWarning)
+                    return self._result(p, q, r_u, r_v, iteration, worst / through)
+                if alpha < 1e-10:
+                    raise ConvergenceError(f"network: the line search stalled after {iteration} Newton iterations; "
+                                           f"largest mass imbalance {worst:.3e} m^3/s = {worst / through:.3e} of the "
+                                           f"throughput (rtol {rtol:g})")
+            p, q, gu, gv, r_u, r_v, balance = trial, t_q, t_gu, t_gv, t_ru, t_rv, t_balance
+        raise ConvergenceError(f"network: no convergence in {max_iterations} Newton iterations; largest mass "
+                               f"imbalance {worst:.3e} m^3/s = {worst / through:.3e} of the throughput (rtol {rtol:g})")
+
+    def _result(self, p, q, r_u, r_v, iterations, residual):
+        if self.feed_groups.parts:
+            other = np.where(self.feed_node == self.U, self.V, self.U)
+            p_in, r_in, r_out = self.feed_groups.inlet(np.where(self.feeder, q * np.where(self.feed_node == self.U,
+                                                                                         1.0, -1.0), 1.0),
+                                                       p[other], self.tubes)
+            p = p.copy()
+            p[self.feed_node[self.feeder]] = p_in[self.feeder]
+            at_u = self.feed_node == self.U
+            r_u = np.where(self.feeder, np.where(at_u, r_in, r_out), r_u)
+            r_v = np.where(self.feeder, np.where(at_u, r_out, r_in), r_v)
+        return NetworkSolution(net=self.net, nodes=self.nodes, tubes=self.tubes, p=p, q=q, radius_u=r_u,
+                               radius_v=r_v, iterations=iterations, residual=residual)
+
+    def _noise(self, p, q, gu, gv):
+        """Per free node, the mass imbalance that rounding alone leaves: the pressures' rounding
+        through the tubes' conductances plus the flows' own relative accuracy (~1e-14)."""
+        n = len(self.nodes)
+        per_tube = 4 * np.finfo(float).eps * (np.abs(gu * p[self.U]) + np.abs(gv * p[self.V])) + 1e-14 * np.abs(q)
+        return (np.bincount(self.U, per_tube, n) + np.bincount(self.V, per_tube, n))[self.free]
+
+    def _throughput(self, balance):
+        """The flow that enters the network: injections plus what the fixed nodes supply."""
+        supplied = np.where(self.fixed, -balance, self.source)
+        return float(np.sum(np.maximum(supplied, 0.0)))
+
+    def _to_bound(self, p, step):
+        """The largest step fraction (<= 1) that goes at most 90 % of the way to a bound; raises
+        when a node sits at a bound and the step still pushes outward."""
+        pf, lim = p[self.free], self.p_limit[self.free]
+        up = step > 0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            gap_up = np.where(up, lim - pf, np.inf)
+            gap_down = np.where(~up, pf, np.inf)
+            frac = np.where(up, _TO_BOUND * gap_up / step, _TO_BOUND * gap_down / -step)
+        frac = np.where(step == 0, np.inf, frac)
+        i = int(np.argmin(frac))
+        if frac[i] >= 1:
+            return 1.0
+        node = int(self.free[i])
+        if up[i] and gap_up[i] <= _AT_BOUND * lim[i]:
+            tube = self._limiting_tube(node)
+            raise NoSteadyStateError("pressure", float(lim[i]), float(pf[i]),
+                                     f"tube {tube!r} reaches its limit pressure at node {self.nodes[node]!r} "
+                                     f"(to {_AT_BOUND:g} relative): no steady state below it carries these inflows")
+        if not up[i] and gap_down[i] <= _AT_BOUND * max(float(np.max(p)), 1e-300):
+            raise InvalidParameterError("inflow", "inflows that keep every pressure >= 0 (tubefsi models "
+                                        "inflation, not collapse)", self.nodes[node],
+                                        f"node {self.nodes[node]!r} would need a negative transmural pressure")
+        return float(frac[i])
+
+
+@attrs.frozen(kw_only=True, repr=False, eq=False)
+class NetworkSolution:
+    """The steady state of a :class:`Network`.
+
+    Attributes
+    ----------
+    pressure : dict
+        node -> pressure (Pa).
+    flow_rate : dict
+        tube name -> flow rate (m^3/s), positive from the tube's ``u`` to its ``v``.
+    iterations : int
+        Newton iterations taken.
+    residual : float
+        The largest mass imbalance of a free node over the throughput.
+    """
+
+    net: Network
+    nodes: list
+    tubes: list
+    p: np.ndarray
+    q: np.ndarray
+    radius_u: np.ndarray
+    radius_v: np.ndarray
+    iterations: int
+    residual: float
+
+    @property
+    def pressure(self) -> dict:
+        return dict(zip(self.nodes, self.p.tolist()))
+
+    @property
+    def flow_rate(self) -> dict:
+        return {t.name: q for t, q in zip(self.tubes, self.q.tolist())}
+
+    @property
+    def tube_names(self) -> list:
+        return [t.name for t in self.tubes]
+
+    @property
+    def pressures(self) -> np.ndarray:
+        """Node pressures (Pa) in the order of :attr:`nodes`."""
+        return self.p.copy()
+
+    @property
+    def flow_rates(self) -> np.ndarray:
+        """Tube flow rates (m^3/s) in the order of :attr:`tube_names`."""
+        return self.q.copy()
+
+    def solution(self, name) -> Solution:
+        """The full single-tube :class:`~tubefsi.Solution` of tube ``name`` (profiles included): its
+        flow rate at its outlet pressure, oriented from its higher-pressure end (``z = 0`` is ``u``
+        if the flow runs u -> v, else ``v``)."""
+        t = self.net._tubes.get(name) if _hashable(name) else None
+        if t is None:
+            raise InvalidParameterError("name", "the name of a tube of the network", name)
+        pu, pv = self.pressure[t.u], self.pressure[t.v]
+        return solve(t.rheology, t.wall, t.tube, flow_rate=abs(self.flow_rate[name]), outlet_pressure=min(pu, pv))
+
+    def node_table(self) -> dict:
+        """Columns ``node``, ``pressure`` (Pa), ``inflow`` (m^3/s, net flow injected; at a fixed
+        node, what the boundary supplies) and ``fixed``."""
+        n = len(self.nodes)
+        U = np.array([self.net._nodes[t.u] for t in self.tubes])
+        V = np.array([self.net._nodes[t.v] for t in self.tubes])
+        injected = np.bincount(U, self.q, n) - np.bincount(V, self.q, n)
+        return {"node": list(self.nodes), "pressure": self.p.tolist(), "inflow": injected.tolist(),
+                "fixed": [node in self.net._pressure for node in self.nodes]}
+
+    def tube_table(self) -> dict:
+        """Columns ``name``, ``u``, ``v``, ``flow_rate`` (m^3/s), ``pressure_u``, ``pressure_v``
+        (Pa), ``radius_u``, ``radius_v`` (deformed inner radii at the two ends, m) and ``length`` (m)."""
+        p = self.pressure
+        return {"name": self.tube_names, "u": [t.u for t in self.tubes], "v": [t.v for t in self.tubes],
+                "flow_rate": self.q.tolist(), "pressure_u": [p[t.u] for t in self.tubes],
+                "pressure_v": [p[t.v] for t in self.tubes], "radius_u": self.radius_u.tolist(),
+                "radius_v": self.radius_v.tolist(), "length": [t.tube.length for t in self.tubes]}
+
+    def to_csv(self, prefix) -> tuple:
+        """Write ``<prefix>_nodes.csv`` and ``<prefix>_tubes.csv``; returns the two paths."""
+        paths = (f"{prefix}_nodes.csv", f"{prefix}_tubes.csv")
+        for path, table in zip(paths, (self.node_table(), self.tube_table())):
+            with open(path, "w", newline="", encoding="utf-8") as fh:
+                writer = csv.writer(fh)
+                writer.writerow(list(table))
+                for row in zip(*table.values()):
+                    writer.writerow([_text(x) if not isinstance(x, float) else repr(x) for x in row])
+        return paths
+
+    def to_json(self, path=None) -> str:
+        """The node and tube tables as JSON (node and tube names as text); written to ``path`` if given."""
+        data = {"nodes": _records(self.node_table()), "tubes": _records(self.tube_table()),
+                "iterations": self.iterations, "residual": self.residual}
+        text = json.dumps(data, indent=1)
+        if path is not None:
+            with open(path, "w", encoding="utf-8") as fh:
+                fh.write(text)
+        return text
+
+    def plot(self, **kwargs):
+        """The network coloured by pressure, tubes as wide as their deformed radius; see
+        :func:`tubefsi.plotting.plot_network`."""
+        from .plotting import plot_network
+
+        return plot_network(self, **kwargs)
+
+    def __repr__(self) -> str:
+        return (f"NetworkSolution({len(self.nodes)} nodes, {len(self.tubes)} tubes, "
+                f"{self.iterations} iterations, residual {self.residual:.2e})")
+
+
+def _hashable(x) -> bool:
+    try:
+        hash(x)
+    except TypeError:
+        return False
+    return True
+
+
+def _text(x):
+    return x if isinstance(x, (str, int, bool)) else str(x)
+
+
+def _records(table):
+    return [{k: (v if isinstance(v, (float, int, bool, str)) else str(v)) for k, v in zip(table, row)}
+            for row in zip(*table.values())]
