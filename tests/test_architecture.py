@@ -23,7 +23,7 @@ LAYERS = [
     {"tubefsi.geometry", "tubefsi.rheology", "tubefsi.walls"},
     {"tubefsi.scene"},
     {"tubefsi.couplers"},
-    {"tubefsi.solution"},
+    {"tubefsi.solution", "tubefsi.validity"},
     {"tubefsi.solve"},
     {"tubefsi.advise", "tubefsi.fit", "tubefsi.dimensionless"},
     {"tubefsi.chapter", "tubefsi.plotting"},

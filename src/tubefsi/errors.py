@@ -17,7 +17,9 @@ __all__ = [
     "InvalidParameterError",
     "NoSteadyStateError",
     "ConvergenceError",
+    "StretchRangeError",
     "AccuracyWarning",
+    "ModelValidityWarning",
     "warn_user",
 ]
 
@@ -68,6 +70,26 @@ class NoSteadyStateError(TubefsiError, ValueError):
         )
 
 
+class StretchRangeError(InvalidParameterError):
+    """A flow rate the model answers but the solver does not: its inlet stretch would exceed
+    ``MAX_STRETCH`` (``1e15``) times the outlet stretch.
+
+    Not a physical limit: :func:`tubefsi.max_flow_rate` (the one limit, ``inf`` here) says a
+    steady state exists, but a tube inflated that far left the model's assumptions (a slender
+    tube, ``R/L`` small) long before (``docs/theory.md``, section "The maximum flow rate").
+
+    Attributes
+    ----------
+    limit : float
+        The largest flow rate within the solver's range at that point (m^3/s).
+    """
+
+    def __init__(self, limit: float, value=None, detail: str = ""):
+        self.limit = float(limit)
+        super().__init__("flow_rate", f"[0, {self.limit:.6g}] m^3/s, the flow rates whose inlet stretch stays "
+                         "below 1e15 (the solver's range, not a physical limit)", value, detail)
+
+
 class ConvergenceError(TubefsiError, ArithmeticError):
     """An iterative method did not reach its tolerance (a non-default method's failure)."""
 
@@ -81,6 +103,16 @@ def _short(value) -> str:
 
 class AccuracyWarning(UserWarning):
     """A non-default method's result is less accurate than its tolerance promises."""
+
+
+class ModelValidityWarning(UserWarning):
+    """A result leaves an assumption of the model (a slender tube, small strain for a linear
+    wall, the wall law's calibrated range, a small reduced Reynolds number...).
+
+    :func:`tubefsi.solve` issues it for the deformed tube; silence it with the standard
+    filter, ``warnings.filterwarnings("ignore", category=tubefsi.ModelValidityWarning)``
+    (``docs/scope.md``).
+    """
 
 
 _PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__))

@@ -40,6 +40,8 @@ class Solution:
     coupler_name: str = ""
     #: Where ``solve(..., on_infeasible="nan")`` found a steady state (None: everywhere).
     feasible: object = None
+    #: The fluid density given to ``solve`` (kg/m^3; None if not given), for the Reynolds number.
+    density: object = None
 
     # ------------------------------------------------------------------ loads
     @property
