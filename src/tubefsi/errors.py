@@ -45,7 +45,9 @@ class InvalidParameterError(TubefsiError, ValueError):
         self.value = value
         got = "" if value is None else f" (got {_short(value)})"
         extra = f"; {detail}" if detail else ""
-        super().__init__(f"{parameter} must be in {admissible}{got}{extra}")
+        # a range or a set reads "must be in [0, inf)"; a description "must be a coupler that ..."
+        joiner = "in " if admissible[:1] in "[({" or admissible.startswith("the ") else ""
+        super().__init__(f"{parameter} must be {joiner}{admissible}{got}{extra}")
 
 
 class NoSteadyStateError(TubefsiError, ValueError):
@@ -59,14 +61,15 @@ class NoSteadyStateError(TubefsiError, ValueError):
         The limit (Pa or m^3/s) that the load must stay below.
     """
 
-    def __init__(self, quantity: str, limit: float, value=None, detail: str = ""):
+    def __init__(self, quantity: str, limit: float, value=None, detail: str = "", *, name: str = ""):
         self.quantity = quantity
         self.limit = float(limit)
-        got = "" if value is None else f" (got {_short(value)})"
         unit = "Pa" if quantity == "pressure" else "m^3/s"
+        got = "" if value is None else f" (got {_short(value)} {unit})"
         extra = f"; {detail}" if detail else ""
+        what = "the limit pressure" if quantity == "pressure" else "the maximum flow rate"
         super().__init__(
-            f"no steady state: {quantity} must stay below its limit {self.limit:.10g} {unit}{got}{extra}"
+            f"no steady state: {name or quantity} must stay below {what} {self.limit:.10g} {unit}{got}{extra}"
         )
 
 

@@ -14,6 +14,7 @@ import attrs
 import numpy as np
 
 from . import registry
+from ._progress import bar
 from ._validation import as_load
 from .couplers.base import Coupler
 from .couplers.checked import checked
@@ -65,7 +66,7 @@ def select_coupler(rheology, wall, coupler="auto") -> Coupler:
 
 
 def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="auto",
-          outlet_pressure=0.0, on_infeasible="raise", density=None) -> Solution:
+          outlet_pressure=0.0, on_infeasible="raise", density=None, progress=False) -> Solution:
     r"""Solve steady flow of ``rheology`` through ``tube`` with wall ``wall``.
 
     Exactly one of ``flow_rate`` (flow-controlled) and ``pressure_drop``
@@ -93,6 +94,9 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
         ``"nan"`` gives that point NaN results and ``False`` in :attr:`Solution.feasible`.
     density : float or array_like, optional
         The fluid's density (kg/m^3): adds the reduced Reynolds number to the validity checks.
+    progress : bool or "auto"
+        Show a progress bar over the points (tqdm, ``pip install 'tubefsi[progress]'``) for a
+        long sweep; ``"auto"``: only if tqdm is installed and standard error is a terminal.
 
     Every result is checked against the model's assumptions on the *deformed* tube
     (:mod:`tubefsi.validity`: slenderness :math:`R_{in}/L`, the wall law's calibrated strain,
@@ -116,7 +120,7 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
     """
     if (type(flow_rate) is float and pressure_drop is None and type(coupler) is str and coupler == "auto"
             and type(outlet_pressure) is float and outlet_pressure == 0.0 and on_infeasible == "raise"
-            and density is None):
+            and density is None and progress is False):
         fast = _scalar_flow(rheology, wall, tube, flow_rate)
         if fast is not None:
             return fast
@@ -140,6 +144,7 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
     n = values.size
     out = {f.name: np.full(n, np.nan) for f in attrs.fields(State)}
     feasible = np.ones(n, dtype=bool)
+    shown = bar(n, progress, "tubefsi.solve")
     for index, part in flat.split(np.arange(n)):
         for start in range(0, index.size, CHUNK):
             idx = index[start:start + CHUNK]
@@ -149,18 +154,22 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
             if ok is not None:
                 feasible[idx] = ok
             if go.size == 0:
+                shown.update(idx.size)
                 continue
             sub = chunk if go.size == idx.size else (chunk.take(go) if chunk.size > 1 else chunk)
             state = method(sub, values[idx][go])
             for name in out:
                 out[name][idx[go]] = np.broadcast_to(np.asarray(getattr(state, name), dtype=float), go.shape)
+            shown.update(idx.size)
+    shown.close()
     if density is not None:
         density = float(rho) if rho.ndim == 0 else np.broadcast_to(rho, shape).ravel()
     warn(check(flat, out["flow_rate"], out["inlet_strain"], density=density))
     state = State(*(out[f.name].reshape(shape) for f in attrs.fields(State)))
     return Solution(scene=scene, coupler=chosen, state=state, scalar=shape == (),
                     coupler_name=registry.couplers.name_of(chosen) or type(chosen).__name__,
-                    feasible=None if np.all(feasible) else feasible.reshape(shape), density=density)
+                    feasible=None if np.all(feasible) else feasible.reshape(shape), density=density,
+                    controlled=controlled)
 
 
 _SUBCLASS: dict = {}
@@ -233,7 +242,7 @@ def _feasible(coupler, scene, load, controlled, *, raise_):
             return None
         beyond = load >= limit
         limit = limit + np.asarray(scene.outlet_pressure)
-        quantity, detail = "pressure", "the inlet pressure, outlet pressure + pressure drop, reaches it"
+        quantity, detail = "pressure", "the inlet pressure is the outlet pressure plus the pressure drop"
     beyond = np.broadcast_to(beyond, load.shape)
     if not np.any(beyond):
         return None
@@ -241,7 +250,8 @@ def _feasible(coupler, scene, load, controlled, *, raise_):
         i = int(np.argmax(beyond))
         value = float(load[i]) if quantity == "flow_rate" else float(
             np.broadcast_to(np.asarray(scene.outlet_pressure), load.shape)[i] + load[i])
-        raise NoSteadyStateError(quantity, float(np.broadcast_to(limit, load.shape)[i]), value, detail)
+        raise NoSteadyStateError(quantity, float(np.broadcast_to(limit, load.shape)[i]), value, detail,
+                                 name="the flow rate" if quantity == "flow_rate" else "the inlet pressure")
     return ~beyond
 
 
