@@ -77,15 +77,19 @@ class StretchRangeError(InvalidParameterError):
     """A flow rate the model answers but the solver does not: its inlet stretch would exceed
     ``MAX_STRETCH`` (``1e15``) times the outlet stretch.
 
-    Not a physical limit: :func:`tubefsi.max_flow_rate` (the one limit, ``inf`` here) says a
-    steady state exists, but a tube inflated that far left the model's assumptions (a slender
-    tube, ``R/L`` small) long before (``docs/theory.md``, section "The maximum flow rate").
+    Not a physical limit: the flow rate is below :func:`tubefsi.max_flow_rate` (the one limit,
+    often ``inf`` then), so a steady state exists, but a tube inflated that far left the model's
+    assumptions (a slender tube, ``R/L`` small) long before (``docs/theory.md``, section "The
+    maximum flow rate"; ``docs/scope.md``).
 
     Attributes
     ----------
     limit : float
         The largest flow rate within the solver's range at that point (m^3/s).
     """
+
+    #: The load the range bounds (as :attr:`NoSteadyStateError.quantity`).
+    quantity = "flow_rate"
 
     def __init__(self, limit: float, value=None, detail: str = ""):
         self.limit = float(limit)

@@ -18,7 +18,7 @@ import numpy as np
 from .errors import InvalidParameterError
 from .fields import _array_fields, parameters
 
-__all__ = ["RESULTS", "Table", "table"]
+__all__ = ["RESULTS", "Table", "table", "to_dataframe", "to_xarray", "to_quantities"]
 
 #: The results of every solution, with their units (the columns of the command line's tables).
 RESULTS = {
@@ -147,3 +147,12 @@ def to_xarray(solution, dims=None):
     coords = {name: (d, values, {"units": t.units[name]}) for name, (d, values) in t.coords.items()}
     data = {name: (t.dims, values, {"units": t.units[name]}) for name, values in t.data.items()}
     return xr.Dataset(data, coords=coords, attrs=t.attrs)
+
+
+def to_quantities(solution, registry=None) -> dict:
+    """The results as :class:`pint.Quantity` objects (``registry``: a :class:`pint.UnitRegistry`,
+    default pint's application registry), keyed as :data:`RESULTS`."""
+    pint = _require("pint", "units")
+    registry = registry or pint.get_application_registry()
+    return {name: registry.Quantity(getattr(solution, name), unit.replace("^", "**"))
+            for name, unit in RESULTS.items()}

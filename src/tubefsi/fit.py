@@ -11,12 +11,13 @@ errors come from the Gauss–Newton covariance :math:`s^2 (J^T J)^{-1}`,
 from __future__ import annotations
 
 import math
+import warnings
 
 import attrs
 import numpy as np
 from scipy import optimize
 
-from .errors import InvalidParameterError, TubefsiError
+from .errors import InvalidParameterError, ModelValidityWarning, TubefsiError
 from .scene import make_scene
 from .solve import max_flow_rate, solve
 
@@ -113,8 +114,10 @@ def fit(flow_rate, pressure_drop, rheology, wall, tube, *, parameters, outlet_pr
         ok = q < q_max
         out = np.empty_like(q)
         if np.any(ok):
-            out[ok] = solve(m["rheology"], m["wall"], tube, flow_rate=q[ok], outlet_pressure=outlet_pressure,
-                            coupler=coupler).pressure_drop
+            with warnings.catch_warnings():    # trial points: validity is the fitted model's business
+                warnings.simplefilter("ignore", ModelValidityWarning)
+                out[ok] = solve(m["rheology"], m["wall"], tube, flow_rate=q[ok], outlet_pressure=outlet_pressure,
+                                coupler=coupler).pressure_drop
         if not np.all(ok):
             out[~ok] = m["wall"].limit_pressure(tube.reduced_thickness) - outlet_pressure
         return out

@@ -221,6 +221,13 @@ class Solution:
         (``pip install 'tubefsi[xarray]'``); ``dataset.to_netcdf(path)`` writes NetCDF."""
         return export.to_xarray(self, dims)
 
+    def to_quantities(self, registry=None) -> dict:
+        """Pressure drop, flow rate, inlet pressure, inlet displacement and inlet radius as
+        :class:`pint.Quantity` objects (``pip install 'tubefsi[units]'``; ``registry`` a
+        :class:`pint.UnitRegistry`, default pint's application registry). Every argument of
+        ``solve`` and of the models may be a Quantity too: it is converted to SI on the way in."""
+        return export.to_quantities(self, registry)
+
     # ------------------------------------------------------------------ accessors (upper layers)
     def diagnostics(self, *, density=None, warn=True):
         """Validity of the model's assumptions for this solution.

@@ -587,8 +587,9 @@ class SeparatedVariables(Coupler):
         if float(cap[0]) < MAX_LOG_STRETCH:
             raise NoSteadyStateError("flow_rate", reach, q_bad,
                                      "the inlet stretch would reach the wall's maximum stretch")
-        raise StretchRangeError(reach, q_bad, "a steady state exists (max_flow_rate is inf) but its inlet "
-                                "stretch exceeds 1e15, and R/L far exceeds 0.1 there: the model no longer applies")
+        limit = "max_flow_rate is inf" if not math.isfinite(q_max) else f"below max_flow_rate = {q_max:.6g} m^3/s"
+        raise StretchRangeError(reach, q_bad, f"a steady state exists ({limit}) but its inlet stretch exceeds "
+                                "1e15, and R/L far exceeds 0.1 there: the model no longer applies")
 
 
 @functools.lru_cache(maxsize=256)
