@@ -15,7 +15,7 @@ API = Path(__file__).resolve().parents[1] / "docs" / "api.rst"
 PUBLIC_MODULES = [
     "tubefsi", "tubefsi.fields", "tubefsi.scene", "tubefsi.couplers", "tubefsi.walls", "tubefsi.rheology",
     "tubefsi.registry", "tubefsi.errors", "tubefsi.advise", "tubefsi.fit", "tubefsi.network", "tubefsi.dimensionless",
-    "tubefsi.chapter", "tubefsi.plotting", "tubefsi.cli", "tubefsi.testing",
+    "tubefsi.chapter", "tubefsi.plotting", "tubefsi.cli", "tubefsi.testing", "tubefsi.validity", "tubefsi.export",
 ]
 
 _DIRECTIVE = re.compile(r"^\.\. (autofunction|autoclass|automodule|py:data):: (\S+)\s*$")

@@ -23,12 +23,14 @@ import importlib
 import sys
 import types
 
-from .errors import AccuracyWarning, ConvergenceError, InvalidParameterError, NoSteadyStateError, TubefsiError
+from .errors import (AccuracyWarning, ConvergenceError, InvalidParameterError, ModelValidityWarning,
+                     NoSteadyStateError, StretchRangeError, TubefsiError)
 
 __all__ = [
     "dimensionless", "fields", "Tube", "solve", "max_flow_rate", "select_coupler", "Solution", "registry",
     "advise", "Advice", "Diagnostics", "ModelValidityWarning", "fit", "FitResult", "Network", "NetworkSolution",
     "TubefsiError", "InvalidParameterError", "NoSteadyStateError", "ConvergenceError", "AccuracyWarning",
+    "StretchRangeError",
 ]
 
 __version__ = "0.1.0"
@@ -38,7 +40,7 @@ _LAZY = {
     "dimensionless": None, "fields": None, "registry": None,
     "Tube": "geometry", "Solution": "solution",
     "solve": "solve", "max_flow_rate": "solve", "select_coupler": "solve",
-    "advise": "advise", "Advice": "advise", "Diagnostics": "advise", "ModelValidityWarning": "advise",
+    "advise": "advise", "Advice": "advise", "Diagnostics": "advise",
     "fit": "fit", "FitResult": "fit",
     "Network": "network", "NetworkSolution": "network",
 }

@@ -10,11 +10,13 @@ import math
 
 import numpy as np
 
+from ._units import to_si
 from .errors import InvalidParameterError
 
 
 def as_load(name, value, *, allow_zero=True):
     """Convert a flow rate / pressure to a float array; reject negative, NaN, inf."""
+    value = to_si(name, value)
     try:
         a = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
@@ -30,6 +32,7 @@ def as_load(name, value, *, allow_zero=True):
 
 def as_array(name, value, admissible, predicate):
     """Convert to a float array and check ``predicate`` elementwise."""
+    value = to_si(name, value)
     try:
         a = np.asarray(value, dtype=float)
     except (TypeError, ValueError):

@@ -23,20 +23,17 @@ from typing import Any
 import attrs
 import numpy as np
 
-from . import registry
-from .errors import InvalidParameterError, NoSteadyStateError, TubefsiError
+from . import registry, validity
+from ._validation import as_load
+from .errors import InvalidParameterError, ModelValidityWarning, NoSteadyStateError, TubefsiError, warn_user
 from .rheology.power_law import _PowerLawForms
 from .scene import make_scene
-from .solve import solve
+from .solve import max_flow_rate, solve
 from .walls.hyperelastic import HyperelasticWall, ThickWall, ThinWall
 from .walls.linear import ThickLinear, ThinLinear
 from .walls.rigid import Rigid
 
 __all__ = ["advise", "Advice", "Candidate", "diagnostics", "Diagnostics", "ModelValidityWarning"]
-
-
-class ModelValidityWarning(UserWarning):
-    """An assumption of the model (slenderness, small strain, low Reynolds number...) fails."""
 
 
 @attrs.frozen
@@ -47,8 +44,8 @@ class Candidate:
     rheology: Any
     wall: Any
     rank: int                     # lower = simpler/cheaper
-    pressure_drop: float
-    relative_difference: float    # |dp / dp_requested - 1|
+    pressure_drop: float          # or an array, for an array of loads
+    relative_difference: float    # |dp / dp_requested - 1|, the largest over the loads
     seconds: float
     note: str = ""
 
@@ -63,11 +60,15 @@ class Advice:
     tolerance: float
 
     def __str__(self) -> str:
-        lines = [f"{'model':58s} {'pressure drop (Pa)':>19s} {'rel. diff':>10s}  ok"]
+        curve = np.ndim(self.requested.pressure_drop) > 0
+        width = max([58] + [len(c.label) for c in self.candidates])
+        head = "max pressure drop (Pa)" if curve else "pressure drop (Pa)"
+        lines = [f"{'model':{width}s} {head:>22s} {'max rel. diff' if curve else 'rel. diff':>13s}  ok"]
         for c in self.candidates:
             ok = "yes" if c.relative_difference <= self.tolerance else ("-" if math.isnan(c.relative_difference) else "no")
             mark = "  <- recommended" if c is self.recommended else ""
-            lines.append(f"{c.label:58s} {c.pressure_drop:19.6g} {c.relative_difference:10.2e}  {ok}{mark}"
+            dp = float(np.max(c.pressure_drop))
+            lines.append(f"{c.label:{width}s} {dp:22.6g} {c.relative_difference:13.2e}  {ok}{mark}"
                          + (f" ({c.note})" if c.note else ""))
         return "\n".join(lines)
 
@@ -81,8 +82,8 @@ def _material(wall):
     return None
 
 
-def _thin_counterpart(wall):
-    """The registered thin (current-thickness) wall of the same material, if any."""
+def _thin_counterpart(wall, convention="current"):
+    """The registered thin wall of the same material with the thickness ``convention``, if any."""
     material = _material(wall)
     if material is None:
         return None
@@ -90,7 +91,7 @@ def _thin_counterpart(wall):
         cls = registry.walls[name]
         if issubclass(cls, ThinWall) and issubclass(cls, material):
             kwargs = {f.name: getattr(wall, f.name) for f in attrs.fields(material)}
-            return cls(**kwargs, thickness_convention="current")
+            return cls(**kwargs, thickness_convention=convention)
     return None
 
 
@@ -115,9 +116,12 @@ def _candidates(rheology, wall, tube, load):
         out.append((1, f"{registry.walls.name_of(lin)}, E = {lin.youngs_modulus:.4g} Pa, nu = 1/2 (same P'(1))",
                     rheology, lin))
         if isinstance(wall, ThickWall):
-            thin = _thin_counterpart(wall)
-            if thin is not None:
-                out.append((3, f"{registry.walls.name_of(thin)} (current thickness)", rheology, thin))
+            for convention, why in (("current", "the thick law's thin limit"),
+                                    ("reference", "the thin walls' default; first-order agreement only")):
+                thin = _thin_counterpart(wall, convention)
+                if thin is not None:
+                    out.append((3, f"{registry.walls.name_of(thin)}:thickness_convention={convention} ({why})",
+                                rheology, thin))
     rank = {ThinLinear: 1, ThickLinear: 1}.get(type(wall), 4 if isinstance(wall, ThickWall) else 3)
     rank = 0 if wall.is_rigid else rank
     out = [c for c in out if c[0] < rank]
@@ -143,13 +147,23 @@ def advise(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, toleranc
            outlet_pressure=0.0) -> Advice:
     """Compare the requested model with simpler ones on the same scene.
 
+    The candidates: a rigid wall; the linear wall of the same theory with the same
+    small-strain slope; for a thick hyperelastic wall, the thin wall of the same material in
+    both thickness conventions — ``current`` (the thick law's limit as t/a -> 0, with the
+    same limit pressure) and ``reference`` (the default of the thin walls: no limit pressure,
+    equal to the others to first order in strain only; ``docs/theory.md``, section "Thin
+    walls"), each labelled with the exact ``thickness_convention`` it uses; and a Newtonian
+    fluid for a power law with an index within 0.2 of 1.
+
     Parameters
     ----------
     rheology, wall, tube
         The requested model, as for :func:`tubefsi.solve`.
-    flow_rate, pressure_drop : float
-        The load (exactly one). For a pressure drop, candidates are compared on the
-        pressure drop that the requested model needs for the flow rate it predicts.
+    flow_rate, pressure_drop : float or array_like
+        The load (exactly one), a value or an array of values (a curve): models are then
+        compared on their largest relative difference over the loads. For a pressure drop,
+        candidates are compared on the pressure drop that the requested model needs for the
+        flow rate it predicts.
     tolerance : float
         Largest acceptable relative difference in pressure drop.
 
@@ -157,7 +171,8 @@ def advise(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, toleranc
     -------
     Advice
         ``recommended`` is the simplest candidate within ``tolerance``; ``str(advice)``
-        prints the comparison table.
+        prints the comparison table. The candidates' ``solve`` calls are silent: the
+        requested model's own solve issues any :class:`~tubefsi.ModelValidityWarning`.
     """
     scene = make_scene(rheology, wall, tube, outlet_pressure=outlet_pressure)
     rheology, wall = scene.rheology, scene.wall
@@ -165,6 +180,9 @@ def advise(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, toleranc
         raise InvalidParameterError("flow_rate / pressure_drop", "exactly one of the two", None)
     if not (isinstance(tolerance, (int, float)) and math.isfinite(tolerance) and tolerance >= 0):
         raise InvalidParameterError("tolerance", "[0, inf)", tolerance)
+    if scene.shape != ():
+        raise InvalidParameterError("rheology / wall / tube", "scalar parameters (advise compares one scene)",
+                                    None, f"got parameters of shape {scene.shape}; call advise per scene")
     if flow_rate is None:
         flow_rate = solve(rheology, wall, tube, pressure_drop=pressure_drop,
                           outlet_pressure=outlet_pressure).flow_rate
@@ -176,16 +194,26 @@ def advise(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, toleranc
     for rank, label, fluid, w in _candidates(rheology, wall, tube, load):
         start = time.perf_counter()
         try:
-            dp = float(solve(fluid, w, tube, flow_rate=flow_rate, outlet_pressure=outlet_pressure).pressure_drop)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", ModelValidityWarning)
+                dp = solve(fluid, w, tube, flow_rate=flow_rate, outlet_pressure=outlet_pressure).pressure_drop
             note = ""
         except (NoSteadyStateError, TubefsiError) as exc:
             dp, note = math.nan, f"{type(exc).__name__}"
         results.append([rank, label, fluid, w, dp, time.perf_counter() - start, note])
         if w is wall and fluid is rheology:
             reference = dp
+
+    def difference(dp):
+        if np.ndim(dp) == 0 and math.isnan(dp):
+            return math.nan
+        with np.errstate(invalid="ignore", divide="ignore"):
+            rel = np.abs(np.asarray(dp) / reference - 1.0)
+        rel = np.where(np.asarray(reference) == np.asarray(dp), 0.0, rel)   # q = 0: both 0
+        return float(np.max(rel))
+
     cands = tuple(Candidate(label=label, rheology=fluid, wall=w, rank=int(rank), pressure_drop=dp,
-                            relative_difference=abs(dp / reference - 1.0) if math.isfinite(dp) else math.nan,
-                            seconds=sec, note=note)
+                            relative_difference=difference(dp), seconds=sec, note=note)
                   for rank, label, fluid, w, dp, sec, note in results)
     requested = next(c for c in cands if c.wall is wall and c.rheology is rheology)
     recommended = next(c for c in cands if c.relative_difference <= tolerance)
@@ -196,62 +224,58 @@ def advise(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, toleranc
 class Diagnostics:
     """Validity of a solution's assumptions; ``warnings`` lists what fails."""
 
-    slenderness: float
-    max_strain: float
+    slenderness: float                  # undeformed a / L
+    max_strain: float                   # largest inlet hoop strain
     inlet_pressure_fraction: float      # p_in / limit pressure (0 if no limit)
     flow_rate_fraction: float           # q / maximum flow rate (0 if none)
-    reynolds_number: float | None       # Metzner–Reed, with the given density
-    reduced_reynolds_number: float | None   # Re * a / L, what lubrication needs small
+    reynolds_number: float | None       # Metzner–Reed, with the given density, where Re R/L is largest
+    reduced_reynolds_number: float | None   # Re * R / L, what lubrication needs small
     warnings: tuple
+    deformed_slenderness: float = math.nan   # largest R_in / L: the deformed tube's
 
     def __str__(self) -> str:
-        rows = [("slenderness a/L", self.slenderness), ("max hoop strain", self.max_strain),
+        rows = [("slenderness a/L", self.slenderness), ("deformed slenderness R/L", self.deformed_slenderness),
+                ("max hoop strain", self.max_strain),
                 ("p_in / limit pressure", self.inlet_pressure_fraction),
                 ("q / max flow rate", self.flow_rate_fraction),
-                ("Reynolds number", self.reynolds_number), ("reduced Reynolds Re a/L", self.reduced_reynolds_number)]
+                ("Reynolds number", self.reynolds_number), ("reduced Reynolds Re R/L", self.reduced_reynolds_number)]
         text = "\n".join(f"{k:26s} {'n/a' if v is None else f'{v:.4g}'}" for k, v in rows)
         return text + "".join(f"\nwarning: {w}" for w in self.warnings)
 
 
 def diagnostics(solution, *, density=None, warn=True) -> Diagnostics:
-    """Check a :class:`~tubefsi.Solution`'s assumptions (see :meth:`tubefsi.Solution.diagnostics`)."""
-    tube, wall = solution.tube, solution.wall
+    """Check a :class:`~tubefsi.Solution`'s assumptions on the deformed tube (see
+    :meth:`tubefsi.Solution.diagnostics` and :mod:`tubefsi.validity`), and how close it is to
+    the limit pressure and the maximum flow rate."""
+    tube, wall, st = solution.tube, solution.wall, solution.state
     tb = tube.reduced_thickness
-    messages = []
-    eps = tube.slenderness
-    if eps > 0.1:
-        messages.append(f"the tube is not slender (a/L = {eps:.3g} > 0.1): lubrication theory is inaccurate")
-    strain = float(np.max(solution.state.inlet_strain))
-    if isinstance(wall, (ThinLinear, ThickLinear)) and strain > 0.05:
-        messages.append(f"hoop strain {strain:.3g} > 0.05 with a linear wall: use a hyperelastic wall")
-    if isinstance(wall, ThinWall) and tb > 0.1:
-        messages.append(f"thin-wall theory with t/a = {tb:.3g} > 0.1: use the thick wall")
-    limit = wall.limit_pressure(tb)
-    p_frac = float(np.max(solution.outlet_pressure + solution.state.pressure_drop)) / limit
-    if p_frac > 0.9:
-        messages.append(f"inlet pressure at {100 * p_frac:.1f} % of the limit pressure {limit:.4g} Pa: "
-                        "the tube is close to unbounded inflation")
-    q_max = solution.max_flow_rate
-    q_frac = float(np.max(solution.state.flow_rate)) / q_max
-    if q_frac > 0.9:
-        messages.append(f"flow rate at {100 * q_frac:.1f} % of the maximum flow rate {q_max:.4g} m^3/s")
-    re = rre = None
+    density = solution.density if density is None else density
+    shape = np.shape(st.flow_rate)
+    flat = solution.scene.flat(shape) if solution.scene.shape != () else solution.scene
     if density is not None:
-        q = float(np.max(solution.state.flow_rate))
-        diameter = 2.0 * tube.radius
-        velocity = q / (math.pi * tube.radius**2)
-        if q > 0:
-            tau_w = 0.5 * solution.rheology.pressure_gradient(q, tube.radius) * tube.radius
-            eta = tau_w / (8.0 * velocity / diameter)   # Metzner–Reed apparent viscosity
-            re = float(density) * velocity * diameter / eta
-        else:
-            re = 0.0
-        rre = re * eps
-        if rre > 0.1:
-            messages.append(f"reduced Reynolds number Re a/L = {rre:.3g} > 0.1: inertia is not negligible")
+        rho = as_load("density", density, allow_zero=False)
+        density = float(rho) if rho.ndim == 0 else np.broadcast_to(rho, shape).ravel()
+    found = validity.check(flat, np.ravel(st.flow_rate), np.ravel(st.inlet_strain), density=density)
+    messages = list(found.messages)
+    eps = float(np.max(tube.slenderness))
+    if np.any(np.asarray(tb) > 0.1) and isinstance(wall, ThinWall):
+        messages.append(f"thin-wall theory with t/a = {float(np.max(tb)):.3g} > 0.1: use the thick wall")
+    limit = np.asarray(wall.limit_pressure(tb), dtype=float)
+    with np.errstate(invalid="ignore"):
+        p_frac = float(np.nanmax(np.asarray(solution.outlet_pressure + st.pressure_drop) / limit, initial=0.0))
+    if p_frac > 0.9:
+        messages.append(f"inlet pressure at {100 * p_frac:.1f} % of the limit pressure {float(np.min(limit)):.4g} Pa: "
+                        "the tube is close to unbounded inflation")
+    q_max = np.asarray(max_flow_rate(solution.rheology, wall, tube, outlet_pressure=solution.outlet_pressure,
+                                     coupler=solution.coupler), dtype=float)
+    with np.errstate(invalid="ignore"):
+        q_frac = float(np.nanmax(np.asarray(st.flow_rate) / q_max, initial=0.0))
+    if q_frac > 0.9:
+        messages.append(f"flow rate at {100 * q_frac:.1f} % of the maximum flow rate {float(np.min(q_max)):.4g} m^3/s")
     if warn:
         for m in messages:
-            warnings.warn(m, ModelValidityWarning, stacklevel=3)
-    return Diagnostics(slenderness=eps, max_strain=strain, inlet_pressure_fraction=p_frac,
-                       flow_rate_fraction=q_frac, reynolds_number=re, reduced_reynolds_number=rre,
-                       warnings=tuple(messages))
+            warn_user(m, ModelValidityWarning)
+    return Diagnostics(slenderness=eps, max_strain=found.max_strain, inlet_pressure_fraction=p_frac,
+                       flow_rate_fraction=q_frac, reynolds_number=found.reynolds_number,
+                       reduced_reynolds_number=found.reduced_reynolds_number, warnings=tuple(messages),
+                       deformed_slenderness=found.deformed_slenderness)

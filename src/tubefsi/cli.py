@@ -6,16 +6,24 @@ r"""The ``tubefsi`` command: list the registered models, solve a scene, sweep a 
     tubefsi solve --rheology power-law:consistency=0.017,index=0.7 \
                   --wall thick-neo-hookean:shear_modulus=2e3 \
                   --tube radius=1e-4,thickness=3e-5,length=1e-2 --flow-rate 1e-9 [--json]
-    tubefsi curve  ... --flow-rate 0:1e-8:200 [--log] [--format csv|json] [--plot FILE]
+    tubefsi curve  ... --flow-rate 0:1e-8:200 [--log] [--format csv|json|netcdf] [--output FILE]
+                       [--plot FILE] [--density RHO] [--progress]
     tubefsi advise ... --flow-rate 5e-9 [--density 1060]
     tubefsi reproduce [OUTDIR]
 
 A model is ``NAME`` or ``NAME:key=value,key=value`` with the parameter names of
 ``tubefsi list`` (SI units); a coupler may take options the same way
 (``--coupler quadrature:order=24``). ``--flow-rate`` and ``--pressure-drop`` take
-one value or a comma-separated list. Any bad argument — an unknown model or
-parameter, a value outside its admissible range, a load beyond the maximum flow
-rate — ends with a one-line ``tubefsi: error: ...`` on stderr and exit status 2.
+one value or a comma-separated list; negative numbers reach the library's
+validation (``--flow-rate -1e-9`` as well as ``--flow-rate=-1e-9``). Output paths and
+formats (``--output``, ``--plot``) are checked before anything is computed. Any bad
+argument — an unknown model or parameter, a value outside its admissible range, a load
+beyond the maximum flow rate — ends with a one-line ``tubefsi: error: ...`` on stderr and
+exit status 2; a result outside the model's assumptions prints ``tubefsi: warning: ...``
+lines on stderr (:mod:`tubefsi.validity`).
+
+The command starts fast: ``--help``, ``--version`` import only the standard library and
+the registry; the models and SciPy load when a command needs them.
 """
 
 from __future__ import annotations
@@ -23,18 +31,15 @@ from __future__ import annotations
 import argparse
 import inspect
 import json
+import os
+import re
 import sys
+import warnings
 
 import numpy as np
 
 from . import __version__, registry
-from .advise import advise
-from .chapter import reproduce_chapter
-from .errors import TubefsiError
-from .fields import parameters
-from .geometry import Tube
-from .plotting import plot_flow_curve
-from .solve import solve
+from .errors import ModelValidityWarning, TubefsiError
 
 __all__ = ["main", "parse_model_spec"]
 
@@ -90,6 +95,8 @@ def _parse_pairs(text: str, spec: str) -> dict:
 
 def _build(kind: str, models, spec: str):
     """An instance of the registered model ``NAME`` with the parameters of ``spec``."""
+    from .fields import parameters
+
     name, params = parse_model_spec(spec)
     if name not in models:
         raise UsageError(f"unknown {kind} {name!r}; known: {', '.join(models)}")
@@ -103,7 +110,18 @@ def _build(kind: str, models, spec: str):
     if missing:
         raise UsageError(f"{kind} {name!r} needs " + ", ".join(_describe(p) for p in missing)
                          + f" (e.g. {name}:{missing[0].name}=...)")
+    _plain_numbers(f"{kind} {name!r}", params, fields)
     return cls(**params)
+
+
+def _plain_numbers(what, params, fields):
+    """A text value for a numeric parameter (``radius=100um``) is a usage error naming the unit."""
+    for key, value in params.items():
+        p = fields[key]
+        if isinstance(value, str) and not p.admissible.startswith("{"):
+            unit = f" ({p.unit})" if p.unit and p.unit != "-" else ""
+            raise UsageError(f"{what}: {key}={value!r} is not a number; give a plain number in SI units{unit}, "
+                             f"e.g. {key}=1e-4")
 
 
 def _describe(parameter) -> str:
@@ -138,33 +156,56 @@ def _summary(cls) -> str:
         elif depth == 0 and (ch == ";" or (ch == "." and (i + 1 == len(doc) or doc[i + 1] == " "))):
             cut = i
             break
-    math_at = doc.find(":math:")
-    if 0 <= math_at < cut:
-        cut = math_at
-    return doc[:cut].rstrip(" ,:;")
+    return _plain(doc[:cut]).rstrip(" ,:;")
+
+
+_SYMBOL = re.compile(r":math:`\\?([A-Za-z]+)`")
+
+
+def _plain(text: str) -> str:
+    """reST to plain text: a math symbol (``:math:`\\mu```) becomes its name, the phrase stops
+    at the first formula, ````code```` loses its quotes."""
+    text = _SYMBOL.sub(lambda m: m.group(1), text)
+    formula = text.find(":math:")
+    if formula >= 0:
+        text = text[:formula]
+    return text.replace("``", "")
 
 
 def _cmd_list(args, out) -> int:
+    from .fields import parameters
+
     groups = [("rheologies", registry.rheologies), ("walls", registry.walls), ("couplers", registry.couplers)]
-    for title, reg in groups:
-        print(f"{title}:", file=out)
-        for name in reg:
-            cls = reg[name]
-            dist = reg.distribution(name)
-            origin = "" if dist == "tubefsi" else f"  [{dist}]"
-            print(f"  {name:<22}{_summary(cls)}{origin}", file=out)
-            fields = parameters(cls)
-            if not fields:
-                print(f"      {'(no parameters)' if title != 'couplers' else '(no options)'}", file=out)
-            width = max([22] + [len(p.name) + 2 for p in fields])
-            for p in fields:
-                default = "" if p.required else f"  default {p.default!r}"
-                line = f"      {p.name:<{width}}{p.unit or '-':<9}{p.admissible:<26}{p.doc}{default}"
-                print(line.rstrip(), file=out)
+    classes = [(title, reg, name, reg[name]) for title, reg in groups for name in reg]
+    every = [p for *_, cls in classes for p in parameters(cls)]
+    # one set of columns for the whole listing, each as wide as its longest entry
+    w_name = max([22] + [len(p.name) + 2 for p in every])
+    w_unit = max([9] + [len(p.unit) + 2 for p in every])
+    w_adm = max([12] + [len(p.admissible) + 2 for p in every])
+    w_model = max([22] + [len(name) + 2 for _, _, name, _ in classes])
+    current = None
+    for title, reg, name, cls in classes:
+        if title != current:
+            print(f"{title}:", file=out)
+            current = title
+        dist = reg.distribution(name)
+        origin = "" if dist == "tubefsi" else f"  [{dist}]"
+        print(f"  {name:<{w_model}}{_summary(cls)}{origin}", file=out)
+        fields = parameters(cls)
+        if not fields:
+            print(f"      {'(no parameters)' if title != 'couplers' else '(no options)'}", file=out)
+        for p in fields:
+            default = "" if p.required else f" (default {p.default!r})"
+            line = f"      {p.name:<{w_name}}{p.unit or '-':<{w_unit}}{p.admissible:<{w_adm}}{p.doc}{default}"
+            print(line.rstrip(), file=out)
+    print("\nThin walls take thickness_convention='reference' by default (the chapter's hoop stress pR/t: no "
+          "limit pressure);\n'current' (thinning t/lambda) is the thick law's thin limit, with a limit pressure.",
+          file=out)
     return 0
 
 
 # ---------------------------------------------------------------------------- solve
+#: The results the commands print, with their units (the table of ``tubefsi.export``).
 _OUTPUT_UNITS = {
     "pressure_drop": "Pa",
     "flow_rate": "m^3/s",
@@ -187,6 +228,10 @@ def _scene_from_args(args):
     if missing:
         raise UsageError(f"--tube needs {', '.join(missing)} (m), e.g. --tube radius=1e-4,thickness=3e-5,"
                          "length=1e-2")
+    from .fields import parameters
+    from .geometry import Tube
+
+    _plain_numbers("--tube", tube_params, {p.name: p for p in parameters(Tube)})
     tube = Tube(**tube_params)
     coupler = args.coupler
     if coupler != "auto":
@@ -201,6 +246,8 @@ def _cmd_solve(args, out) -> int:
         load["flow_rate"] = _load_values("--flow-rate", args.flow_rate)
     else:
         load["pressure_drop"] = _load_values("--pressure-drop", args.pressure_drop)
+    from .solve import solve
+
     sol = solve(fluid, wall, tube, coupler=coupler, outlet_pressure=args.outlet_pressure, **load)
 
     result = {}
@@ -250,10 +297,16 @@ def _parser() -> argparse.ArgumentParser:
     load = p.add_mutually_exclusive_group(required=True)
     load.add_argument("--flow-rate", metavar="START:STOP[:N]", help="flow-rate range (m^3/s), N points")
     load.add_argument("--pressure-drop", metavar="START:STOP[:N]", help="pressure-drop range (Pa), N points")
-    p.add_argument("--log", action="store_true", help="log-spaced points (START > 0)")
-    p.add_argument("--format", choices=("csv", "json"), default="csv", help="output format (default csv)")
+    p.add_argument("--log", action="store_true", help="log-spaced points (START > 0), and log axes with --plot")
+    p.add_argument("--format", choices=("csv", "json", "netcdf"), default=None,
+                   help="table format (default: from the --output suffix .csv/.json/.nc, else csv; "
+                        "netcdf needs xarray)")
     p.add_argument("--output", metavar="FILE", help="write the table to FILE instead of standard output")
-    p.add_argument("--plot", metavar="FILE", help="also save a plot of the curve (PNG, SVG, PDF)")
+    p.add_argument("--plot", metavar="FILE", help="also save a plot of the curve (PNG, SVG, PDF, ...)")
+    p.add_argument("--density", type=float, metavar="RHO",
+                   help="fluid density (kg/m^3): warn where the reduced Reynolds number is not small")
+    p.add_argument("--progress", action="store_true",
+                   help="show a progress bar (tqdm; shown anyway on a terminal when tqdm is installed)")
     p.set_defaults(run=_cmd_curve)
 
     p = sub.add_parser("advise", help="compare the model with simpler ones on the same scene",
@@ -302,50 +355,128 @@ def _range(option, text, log):
     return np.linspace(start, stop, count)
 
 
-def _cmd_curve(args, out) -> int:
-    fluid, wall, tube, coupler = _scene_from_args(args)
-    if args.flow_rate is not None:
-        sol = solve(fluid, wall, tube, coupler=coupler, outlet_pressure=args.outlet_pressure,
-                    flow_rate=_range("--flow-rate", args.flow_rate, args.log))
-    else:
-        sol = solve(fluid, wall, tube, coupler=coupler, outlet_pressure=args.outlet_pressure,
-                    pressure_drop=_range("--pressure-drop", args.pressure_drop, args.log))
-    columns = list(_OUTPUT_UNITS)
-    data = {k: np.atleast_1d(getattr(sol, k)).tolist() for k in columns}
-    stream = open(args.output, "w", encoding="utf-8") if args.output else out
-    try:
-        if args.format == "json":
-            json.dump({"coupler": sol.coupler_name, "units": _OUTPUT_UNITS, **data}, stream, allow_nan=False)
-            stream.write("\n")
-        else:
-            stream.write(",".join(f"{k} ({_OUTPUT_UNITS[k]})" for k in columns) + "\n")
-            for row in zip(*(data[k] for k in columns)):
-                stream.write(",".join(repr(float(v)) for v in row) + "\n")
-    finally:
-        if args.output:
-            stream.close()
+_FORMATS = {".csv": "csv", ".json": "json", ".nc": "netcdf", ".nc4": "netcdf", ".netcdf": "netcdf"}
+
+
+def _writable(option, path):
+    """``path`` can be created: its directory exists and is writable, and it is not a directory."""
+    folder = os.path.dirname(os.path.abspath(path))
+    if os.path.isdir(path):
+        raise UsageError(f"{option} {path!r} is a directory; give a file name")
+    if not os.path.isdir(folder):
+        raise UsageError(f"{option} {path!r}: the directory {folder!r} does not exist")
+    if not os.access(folder, os.W_OK):
+        raise UsageError(f"{option} {path!r}: the directory {folder!r} is not writable")
+
+
+def _check_outputs(args):
+    """The table format and the plot format, checked before anything is computed."""
+    fmt = args.format
+    if args.output:
+        _writable("--output", args.output)
+        if fmt is None:
+            fmt = _FORMATS.get(os.path.splitext(args.output)[1].lower(), "csv")
+    fmt = fmt or "csv"
+    if fmt == "netcdf":
+        if not args.output:
+            raise UsageError("--format netcdf needs --output FILE (NetCDF is a binary file)")
+        try:
+            import xarray  # noqa: F401
+        except ImportError:
+            raise UsageError("--format netcdf needs xarray: pip install 'tubefsi[xarray]'") from None
     if args.plot:
-        ax = plot_flow_curve(fluid, wall, tube, flow_rates=np.atleast_1d(sol.flow_rate))
+        _writable("--plot", args.plot)
+        from matplotlib.figure import Figure
+
+        supported = Figure().canvas.get_supported_filetypes()
+        ext = os.path.splitext(args.plot)[1].lower().lstrip(".")
+        if ext not in supported:
+            raise UsageError(f"--plot {args.plot!r}: the format {ext or '(none)'!r} is not one matplotlib writes; "
+                             f"use one of {', '.join(sorted(supported))}")
+    return fmt
+
+
+def _cmd_curve(args, out) -> int:
+    fmt = _check_outputs(args)
+    fluid, wall, tube, coupler = _scene_from_args(args)
+    from .solve import solve
+
+    kind = "flow_rate" if args.flow_rate is not None else "pressure_drop"
+    option = "--flow-rate" if kind == "flow_rate" else "--pressure-drop"
+    values = _range(option, getattr(args, kind), args.log)
+    sol = solve(fluid, wall, tube, coupler=coupler, outlet_pressure=args.outlet_pressure, density=args.density,
+                progress=True if args.progress else "auto", **{kind: values})
+    if fmt == "netcdf":
+        ds = sol.to_xarray()
+        if "feasible" in ds:                  # NetCDF 3 has no booleans
+            ds["feasible"] = ds["feasible"].astype("i1")
+        ds.to_netcdf(args.output, engine="scipy")
+    else:
+        columns = list(_OUTPUT_UNITS)
+        data = {k: np.atleast_1d(getattr(sol, k)).tolist() for k in columns}
+        stream = open(args.output, "w", encoding="utf-8") if args.output else out
+        try:
+            if fmt == "json":
+                json.dump({"coupler": sol.coupler_name, "units": _OUTPUT_UNITS, **data}, stream, allow_nan=False)
+                stream.write("\n")
+            else:
+                stream.write(",".join(f"{k} ({_OUTPUT_UNITS[k]})" for k in columns) + "\n")
+                for row in zip(*(data[k] for k in columns)):
+                    stream.write(",".join(repr(float(v)) for v in row) + "\n")
+        finally:
+            if args.output:
+                stream.close()
+    if args.plot:
+        from .plotting import plot_flow_curve
+
+        ax = plot_flow_curve(fluid, wall, tube, flow_rates=np.atleast_1d(sol.flow_rate), coupler=coupler,
+                             outlet_pressure=args.outlet_pressure)
+        if args.log:                          # log-spaced points on log axes
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+            ax.autoscale()
         ax.figure.savefig(args.plot, dpi=130)
     return 0
 
 
 def _cmd_reproduce(args, out) -> int:
+    from .chapter import reproduce_chapter
+
     reproduce_chapter(args.out, formats=("png",) if args.png_only else ("png", "csv"), file=out)
     return 0
 
 
 def _cmd_advise(args, out) -> int:
+    from .advise import advise
+    from .solve import solve
+
     fluid, wall, tube, _ = _scene_from_args(args)
     load = {"flow_rate": args.flow_rate} if args.flow_rate is not None else {"pressure_drop": args.pressure_drop}
     advice = advise(fluid, wall, tube, tolerance=args.tolerance, outlet_pressure=args.outlet_pressure,
                             **load)
     print(advice, file=out)
     print(f"\nrecommended: {advice.recommended.label}", file=out)
-    sol = solve(fluid, wall, tube, outlet_pressure=args.outlet_pressure, **load)
+    with warnings.catch_warnings():           # the diagnostics below list them
+        warnings.simplefilter("ignore", ModelValidityWarning)
+        sol = solve(fluid, wall, tube, outlet_pressure=args.outlet_pressure, **load)
     print("\ndiagnostics of the requested model:", file=out)
     print(sol.diagnostics(density=args.density, warn=False), file=out)
     return 0
+
+
+_NUMBERS = re.compile(r"^-[0-9.][0-9eE.+\-]*([,:][-+]?[0-9.][0-9eE.+\-]*)*$")
+
+
+def _join_negative_values(argv):
+    """``--flow-rate -1e-9`` as ``--flow-rate=-1e-9``: argparse takes ``-1e-9`` for an option, so
+    a negative number (or list, or range) after an option reaches the library's validation."""
+    out = []
+    for item in argv:
+        if out and out[-1].startswith("--") and "=" not in out[-1] and _NUMBERS.match(item):
+            out[-1] = f"{out[-1]}={item}"
+        else:
+            out.append(item)
+    return out
 
 
 def _error(message) -> int:
@@ -357,6 +488,7 @@ def _error(message) -> int:
 def main(argv=None) -> int:
     """Run the ``tubefsi`` command with ``argv`` (default ``sys.argv[1:]``); return the exit status."""
     parser = _parser()
+    argv = _join_negative_values(sys.argv[1:] if argv is None else list(argv))
     try:
         args = parser.parse_args(argv)
     except UsageError as exc:
@@ -366,7 +498,15 @@ def main(argv=None) -> int:
     if args.command is None:
         return _error("a command is required: list, solve, curve, advise or reproduce (see 'tubefsi --help')")
     try:
-        return args.run(args, sys.stdout)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", ModelValidityWarning)
+            status = args.run(args, sys.stdout)
+        for w in caught:
+            if issubclass(w.category, ModelValidityWarning):
+                print(f"{PROG}: warning: {' '.join(str(w.message).split())}", file=sys.stderr)
+            else:
+                warnings.showwarning(w.message, w.category, w.filename, w.lineno)
+        return status
     except (UsageError, ValueError, TubefsiError) as exc:
         # InvalidParameterError and NoSteadyStateError are ValueErrors; ConvergenceError a TubefsiError
         return _error(exc)

@@ -17,7 +17,9 @@ __all__ = [
     "InvalidParameterError",
     "NoSteadyStateError",
     "ConvergenceError",
+    "StretchRangeError",
     "AccuracyWarning",
+    "ModelValidityWarning",
     "warn_user",
 ]
 
@@ -43,7 +45,9 @@ class InvalidParameterError(TubefsiError, ValueError):
         self.value = value
         got = "" if value is None else f" (got {_short(value)})"
         extra = f"; {detail}" if detail else ""
-        super().__init__(f"{parameter} must be in {admissible}{got}{extra}")
+        # a range or a set reads "must be in [0, inf)"; a description "must be a coupler that ..."
+        joiner = "in " if admissible[:1] in "[({" or admissible.startswith("the ") else ""
+        super().__init__(f"{parameter} must be {joiner}{admissible}{got}{extra}")
 
 
 class NoSteadyStateError(TubefsiError, ValueError):
@@ -57,15 +61,40 @@ class NoSteadyStateError(TubefsiError, ValueError):
         The limit (Pa or m^3/s) that the load must stay below.
     """
 
-    def __init__(self, quantity: str, limit: float, value=None, detail: str = ""):
+    def __init__(self, quantity: str, limit: float, value=None, detail: str = "", *, name: str = ""):
         self.quantity = quantity
         self.limit = float(limit)
-        got = "" if value is None else f" (got {_short(value)})"
         unit = "Pa" if quantity == "pressure" else "m^3/s"
+        got = "" if value is None else f" (got {_short(value)} {unit})"
         extra = f"; {detail}" if detail else ""
+        what = "the limit pressure" if quantity == "pressure" else "the maximum flow rate"
         super().__init__(
-            f"no steady state: {quantity} must stay below its limit {self.limit:.10g} {unit}{got}{extra}"
+            f"no steady state: {name or quantity} must stay below {what} {self.limit:.10g} {unit}{got}{extra}"
         )
+
+
+class StretchRangeError(InvalidParameterError):
+    """A flow rate the model answers but the solver does not: its inlet stretch would exceed
+    ``MAX_STRETCH`` (``1e15``) times the outlet stretch.
+
+    Not a physical limit: the flow rate is below :func:`tubefsi.max_flow_rate` (the one limit,
+    often ``inf`` then), so a steady state exists, but a tube inflated that far left the model's
+    assumptions (a slender tube, ``R/L`` small) long before (``docs/theory.md``, section "The
+    maximum flow rate"; ``docs/scope.md``).
+
+    Attributes
+    ----------
+    limit : float
+        The largest flow rate within the solver's range at that point (m^3/s).
+    """
+
+    #: The load the range bounds (as :attr:`NoSteadyStateError.quantity`).
+    quantity = "flow_rate"
+
+    def __init__(self, limit: float, value=None, detail: str = ""):
+        self.limit = float(limit)
+        super().__init__("flow_rate", f"[0, {self.limit:.6g}] m^3/s, the flow rates whose inlet stretch stays "
+                         "below 1e15 (the solver's range, not a physical limit)", value, detail)
 
 
 class ConvergenceError(TubefsiError, ArithmeticError):
@@ -81,6 +110,16 @@ def _short(value) -> str:
 
 class AccuracyWarning(UserWarning):
     """A non-default method's result is less accurate than its tolerance promises."""
+
+
+class ModelValidityWarning(UserWarning):
+    """A result leaves an assumption of the model (a slender tube, small strain for a linear
+    wall, the wall law's calibrated range, a small reduced Reynolds number...).
+
+    :func:`tubefsi.solve` issues it for the deformed tube; silence it with the standard
+    filter, ``warnings.filterwarnings("ignore", category=tubefsi.ModelValidityWarning)``
+    (``docs/scope.md``).
+    """
 
 
 _PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__))

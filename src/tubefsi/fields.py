@@ -39,6 +39,7 @@ import math
 import attrs
 import numpy as np
 
+from ._units import to_si
 from .errors import InvalidParameterError
 
 __all__ = ["real", "positive", "nonnegative", "choice", "Parameter", "parameters", "parameter_shape",
@@ -51,7 +52,9 @@ def _invalid_type(field, value):
 
 
 def _convert_real(value, field):
-    """A float for a scalar, a read-only float ndarray for an array (any shape)."""
+    """A float for a scalar, a read-only float ndarray for an array (any shape); a pint Quantity
+    is converted to SI first."""
+    value = to_si(field.name, value, field.metadata.get("unit", ""))
     if isinstance(value, (bool, str, bytes)):
         raise _invalid_type(field, value)
     if isinstance(value, (int, float)):

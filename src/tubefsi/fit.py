@@ -14,12 +14,13 @@ errors come from the Gauss–Newton covariance :math:`s^2 (J^T J)^{-1}`,
 from __future__ import annotations
 
 import math
+import warnings
 
 import attrs
 import numpy as np
 from scipy import optimize
 
-from .errors import InvalidParameterError, TubefsiError
+from .errors import InvalidParameterError, ModelValidityWarning, TubefsiError
 from .scene import make_scene
 from .solve import solve
 
@@ -116,8 +117,10 @@ def fit(flow_rate, pressure_drop, rheology, wall, tube, *, parameters, outlet_pr
             m = build(theta)
             # beyond the maximum flow rate the drop is continued by its supremum, the limit
             # pressure rise, so trial parameters with no steady state still steer the fit
-            sol = solve(m["rheology"], m["wall"], tube, flow_rate=q, outlet_pressure=outlet_pressure,
-                        coupler=coupler, on_infeasible="nan")
+            with warnings.catch_warnings():    # trial points: validity is the fitted model's business
+                warnings.simplefilter("ignore", ModelValidityWarning)
+                sol = solve(m["rheology"], m["wall"], tube, flow_rate=q, outlet_pressure=outlet_pressure,
+                            coupler=coupler, on_infeasible="nan")
             out = np.array(sol.pressure_drop, dtype=float)
             ok = np.isfinite(out)
             if not np.all(ok):

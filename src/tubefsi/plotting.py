@@ -42,7 +42,7 @@ import attrs
 import numpy as np
 
 from . import registry
-from .errors import InvalidParameterError, NoSteadyStateError
+from .errors import InvalidParameterError, NoSteadyStateError, StretchRangeError
 from .solve import max_flow_rate, solve
 from .walls.hyperelastic import HyperelasticWall
 
@@ -319,10 +319,10 @@ def plot_flow_curve(rheology, wall, tube, *, flow_rates=None, ax=None, n=200, la
         q_max = max_flow_rate(fluid, wall, tube, outlet_pressure=outlet_pressure)
     try:
         sol = solve(fluid, wall, tube, flow_rate=q, outlet_pressure=outlet_pressure, coupler=coupler)
-    except NoSteadyStateError as exc:
-        # near n = 1 the inlet stretch diverges so fast that the solver's practical reach lies
-        # well below q_max; a default range then stops at 90 % of what can be reached
-        if flow_rates is not None or exc.quantity != "flow_rate" or not exc.limit < q[-1]:
+    except (NoSteadyStateError, StretchRangeError) as exc:
+        # near n = 1 the inlet stretch diverges so fast that the solver's range lies well below
+        # q_max; a default range then stops at 90 % of what can be reached
+        if flow_rates is not None or getattr(exc, "quantity", "flow_rate") != "flow_rate" or not exc.limit < q[-1]:
             raise
         q = np.linspace(0.0, 0.9 * exc.limit, q.size)
         sol = solve(fluid, wall, tube, flow_rate=q, outlet_pressure=outlet_pressure, coupler=coupler)

@@ -298,5 +298,5 @@ def make_scene(rheology, wall, tube, *, outlet_pressure=0.0) -> Scene:
         i = np.unravel_index(int(np.argmax(beyond.ravel())), beyond.shape) if beyond.ndim else ()
         raise NoSteadyStateError("pressure", float(np.broadcast_to(lim, beyond.shape)[i]),
                                  float(np.broadcast_to(p_out, beyond.shape)[i]),
-                                 "the outlet pressure already reaches it")
+                                 "the outlet pressure already reaches it", name="the outlet pressure")
     return Scene(rheology=rheology, wall=wall, tube=tube, outlet_pressure=p_out)

@@ -11,6 +11,7 @@ from __future__ import annotations
 import attrs
 import numpy as np
 
+from . import export
 from ._numerics import as_output
 from ._validation import as_array
 from .couplers.base import Coupler
@@ -40,6 +41,10 @@ class Solution:
     coupler_name: str = ""
     #: Where ``solve(..., on_infeasible="nan")`` found a steady state (None: everywhere).
     feasible: object = None
+    #: The fluid density given to ``solve`` (kg/m^3; None if not given), for the Reynolds number.
+    density: object = None
+    #: The load ``solve`` was given: ``"flow_rate"`` or ``"pressure_drop"``.
+    controlled: str = "flow_rate"
 
     # ------------------------------------------------------------------ loads
     @property
@@ -259,6 +264,28 @@ class Solution:
         if np.any(r_arr > big_r * (1 + 1e-12)) or np.any(r_arr < 0):
             raise InvalidParameterError("r", "[0, R(z)] (m)", r_arr[(r_arr > big_r) | (r_arr < 0)].flat[0])
         return self._out(self.rheology.velocity(np.minimum(r_arr, big_r), big_r, g), z, r)
+
+    # ------------------------------------------------------------------ tables (optional extras)
+    def to_dataframe(self, dims=None):
+        """The results as a :class:`pandas.DataFrame`, one row per point: the inputs that vary
+        (the load, array parameters), then pressure drop, flow rate, inlet pressure, inlet
+        displacement and inlet radius (SI; units in ``frame.attrs["units"]``). Needs pandas
+        (``pip install 'tubefsi[pandas]'``); ``dims`` names the axes (:mod:`tubefsi.export`)."""
+        return export.to_dataframe(self, dims)
+
+    def to_xarray(self, dims=None):
+        """The results as an :class:`xarray.Dataset`: one named dimension per broadcast axis
+        (the input that varies along it, or ``dims``), the varying inputs as coordinates, the
+        results as data variables with ``units`` attributes. Needs xarray
+        (``pip install 'tubefsi[xarray]'``); ``dataset.to_netcdf(path)`` writes NetCDF."""
+        return export.to_xarray(self, dims)
+
+    def to_quantities(self, registry=None) -> dict:
+        """Pressure drop, flow rate, inlet pressure, inlet displacement and inlet radius as
+        :class:`pint.Quantity` objects (``pip install 'tubefsi[units]'``; ``registry`` a
+        :class:`pint.UnitRegistry`, default pint's application registry). Every argument of
+        ``solve`` and of the models may be a Quantity too: it is converted to SI on the way in."""
+        return export.to_quantities(self, registry)
 
     # ------------------------------------------------------------------ accessors (upper layers)
     def diagnostics(self, *, density=None, warn=True):

@@ -14,6 +14,7 @@ import attrs
 import numpy as np
 
 from . import registry
+from ._progress import bar
 from ._validation import as_load
 from .couplers.base import Coupler
 from .couplers.checked import checked
@@ -23,6 +24,7 @@ from .geometry import Tube
 from .rheology.base import Rheology
 from .scene import Scene, State, _resolve, make_scene
 from .solution import Solution
+from .validity import SLENDERNESS, check, warn
 from .walls.base import WallModel
 
 __all__ = ["solve", "max_flow_rate", "select_coupler"]
@@ -64,7 +66,7 @@ def select_coupler(rheology, wall, coupler="auto") -> Coupler:
 
 
 def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="auto",
-          outlet_pressure=0.0, on_infeasible="raise") -> Solution:
+          outlet_pressure=0.0, on_infeasible="raise", density=None, progress=False) -> Solution:
     r"""Solve steady flow of ``rheology`` through ``tube`` with wall ``wall``.
 
     Exactly one of ``flow_rate`` (flow-controlled) and ``pressure_drop``
@@ -90,6 +92,17 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
         What a point beyond a limit (the maximum flow rate, the limit pressure) gets:
         ``"raise"`` (the default) raises :class:`NoSteadyStateError` for the whole call;
         ``"nan"`` gives that point NaN results and ``False`` in :attr:`Solution.feasible`.
+    density : float or array_like, optional
+        The fluid's density (kg/m^3): adds the reduced Reynolds number to the validity checks.
+    progress : bool or "auto"
+        Show a progress bar over the points (tqdm, ``pip install 'tubefsi[progress]'``) for a
+        long sweep; ``"auto"``: only if tqdm is installed and standard error is a terminal.
+
+    Every result is checked against the model's assumptions on the *deformed* tube
+    (:mod:`tubefsi.validity`: slenderness :math:`R_{in}/L`, the wall law's calibrated strain,
+    a linear wall at large strain, the reduced Reynolds number when ``density`` is given); each
+    that fails is a :class:`~tubefsi.ModelValidityWarning` (silence it with
+    ``warnings.filterwarnings("ignore", category=tubefsi.ModelValidityWarning)``).
 
     Returns
     -------
@@ -101,9 +114,13 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
         For any input outside its admissible range.
     NoSteadyStateError
         Beyond the wall's limit pressure or the maximum flow rate (``on_infeasible="raise"``).
+    StretchRangeError
+        Below the maximum flow rate but beyond the solver's range (an inlet stretch over
+        ``1e15``; ``docs/theory.md``, section "The maximum flow rate"), whatever ``on_infeasible``.
     """
     if (type(flow_rate) is float and pressure_drop is None and type(coupler) is str and coupler == "auto"
-            and type(outlet_pressure) is float and outlet_pressure == 0.0 and on_infeasible == "raise"):
+            and type(outlet_pressure) is float and outlet_pressure == 0.0 and on_infeasible == "raise"
+            and density is None and progress is False):
         fast = _scalar_flow(rheology, wall, tube, flow_rate)
         if fast is not None:
             return fast
@@ -113,11 +130,14 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
                                     None, "give flow_rate= or pressure_drop=, not both or neither")
     if on_infeasible not in ("raise", "nan"):
         raise InvalidParameterError("on_infeasible", "{'raise', 'nan'}", on_infeasible)
+    rho = None if density is None else as_load("density", density, allow_zero=False)
     chosen = select_coupler(scene.rheology, scene.wall, coupler)
     runner = checked(chosen)            # a self-checking coupler is re-solved finer (AccuracyWarning)
     controlled = "flow_rate" if flow_rate is not None else "pressure_drop"
     load = as_load(controlled, flow_rate if flow_rate is not None else pressure_drop)
     shape = np.broadcast_shapes(scene.shape, load.shape)
+    if rho is not None and np.broadcast_shapes(shape, rho.shape) != shape:
+        raise InvalidParameterError("density", f"an array that broadcasts to the result's shape {shape}", rho)
     flat = scene.flat(shape)
     values = np.broadcast_to(load, shape).ravel()
     method = runner.flow_controlled if controlled == "flow_rate" else runner.pressure_controlled
@@ -125,6 +145,7 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
     out = {f.name: np.full(n, np.nan) for f in attrs.fields(State)}
     feasible = np.ones(n, dtype=bool)
     optimistic = controlled == "flow_rate" and _is(type(chosen), SeparatedVariables)
+    shown = bar(n, progress, "tubefsi.solve")
     for index, part in flat.split(np.arange(n)):
         for start in range(0, index.size, CHUNK):
             idx = index[start:start + CHUNK]
@@ -140,21 +161,29 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
                 else:
                     for name in out:
                         out[name][idx] = np.broadcast_to(np.asarray(getattr(state, name), dtype=float), idx.shape)
+                    shown.update(idx.size)
                     continue
             ok = _feasible(runner, chunk, values[idx], controlled, raise_=on_infeasible == "raise")
             go = np.arange(idx.size) if ok is None else np.flatnonzero(ok)
             if ok is not None:
                 feasible[idx] = ok
             if go.size == 0:
+                shown.update(idx.size)
                 continue
             sub = chunk if go.size == idx.size else (chunk.take(go) if chunk.size > 1 else chunk)
             state = method(sub, values[idx][go])
             for name in out:
                 out[name][idx[go]] = np.broadcast_to(np.asarray(getattr(state, name), dtype=float), go.shape)
+            shown.update(idx.size)
+    shown.close()
+    if density is not None:
+        density = float(rho) if rho.ndim == 0 else np.broadcast_to(rho, shape).ravel()
+    warn(check(flat, out["flow_rate"], out["inlet_strain"], density=density))
     state = State(*(out[f.name].reshape(shape) for f in attrs.fields(State)))
     return Solution(scene=scene, coupler=chosen, state=state, scalar=shape == (),
                     coupler_name=registry.couplers.name_of(chosen) or type(chosen).__name__,
-                    feasible=None if np.all(feasible) else feasible.reshape(shape))
+                    feasible=None if np.all(feasible) else feasible.reshape(shape), density=density,
+                    controlled=controlled)
 
 
 _SUBCLASS: dict = {}
@@ -204,6 +233,8 @@ def _scalar_flow(rheology, wall, tube, q):
     lam_max = wall._max_stretch(t / a)
     scene = Scene._trusted(rheology, wall, tube, math.log(lam_max) if type(lam_max) is float else
                            float(np.log(lam_max)))
+    if a * (1.0 + strain) > SLENDERNESS * L or strain > wall.calibrated_strain:
+        warn(check(scene, q, strain))
     return Solution(scene=scene, coupler=chosen, state=State(q, drop, strain, v), scalar=True, coupler_name=name)
 
 
@@ -225,7 +256,7 @@ def _feasible(coupler, scene, load, controlled, *, raise_):
             return None
         beyond = load >= limit
         limit = limit + np.asarray(scene.outlet_pressure)
-        quantity, detail = "pressure", "the inlet pressure, outlet pressure + pressure drop, reaches it"
+        quantity, detail = "pressure", "the inlet pressure is the outlet pressure plus the pressure drop"
     beyond = np.broadcast_to(beyond, load.shape)
     if not np.any(beyond):
         return None
@@ -233,7 +264,8 @@ def _feasible(coupler, scene, load, controlled, *, raise_):
         i = int(np.argmax(beyond))
         value = float(load[i]) if quantity == "flow_rate" else float(
             np.broadcast_to(np.asarray(scene.outlet_pressure), load.shape)[i] + load[i])
-        raise NoSteadyStateError(quantity, float(np.broadcast_to(limit, load.shape)[i]), value, detail)
+        raise NoSteadyStateError(quantity, float(np.broadcast_to(limit, load.shape)[i]), value, detail,
+                                 name="the flow rate" if quantity == "flow_rate" else "the inlet pressure")
     return ~beyond
 
 

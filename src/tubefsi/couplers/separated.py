@@ -43,14 +43,15 @@ from scipy.optimize import elementwise
 
 from .._numerics import EPS, integrate_graded, solve_increasing
 from .._quadrature import adaptive_to_pole, quiet, warn_unconverged
-from ..errors import NoSteadyStateError
+from ..errors import NoSteadyStateError, StretchRangeError
 from ..scene import Points, Scene, State
 from ._tables import SeparatedTable, fit_chebyshev
 from .base import Coupler
 
 __all__ = ["SeparatedVariables", "MAX_LOG_STRETCH"]
 
-#: Largest inlet stretch (relative to the outlet) a solve may reach: ln(1e15).
+#: Largest inlet stretch (relative to the outlet) a solve may reach: ln(1e15). Not a physical
+#: limit (``max_flow_rate`` is the one limit): beyond it ``StretchRangeError``.
 MAX_LOG_STRETCH = math.log(1e15)
 _PROBE_LOG_STRETCH = math.log(1e8)
 
@@ -631,8 +632,9 @@ class SeparatedVariables(Coupler):
         if float(cap[0]) < MAX_LOG_STRETCH:
             raise NoSteadyStateError("flow_rate", reach, q_bad,
                                      "the inlet stretch would reach the wall's maximum stretch")
-        raise NoSteadyStateError("flow_rate", reach, q_bad,
-                                 "the inlet stretch would exceed 1e15 (the tube inflates without practical bound)")
+        limit = "max_flow_rate is inf" if not math.isfinite(q_max) else f"below max_flow_rate = {q_max:.6g} m^3/s"
+        raise StretchRangeError(reach, q_bad, f"a steady state exists ({limit}) but its inlet stretch exceeds "
+                                "1e15, and R/L far exceeds 0.1 there: the model no longer applies")
 
 
 @functools.lru_cache(maxsize=256)

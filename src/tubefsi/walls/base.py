@@ -68,15 +68,19 @@ class WallModel(abc.ABC):
     ``_pressure_needs_quadrature()``                        False (True for a generic thick wall)
     ======================================================  ==============================================
 
-    Class attributes: ``is_rigid`` (True only for :class:`~tubefsi.walls.Rigid`) and
+    Class attributes: ``is_rigid`` (True only for :class:`~tubefsi.walls.Rigid`),
     ``closed_form_integral`` (True where ``_power_law_integral`` is implemented, which makes
-    the ``closed-form`` coupler available for power-law fluids).
+    the ``closed-form`` coupler available for power-law fluids) and ``calibrated_strain`` (the
+    largest hoop strain the law is meant for: ``solve`` warns beyond it).
     """
 
     __slots__ = ()
 
     #: True only for the rigid wall, whose tube law is the vertical line ``stretch = 1``.
     is_rigid: ClassVar[bool] = False
+    #: The largest hoop strain the law is meant for (the range its constants were calibrated
+    #: on, or 0.05 for small-strain theory): beyond it ``solve`` issues a ModelValidityWarning.
+    calibrated_strain: ClassVar[float] = math.inf
     #: Example parameter sets (keyword dicts) run through the contract suites of :mod:`tubefsi.testing`.
     _examples: ClassVar[tuple] = ()
     #: True where ``_power_law_integral`` gives the separated integral of a power-law fluid in

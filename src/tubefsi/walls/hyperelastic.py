@@ -142,10 +142,18 @@ class ThinWall(HyperelasticWall):
     ``"current"``: the thickness thins to :math:`t/\lambda` by incompressibility,
     :math:`P = \bar t\,\hat W'(\lambda)/\lambda`; this is the :math:`\bar t\to 0`
     limit of the thick theory.
+
+    The default is ``"reference"``, so that the chapter's results reproduce; its consequence
+    for a Mooney–Rivlin or neo-Hookean wall: **no limit pressure** (the law grows like
+    :math:`\lambda`), hence no maximum flow rate, where the ``"current"`` law and the thick
+    wall saturate at a limit pressure. Choose ``"current"`` for a thin wall that should behave
+    like the thick one (:func:`tubefsi.advise` compares a thick wall with both;
+    ``docs/theory.md``, section "Thin walls").
     """
 
     thickness_convention: str = choice(THICKNESS_CONVENTIONS, default="reference",
-                                       doc="hoop stress with the reference or current thickness")
+                                       doc="hoop stress with the reference thickness (the chapter's; no limit "
+                                           "pressure) or the current one (the thick law's thin limit)")
 
     #: Below this hoop strain, :math:`\hat W'(1 + \varepsilon)` is integrated from the strain itself.
     _SMALL_STRAIN = 0.1

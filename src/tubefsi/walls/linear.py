@@ -23,6 +23,8 @@ class _LinearWall(WallModel):
     __slots__ = ()
 
     closed_form_integral = True
+    #: small-strain theory: a linear wall past a few per cent of strain is the wrong model
+    calibrated_strain = 0.05
 
     def _pressure_scale(self):
         return self.youngs_modulus

@@ -25,8 +25,8 @@ __all__ = ["MooneyRivlin", "ThinMooneyRivlin", "ThickMooneyRivlin"]
 class MooneyRivlin(HyperelasticWall):
     """Mooney–Rivlin material (abstract: pick a theory). Requires ``c1 + c2 > 0``."""
 
-    c1: float = real(unit="Pa", doc="first Mooney–Rivlin constant")
-    c2: float = real(unit="Pa", doc="second Mooney–Rivlin constant (often negative)")
+    c1: float = real(unit="Pa", doc="first Mooney–Rivlin constant (c1 + c2 > 0)")
+    c2: float = real(unit="Pa", doc="second Mooney–Rivlin constant, often negative (c1 + c2 > 0)")
 
     def __attrs_post_init__(self):
         total = np.asarray(self.c1 + self.c2)
