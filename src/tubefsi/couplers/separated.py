@@ -73,6 +73,8 @@ class SeparatedVariables(Coupler):
 
     #: Relative tolerance of every quadrature of the separated integrand (error-controlled).
     _RTOL: float = 1e-14
+    #: A fixed (unchecked) rule: no tables or interpolated curves, so that it is what it says.
+    _coarse: bool = False
 
     # --------------------------------------------------------------- the tube law along u
     @staticmethod
@@ -216,7 +218,7 @@ class SeparatedVariables(Coupler):
                 v[served] = np.exp(y)
                 dp[served] = table.rise(y, v[served])
                 direct &= ~served
-        if scene.size == 1 and np.count_nonzero(direct) >= _TABLE_MIN_POINTS:
+        if scene.size == 1 and not self._coarse and np.count_nonzero(direct) >= _TABLE_MIN_POINTS:
             sub = np.flatnonzero(direct)
             v_c = self._curve_by_interpolation(scene, q[sub])
             if v_c is not None:
@@ -272,7 +274,7 @@ class SeparatedVariables(Coupler):
         power-law fluid and an unloaded outlet (cached per wall shape, t/a and n), or None
         (``build=False``: only if already cached)."""
         key = _table_key(scene)
-        if key is None:
+        if key is None or self._coarse:         # a fixed rule is timed and charted as itself
             return None
         cached = _TABLES.get(key)
         if cached is None and not build:
