@@ -123,3 +123,40 @@ def test_walls_that_do_not_broadcast_are_solved_per_parameter_set():
     for i, c2 in enumerate([-120.0, 50.0, -120.0]):
         ref = tubefsi.solve(fluid, walls["thick-yeoh"](c1=1e3, c2=c2, c3=8.0), TUBE, flow_rate=1e-10)
         assert sol.pressure_drop[i] == pytest.approx(ref.pressure_drop, rel=1e-13)
+
+
+def _rheology_cases():
+    for name in sorted(rheologies):
+        cls = rheologies[name]
+        examples = [e for e in cls._examples if e]
+        if len(examples) >= 2:
+            yield pytest.param(cls, examples[0], examples[1], id=name)
+
+
+@pytest.mark.parametrize("cls, first, second", list(_rheology_cases()))
+def test_rheology_methods_broadcast_over_parameters(cls, first, second):
+    """Every registered rheology: parameters given as arrays (two example sets stacked) give, entry
+    by entry, what each parameter set gives alone, for every public method, zeros included."""
+    keys = [k for k in first if k in second and isinstance(first[k], float) and isinstance(second[k], float)]
+    if not keys:
+        pytest.skip("no numeric parameters shared by two examples")
+    stacked = {k: np.array([first[k], second[k]]) if k in keys else first[k] for k in first}
+    try:
+        both = cls(**stacked)
+        alone = [cls(**first), cls(**{**first, **{k: second[k] for k in keys}})]
+    except tubefsi.InvalidParameterError:
+        pytest.skip("the mixed parameter set is not admissible")
+    rate = np.array([[0.0], [3.0], [40.0]])
+    radius, q = 1e-4, np.array([[0.0], [1e-10], [1e-9]])
+    got = {"stress": both.stress(rate), "pressure_gradient": both.pressure_gradient(q, radius),
+           "apparent_viscosity": both.apparent_viscosity(rate[1:])}
+    for j, model in enumerate(alone):
+        np.testing.assert_allclose(got["stress"][:, j], model.stress(rate[:, 0]), rtol=1e-14)
+        np.testing.assert_allclose(got["pressure_gradient"][:, j], model.pressure_gradient(q[:, 0], radius),
+                                   rtol=1e-13)
+        np.testing.assert_allclose(got["apparent_viscosity"][:, j], model.apparent_viscosity(rate[1:, 0]),
+                                   rtol=1e-14)
+    g = both.pressure_gradient(1e-9, radius)
+    assert g.shape == (2,)
+    flow = both.flow_rate(radius, g)
+    np.testing.assert_allclose(flow, 1e-9, rtol=1e-12)

@@ -260,13 +260,15 @@ def parameter_sets(model, shape):
             for j in range(rows.shape[0])]
 
 
-def evaluate(model, fn, *args):
+def evaluate(model, fn, *args, per_set=False):
     """``fn(model', *args')`` with the arguments and the model's parameters broadcast together.
 
     The arguments (floats or arrays) and the model's array parameters are broadcast to one
     shape and flattened; ``fn`` gets the model with aligned 1-D parameters (or, for a model
     with ``broadcasts = False``, one call per distinct parameter set) and returns values of the
     flat shape. Returns a float when everything is scalar, else an array of the broadcast shape.
+    ``per_set`` forces one call per parameter set (a model whose derived quantities are cached per
+    parameter set, such as the flow table of a non-separable rheology).
     """
     arrays = [np.asarray(a, dtype=float) for a in args]
     shape = np.broadcast_shapes(*(a.shape for a in arrays), parameter_shape(model))
@@ -274,7 +276,7 @@ def evaluate(model, fn, *args):
         return float(np.asarray(fn(model, *arrays), dtype=float))
     flat = [np.broadcast_to(a, shape).ravel() if a.ndim else a for a in arrays]
     n = int(np.prod(shape, dtype=int))
-    if getattr(type(model), "broadcasts", True):
+    if getattr(type(model), "broadcasts", True) and not per_set:
         out = np.asarray(fn(broadcast_model(model, shape), *flat), dtype=float)
         return np.array(np.broadcast_to(out.reshape(-1) if out.ndim else out, (n,)).reshape(shape))
     out = np.empty(n)

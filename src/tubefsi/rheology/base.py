@@ -37,6 +37,7 @@ import numpy as np
 from .._numerics import as_output
 from .._validation import as_array
 from ..errors import InvalidParameterError
+from ..fields import _array_fields, evaluate, model_at
 from ._flow_table import check, flow_table, rate_natural_rate, stress_natural_rate, unit_integral
 
 __all__ = ["Rheology"]
@@ -91,54 +92,49 @@ class Rheology(abc.ABC):
     _examples: ClassVar[tuple] = ()
 
     # ------------------------------------------------------------------ public API
+    # Arguments and array parameters broadcast together (tubefsi.fields.evaluate); a
+    # non-separable rheology is evaluated per parameter set (its flow table is per set).
+    def _evaluate(self, fn, *args):
+        return evaluate(self, fn, *args, per_set=not self.separable)
+
     def stress(self, shear_rate):
         """Shear stress (Pa) at shear rate ``shear_rate`` (1/s, >= 0)."""
         g = as_array("shear_rate", shear_rate, "[0, inf)", lambda a: a >= 0)
-        return as_output(np.where(g == 0, 0.0, self._stress(np.where(g == 0, 1.0, g))), np.ndim(shear_rate) == 0)
+        return self._evaluate(lambda m, g: _masked(m, "_stress", g > 0, g), g)
 
     def shear_rate(self, stress):
         """Shear rate (1/s) at shear stress ``stress`` (Pa, >= 0)."""
         t = as_array("stress", stress, "[0, inf)", lambda a: a >= 0)
-        return as_output(np.where(t == 0, 0.0, self._shear_rate(np.where(t == 0, 1.0, t))), np.ndim(stress) == 0)
+        return self._evaluate(lambda m, t: _masked(m, "_shear_rate", t > 0, t), t)
 
     def apparent_viscosity(self, shear_rate):
         r"""Apparent viscosity :math:`\eta = \tau/\dot\gamma` (Pa s), shear rate > 0."""
         g = as_array("shear_rate", shear_rate, "(0, inf)", lambda a: a > 0)
-        return as_output(self._stress(g) / g, np.ndim(shear_rate) == 0)
+        return self._evaluate(lambda m, g: m._stress(g) / g, g)
 
     def flow_rate(self, radius, pressure_gradient):
         r"""Flow rate :math:`q(R, G)` (m^3/s) in a rigid tube of radius ``radius`` (m)
         under pressure gradient :math:`G = -dp/dz` (Pa/m)."""
         r = as_array("radius", radius, "(0, inf)", lambda a: a > 0)
         g = as_array("pressure_gradient", pressure_gradient, "[0, inf)", lambda a: a >= 0)
-        r, g = np.broadcast_arrays(r, g)
-        out = np.zeros(r.shape)
-        pos = g > 0
-        out[pos] = self._flow_rate(r[pos], g[pos])
-        return as_output(out, np.ndim(radius) == 0 and np.ndim(pressure_gradient) == 0)
+        return self._evaluate(lambda m, r, g: _masked(m, "_flow_rate", g > 0, r, g), r, g)
 
     def pressure_gradient(self, flow_rate, radius):
         r"""Pressure gradient :math:`G(q, R) = -dp/dz` (Pa/m) that drives ``flow_rate`` (m^3/s)."""
         q = as_array("flow_rate", flow_rate, "[0, inf)", lambda a: a >= 0)
         r = as_array("radius", radius, "(0, inf)", lambda a: a > 0)
-        q, r = np.broadcast_arrays(q, r)
-        out = np.zeros(q.shape)
-        pos = q > 0
-        out[pos] = self._pressure_gradient(q[pos], r[pos])
-        return as_output(out, np.ndim(flow_rate) == 0 and np.ndim(radius) == 0)
+        return self._evaluate(lambda m, q, r: _masked(m, "_pressure_gradient", q > 0, q, r), q, r)
 
     def velocity(self, r, radius, pressure_gradient):
         r"""Axial velocity (m/s) at radial position ``r`` (0 <= r <= radius)."""
         rr = as_array("r", r, "[0, radius]", lambda a: a >= 0)
         big_r = as_array("radius", radius, "(0, inf)", lambda a: a > 0)
         g = as_array("pressure_gradient", pressure_gradient, "[0, inf)", lambda a: a >= 0)
-        rr, big_r, g = np.broadcast_arrays(rr, big_r, g)
-        if np.any(rr > big_r * (1 + 1e-12)):
-            raise _invalid("r", "[0, radius]", rr[rr > big_r].flat[0])
-        out = np.zeros(rr.shape)
-        pos = g > 0
-        out[pos] = self._velocity(np.minimum(rr[pos], big_r[pos]), big_r[pos], g[pos])
-        return as_output(out, all(np.ndim(v) == 0 for v in (r, radius, pressure_gradient)))
+        rb, bb = np.broadcast_arrays(rr, big_r)
+        if np.any(rb > bb * (1 + 1e-12)):
+            raise _invalid("r", "[0, radius]", rb[rb > bb * (1 + 1e-12)].flat[0])
+        return self._evaluate(lambda m, rr, big_r, g: _masked(
+            m, "_velocity", g > 0, np.minimum(rr, big_r), big_r, g), rr, big_r, g)
 
     # ------------------------------------------------------------------ hooks
     def _stress(self, shear_rate):
@@ -318,6 +314,23 @@ class Rheology(abc.ABC):
 
     def _radius_factor(self, radius):
         raise NotImplementedError
+
+
+def _masked(model, hook, mask, *args):
+    """``model.<hook>(*args)`` where ``mask`` holds, 0 elsewhere (flat arguments, or scalars; the
+    model's array parameters aligned with the flat arguments)."""
+    shape = np.broadcast_shapes(*(np.shape(a) for a in args), np.shape(mask))
+    mask = np.broadcast_to(mask, shape)
+    out = np.zeros(shape)
+    if shape == ():
+        return getattr(model, hook)(*args) if mask else 0.0
+    index = np.flatnonzero(mask.ravel())
+    if index.size:
+        sub = model_at(model, index) if any(np.ndim(getattr(model, n)) for n in _array_fields(type(model))) \
+            else model
+        picked = [np.broadcast_to(a, shape).ravel()[index] for a in args]
+        out.ravel()[index] = getattr(sub, hook)(*picked)
+    return out
 
 
 def _positive(x):

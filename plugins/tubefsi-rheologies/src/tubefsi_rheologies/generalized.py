@@ -28,15 +28,25 @@ def _log1p_power(x, a):
     return np.where(la > 0, la + np.log1p(np.exp(-np.abs(la))), np.log1p(np.exp(np.minimum(la, 0.0))))
 
 
+def _require(ok, name, admissible, value, detail=None):
+    """An ``InvalidParameterError`` naming the first entry where ``ok`` fails (arrays broadcast)."""
+    ok = np.asarray(ok)
+    if np.all(ok):
+        return
+    bad = tuple(int(i) for i in np.argwhere(~ok)[0]) if ok.ndim else ()
+    value = np.broadcast_to(np.asarray(value, dtype=float), ok.shape)[bad]
+    where = f"entry {bad}" if bad else ""
+    raise InvalidParameterError(name, admissible, float(value), "; ".join(p for p in (detail, where) if p))
+
+
 class _ViscosityRange(Rheology):
     """Shared check: ``0 <= infinite_shear_viscosity <= zero_shear_viscosity``."""
 
     __slots__ = ()
 
     def __attrs_post_init__(self):
-        if not self.infinite_shear_viscosity <= self.zero_shear_viscosity:
-            raise InvalidParameterError("infinite_shear_viscosity", f"[0, zero_shear_viscosity = "
-                                        f"{self.zero_shear_viscosity:g}]", self.infinite_shear_viscosity)
+        _require(self.infinite_shear_viscosity <= self.zero_shear_viscosity, "infinite_shear_viscosity",
+                 "[0, zero_shear_viscosity]", self.infinite_shear_viscosity)
 
 
 @attrs.frozen(kw_only=True)
@@ -114,11 +124,10 @@ class Cross(_ViscosityRange):
     def __attrs_post_init__(self):
         super().__attrs_post_init__()
         m, e0, einf = self.exponent, self.zero_shear_viscosity, self.infinite_shear_viscosity
-        if m >= 1.0 and not einf > (e0 - einf) * (m - 1.0) ** 2 / (4.0 * m):
-            raise InvalidParameterError(
-                "exponent", "(0, 1), or [1, inf) with infinite_shear_viscosity > "
-                "(zero_shear_viscosity - infinite_shear_viscosity) (m - 1)^2 / (4 m)", m,
-                "the shear stress would not increase with the shear rate")
+        _require((m < 1.0) | (einf > (e0 - einf) * (m - 1.0) ** 2 / (4.0 * m)), "exponent",
+                 "(0, 1), or [1, inf) with infinite_shear_viscosity > "
+                 "(zero_shear_viscosity - infinite_shear_viscosity) (m - 1)^2 / (4 m)", m,
+                 "the shear stress would not increase with the shear rate")
 
     def _stress(self, shear_rate):
         x = self.relaxation_time * shear_rate
