@@ -197,14 +197,15 @@ class SeparatedVariables(Coupler):
         return out
 
     # --------------------------------------------------------------- problems
-    def flow_controlled(self, scene: Scene, flow_rate) -> State:
-        """Solve for the pressure drop at each flow rate (flat array, one per point)."""
+    def flow_controlled(self, scene: Scene, flow_rate, *, target=None) -> State:
+        """Solve for the pressure drop at each flow rate (flat array, one per point); ``target``:
+        the right-hand side of the separated identity if the caller has it already."""
         q = np.asarray(flow_rate, dtype=float)
         if scene.wall.is_rigid:
             return _rigid_state(scene, flow_rate=q)
         index = np.arange(q.size)
         pts = scene.at(index)
-        target = np.where(q == 0, 0.0, self.target(pts, q))
+        target = np.where(q == 0, 0.0, self.target(pts, q) if target is None else target)
         v = np.zeros(q.shape)
         dp = np.full(q.shape, np.nan)
         direct = target > 0
