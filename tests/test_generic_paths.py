@@ -5,6 +5,8 @@ A power law written as a *non-separable* rheology (only ``_stress`` or only
 the tabulated flow function, the non-separable couplers and max_flow_rate.
 """
 
+import re
+
 import attrs
 import numpy as np
 import pytest
@@ -80,6 +82,12 @@ def test_wall_given_only_by_its_inverse_law():
     fluid = rheologies["power-law"](consistency=0.017, index=0.7)
     ref = walls["thin-linear"](youngs_modulus=6e3, poisson_ratio=0.5)
     q = np.array([1e-11, 1e-9, 5e-9])
-    a = tubefsi.solve(fluid, InverseLinear(), TUBE, flow_rate=q)
+    # the tube law of a wall given by its inverse is itself a root solve, and its slope a difference
+    # of it: the integral cannot reach 1e-14 and says so, with its estimate (a few 1e-9)
+    with pytest.warns(tubefsi.AccuracyWarning, match="estimated relative error up to") as caught:
+        a = tubefsi.solve(fluid, InverseLinear(), TUBE, flow_rate=q)
+    estimate = max(float(re.search(r"up to ([0-9.e+-]+)", str(w.message)).group(1)) for w in caught
+                   if issubclass(w.category, tubefsi.AccuracyWarning))
     b = tubefsi.solve(fluid, ref, TUBE, flow_rate=q)
-    np.testing.assert_allclose(a.pressure_drop, b.pressure_drop, rtol=1e-9)
+    assert estimate < 1e-7
+    np.testing.assert_allclose(a.pressure_drop, b.pressure_drop, rtol=2 * estimate)
