@@ -18,7 +18,7 @@ from ._progress import bar
 from ._validation import as_load
 from .couplers.base import Coupler
 from .couplers.checked import checked
-from .errors import InvalidParameterError, NoSteadyStateError
+from .errors import InvalidParameterError, NoSteadyStateError, StretchRangeError
 from .couplers.separated import _TABLES, SeparatedVariables
 from .geometry import Tube
 from .rheology.base import Rheology
@@ -155,7 +155,7 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
                 # solve first, and look for the limit (a quadrature to infinity) only if one did
                 try:
                     state = method(chunk, values[idx])
-                except NoSteadyStateError as error:
+                except (NoSteadyStateError, StretchRangeError) as error:   # the limit decides which
                     if _feasible(runner, chunk, values[idx], controlled, raise_=on_infeasible == "raise") is None:
                         raise error
                 else:
