@@ -248,7 +248,8 @@ def _cmd_solve(args, out) -> int:
         load["pressure_drop"] = _load_values("--pressure-drop", args.pressure_drop)
     from .solve import solve
 
-    sol = solve(fluid, wall, tube, coupler=coupler, outlet_pressure=args.outlet_pressure, **load)
+    sol = solve(fluid, wall, tube, coupler=coupler, outlet_pressure=args.outlet_pressure, density=args.density,
+                **load)
 
     result = {}
     for key in _OUTPUT_UNITS:
@@ -283,6 +284,8 @@ def _parser() -> argparse.ArgumentParser:
     load.add_argument("--flow-rate", metavar="Q[,Q...]", help="flow rate(s) (m^3/s)")
     load.add_argument("--pressure-drop", metavar="DP[,DP...]", help="pressure drop(s) (Pa)")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
+    p.add_argument("--density", type=float, metavar="RHO",
+                   help="fluid density (kg/m^3): warn where the reduced Reynolds number is not small")
     p.set_defaults(run=_cmd_solve)
 
     p = sub.add_parser("reproduce", help="the chapter's figures, as printed and consistent (PNG and CSV)")
