@@ -9,6 +9,7 @@ r"""The ``tubefsi`` command: list the registered models, solve a scene, sweep a 
     tubefsi curve  ... --flow-rate 0:1e-8:200 [--log] [--format csv|json|netcdf] [--output FILE]
                        [--plot FILE] [--density RHO] [--progress]
     tubefsi advise ... --flow-rate 5e-9 [--density 1060]
+    tubefsi network FILE [--format json|csv] [--output FILE|PREFIX] [--plot FILE]
     tubefsi reproduce [OUTDIR]
 
 A model is ``NAME`` or ``NAME:key=value,key=value`` with the parameter names of
@@ -219,24 +220,28 @@ def _scene_from_args(args):
     """(fluid, wall, tube, coupler) from the shared scene options."""
     fluid = _build("rheology", registry.rheologies, args.rheology)
     wall = _build("wall", registry.walls, args.wall)
-    tube_params = _parse_pairs(args.tube, args.tube)
-    expected = ("radius", "thickness", "length")
-    unknown = [k for k in tube_params if k not in expected]
-    if unknown:
-        raise UsageError(f"--tube has no parameter {unknown[0]!r}; expected radius, thickness, length (m)")
-    missing = [k for k in expected if k not in tube_params]
-    if missing:
-        raise UsageError(f"--tube needs {', '.join(missing)} (m), e.g. --tube radius=1e-4,thickness=3e-5,"
-                         "length=1e-2")
-    from .fields import parameters
-    from .geometry import Tube
-
-    _plain_numbers("--tube", tube_params, {p.name: p for p in parameters(Tube)})
-    tube = Tube(**tube_params)
+    tube = _tube(args.tube, "--tube")
     coupler = args.coupler
     if coupler != "auto":
         coupler = _build("coupler", registry.couplers, coupler)
     return fluid, wall, tube, coupler
+
+
+def _tube(text, option):
+    """A Tube from ``radius=..,thickness=..,length=..``."""
+    tube_params = _parse_pairs(text, text)
+    expected = ("radius", "thickness", "length")
+    unknown = [k for k in tube_params if k not in expected]
+    if unknown:
+        raise UsageError(f"{option} has no parameter {unknown[0]!r}; expected radius, thickness, length (m)")
+    missing = [k for k in expected if k not in tube_params]
+    if missing:
+        raise UsageError(f"{option} needs {', '.join(missing)} (m), e.g. radius=1e-4,thickness=3e-5,length=1e-2")
+    from .fields import parameters
+    from .geometry import Tube
+
+    _plain_numbers(option, tube_params, {p.name: p for p in parameters(Tube)})
+    return Tube(**tube_params)
 
 
 def _cmd_solve(args, out) -> int:
@@ -248,7 +253,8 @@ def _cmd_solve(args, out) -> int:
         load["pressure_drop"] = _load_values("--pressure-drop", args.pressure_drop)
     from .solve import solve
 
-    sol = solve(fluid, wall, tube, coupler=coupler, outlet_pressure=args.outlet_pressure, **load)
+    sol = solve(fluid, wall, tube, coupler=coupler, outlet_pressure=args.outlet_pressure, density=args.density,
+                **load)
 
     result = {}
     for key in _OUTPUT_UNITS:
@@ -283,6 +289,8 @@ def _parser() -> argparse.ArgumentParser:
     load.add_argument("--flow-rate", metavar="Q[,Q...]", help="flow rate(s) (m^3/s)")
     load.add_argument("--pressure-drop", metavar="DP[,DP...]", help="pressure drop(s) (Pa)")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
+    p.add_argument("--density", type=float, metavar="RHO",
+                   help="fluid density (kg/m^3): warn where the reduced Reynolds number is not small")
     p.set_defaults(run=_cmd_solve)
 
     p = sub.add_parser("reproduce", help="the chapter's figures, as printed and consistent (PNG and CSV)")
@@ -308,6 +316,19 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--progress", action="store_true",
                    help="show a progress bar (tqdm; shown anyway on a terminal when tqdm is installed)")
     p.set_defaults(run=_cmd_curve)
+
+    p = sub.add_parser("network", help="solve a network of tubes described in a JSON file",
+                       description="Solve a network (Kirchhoff over its tubes) described in FILE: "
+                                   '{"rheology": "NAME:k=v,...", "tubes": [{"u": "a", "v": "b", "name": "ab", '
+                                   '"wall": "NAME:k=v,...", "tube": {"radius": 1e-4, "thickness": 3e-5, '
+                                   '"length": 1e-2}}, ...], "pressures": {"a": 500, "c": 0}, "inflows": {}}. '
+                                   + _SCENE_HELP)
+    p.add_argument("file", metavar="FILE", help="the network description (JSON)")
+    p.add_argument("--format", choices=("json", "csv"), default="json",
+                   help="json (default: nodes and tubes) or csv (two tables, PREFIX_nodes.csv, PREFIX_tubes.csv)")
+    p.add_argument("--output", metavar="FILE|PREFIX", help="write the result here instead of standard output")
+    p.add_argument("--plot", metavar="FILE", help="also save a plot of the network")
+    p.set_defaults(run=_cmd_network)
 
     p = sub.add_parser("advise", help="compare the model with simpler ones on the same scene",
                        description="Recommend the cheapest model within a tolerance. " + _SCENE_HELP)
@@ -439,6 +460,74 @@ def _cmd_curve(args, out) -> int:
     return 0
 
 
+def _network_from_file(path):
+    """A :class:`~tubefsi.Network` from a JSON description (``docs/cli.md``, "Networks")."""
+    from .network import Network
+
+    try:
+        with open(path, encoding="utf-8") as fh:
+            spec = json.load(fh)
+    except OSError as exc:
+        raise UsageError(f"cannot read the network file {path!r}: {exc.strerror}") from None
+    except json.JSONDecodeError as exc:
+        raise UsageError(f"{path!r} is not JSON: {exc.msg} at line {exc.lineno}") from None
+    if not isinstance(spec, dict) or not isinstance(spec.get("tubes"), list) or not spec["tubes"]:
+        raise UsageError(f"{path!r}: expected an object with a non-empty list 'tubes'")
+    unknown = sorted(set(spec) - {"rheology", "tubes", "pressures", "inflows", "positions"})
+    if unknown:
+        raise UsageError(f"{path!r}: unknown key {unknown[0]!r}; keys: rheology, tubes, pressures, inflows, "
+                         "positions")
+    fluid = _build("rheology", registry.rheologies, spec["rheology"]) if "rheology" in spec else None
+    net = Network(rheology=fluid)
+    for i, item in enumerate(spec["tubes"]):
+        where = f"{path!r}, tube {i}"
+        if not isinstance(item, dict) or not {"u", "v", "wall", "tube"} <= set(item):
+            raise UsageError(f"{where}: expected u, v, wall, tube (and optionally name, rheology)")
+        geometry = item["tube"]
+        if isinstance(geometry, dict):
+            geometry = ",".join(f"{k}={v}" for k, v in geometry.items())
+        wall = _build("wall", registry.walls, item["wall"])
+        rheology = _build("rheology", registry.rheologies, item["rheology"]) if "rheology" in item else None
+        net.add_tube(item["u"], item["v"], wall, _tube(geometry, f"{where}: tube"), name=item.get("name"),
+                     rheology=rheology)
+    for node, p in dict(spec.get("pressures", {})).items():
+        net.set_pressure(node, p)
+    for node, q in dict(spec.get("inflows", {})).items():
+        net.set_inflow(node, q)
+    for node, xy in dict(spec.get("positions", {})).items():
+        net.set_position(node, xy)
+    return net
+
+
+def _cmd_network(args, out) -> int:
+    if args.format == "csv" and not args.output:
+        raise UsageError("--format csv writes two tables: give --output PREFIX")
+    if args.output:
+        _writable("--output", args.output + "_nodes.csv" if args.format == "csv" else args.output)
+    if args.plot:
+        _check_outputs(argparse.Namespace(format="csv", output=None, plot=args.plot))
+    net = _network_from_file(args.file)
+    if args.plot and set(net.nodes) - set(net.positions):
+        try:
+            import networkx  # noqa: F401
+        except ImportError:
+            raise UsageError("--plot needs the nodes' positions (a 'positions' object in FILE) or networkx "
+                             "for a layout: pip install 'tubefsi[network]'") from None
+    result = net.solve()
+    if args.format == "csv":
+        for written in result.to_csv(args.output):
+            print(f"wrote {written}", file=out)
+    elif args.output:
+        result.to_json(args.output)
+        print(f"wrote {args.output}", file=out)
+    else:
+        out.write(result.to_json() + "\n")
+    if args.plot:
+        ax = result.plot()
+        ax.figure.savefig(args.plot, dpi=130)
+    return 0
+
+
 def _cmd_reproduce(args, out) -> int:
     from .chapter import reproduce_chapter
 
@@ -496,7 +585,8 @@ def main(argv=None) -> int:
     except SystemExit as exc:  # --help, --version
         return exc.code if isinstance(exc.code, int) else 0
     if args.command is None:
-        return _error("a command is required: list, solve, curve, advise or reproduce (see 'tubefsi --help')")
+        return _error("a command is required: list, solve, curve, network, advise or reproduce "
+                      "(see 'tubefsi --help')")
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", ModelValidityWarning)

@@ -40,6 +40,7 @@ import csv
 import functools
 import json
 import math
+import warnings
 
 import attrs
 import numpy as np
@@ -48,10 +49,12 @@ from scipy.sparse import csgraph
 from scipy.sparse import linalg as spla
 
 from ._validation import as_array
-from .errors import AccuracyWarning, ConvergenceError, InvalidParameterError, NoSteadyStateError, warn_user
+from . import validity
+from .errors import (AccuracyWarning, ConvergenceError, InvalidParameterError, ModelValidityWarning,
+                     NoSteadyStateError, warn_user)
 from .fields import _array_fields, parameter_shape
 from .geometry import Tube
-from .scene import resolve
+from .scene import make_scene, resolve
 from .solution import Solution
 from .solve import max_flow_rate as tubefsi_max_flow
 from .solve import solve
@@ -276,19 +279,38 @@ class _Groups:
         controlled; zeros for the tubes of no group)."""
         q, d_in, d_out, radius_in, radius_out = (np.zeros(drop.size) for _ in range(5))
         for index, fluid, wall, tube in self.parts:
-            sol = solve(fluid, wall, tube, pressure_drop=drop[index], outlet_pressure=outlet[index])
+            with warnings.catch_warnings():    # Newton's trial pressures: the result is checked once
+                warnings.simplefilter("ignore", ModelValidityWarning)
+                sol = solve(fluid, wall, tube, pressure_drop=drop[index], outlet_pressure=outlet[index])
             q[index] = sol.flow_rate
             _, d_in[index], d_out[index] = sol._sensitivities()
             radius_in[index] = sol.inlet_radius
             radius_out[index] = np.broadcast_to(tube.radius * sol.scene.outlet_stretch, index.shape)
         return q, d_in, d_out, radius_in, radius_out
 
+    def check(self, q, radius_u, radius_v, tubes):
+        """The converged tubes against the model's assumptions (:mod:`tubefsi.validity`): one
+        ModelValidityWarning per failed assumption of a group, naming its first offending tube."""
+        for index, fluid, wall, tube in self.parts:
+            scene = make_scene(fluid, wall, tube)
+            scene = scene.flat(index.shape) if scene.shape != () else scene
+            big = np.maximum(radius_u[index], radius_v[index])
+            found = validity.check(scene, np.abs(q[index]), big / np.broadcast_to(tube.radius, index.shape) - 1.0)
+            if found.messages:
+                slender = big / np.broadcast_to(tube.length, index.shape)
+                name = tubes[index[int(np.argmax(slender))]].name
+                validity.warn(attrs.evolve(found, messages=tuple(
+                    f"network (e.g. tube {name!r}): {m.replace(' points', ' tubes')}" for m in found.messages)))
+
     def inlet(self, q, outlet, tubes):
         """Flow-controlled: the inlet pressure and the inlet and outlet radii of the tubes carrying
         ``q > 0`` with ``outlet`` pressure; a flow rate beyond a tube's maximum raises, naming it."""
         p_in, radius_in, radius_out = (np.zeros(q.size) for _ in range(3))
         for index, fluid, wall, tube in self.parts:
-            sol = solve(fluid, wall, tube, flow_rate=q[index], outlet_pressure=outlet[index], on_infeasible="nan")
+            with warnings.catch_warnings():    # checked with the rest of the result
+                warnings.simplefilter("ignore", ModelValidityWarning)
+                sol = solve(fluid, wall, tube, flow_rate=q[index], outlet_pressure=outlet[index],
+                            on_infeasible="nan")
             if sol.feasible is not None:
                 j = int(np.flatnonzero(~sol.feasible)[0])
                 limit = np.broadcast_to(tubefsi_max_flow(fluid, wall, tube, outlet_pressure=outlet[index]), index.shape)[j]
@@ -544,6 +566,8 @@ class _Solver:
             at_u = self.feed_node == self.U
             r_u = np.where(self.feeder, np.where(at_u, r_in, r_out), r_u)
             r_v = np.where(self.feeder, np.where(at_u, r_out, r_in), r_v)
+        for groups in (self.groups, self.feed_groups):
+            groups.check(q, r_u, r_v, self.tubes)
         return NetworkSolution(net=self.net, nodes=self.nodes, tubes=self.tubes, p=p, q=q, radius_u=r_u,
                                radius_v=r_v, iterations=iterations, residual=residual)
 

@@ -265,7 +265,7 @@ def _feasible(coupler, scene, load, controlled, *, raise_):
         value = float(load[i]) if quantity == "flow_rate" else float(
             np.broadcast_to(np.asarray(scene.outlet_pressure), load.shape)[i] + load[i])
         raise NoSteadyStateError(quantity, float(np.broadcast_to(limit, load.shape)[i]), value, detail,
-                                 name="the flow rate" if quantity == "flow_rate" else "the inlet pressure")
+                                 name="" if quantity == "flow_rate" else "the inlet pressure")
     return ~beyond
 
 

@@ -54,6 +54,9 @@ __all__ = ["SeparatedVariables", "MAX_LOG_STRETCH"]
 #: limit (``max_flow_rate`` is the one limit): beyond it ``StretchRangeError``.
 MAX_LOG_STRETCH = math.log(1e15)
 _PROBE_LOG_STRETCH = math.log(1e8)
+#: A runaway solve within this relative distance of the maximum flow rate is at the limit (to
+#: the accuracy of q_max): NoSteadyStateError, not StretchRangeError.
+_AT_THE_LIMIT = 1e-11
 
 
 def _pick(value, index):
@@ -651,6 +654,9 @@ class SeparatedVariables(Coupler):
         q_bad = float(q.ravel()[bad])
         if math.isfinite(q_max) and q_bad >= q_max:
             raise NoSteadyStateError("flow_rate", q_max, q_bad, "the tube inflates without bound")
+        if math.isfinite(q_max) and q_bad >= q_max * (1.0 - _AT_THE_LIMIT):
+            raise NoSteadyStateError("flow_rate", q_max, q_bad, "the tube inflates without bound (this flow "
+                                     f"rate is the maximum one to within {_AT_THE_LIMIT:.0e}, its accuracy)")
         ids = np.array([0])
         cap = np.atleast_1d(self._log_stretch_cap(one, ids))
         pts = one.at(ids)
