@@ -60,6 +60,16 @@ class _LinearWall(WallModel):
     def _stiffness_decay_exponent(self, tb):
         return 0.0
 
+    def _min_pressure(self, tb):
+        r"""Minus the buckling pressure of a long ring, :math:`E t^3/(4(1-\nu^2)R^3)`, with the inner
+        radius (thin) or, conservatively, the outer radius (thick) for :math:`R`
+        (``docs/walls_beyond.md``, section "Buckling")."""
+        nu = self.poisson_ratio
+        return -self.youngs_modulus * tb**3 / (4.0 * (1.0 - nu) * (1.0 + nu) * self._ring_radius(tb) ** 3)
+
+    def _min_stretch(self, tb):
+        return 1.0 + self._strain(self._min_pressure(tb), tb)
+
     def _power_law_integral(self, log_ratio, outlet_stretch, exponent, tb):
         k = exponent
         return outlet_stretch ** (k + 1) * expm1_ratio(k + 1, log_ratio) / self._compliance(tb)
@@ -94,6 +104,10 @@ class ThinLinear(_LinearWall):
     poisson_ratio: float = _poisson()
     end_condition: str = _ends()
 
+    @staticmethod
+    def _ring_radius(tb):
+        return 1.0
+
     def _factor(self, tb):
         nu = self.poisson_ratio
         if self.end_condition == "closed":
@@ -114,6 +128,10 @@ class ThickLinear(_LinearWall):
     youngs_modulus: float = _young()
     poisson_ratio: float = _poisson()
     end_condition: str = _ends()
+
+    @staticmethod
+    def _ring_radius(tb):
+        return 1.0 + tb
 
     def _factor(self, tb):
         nu = self.poisson_ratio
