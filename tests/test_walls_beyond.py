@@ -319,6 +319,10 @@ def test_pre_stretched_tube_in_situ_matches_mpmath(lz):
     sol0 = tubefsi.solve(NEWTONIAN, wall, TUBE, flow_rate=0.0)
     assert sol0.radius(0.0) == pytest.approx(TUBE.radius / math.sqrt(lz), rel=1e-15)
     assert sol0.tube.length == pytest.approx(lz * TUBE.length, rel=1e-15)
+    again = tubefsi.solve(NEWTONIAN, wall, sol0.tube, flow_rate=1e-9)         # not installed twice
+    assert again.pressure_drop == tubefsi.solve(NEWTONIAN, wall, TUBE, flow_rate=1e-9).pressure_drop
+    with pytest.raises(tubefsi.InvalidParameterError, match="tube"):
+        tubefsi.solve(NEWTONIAN, make("neo-hookean", "thick", 1.1), sol0.tube, flow_rate=1e-9)
     dW = physical_dW("neo-hookean", lz)
     tb = TUBE.reduced_thickness
     B = (1 + mp.mpf(tb)) ** 2

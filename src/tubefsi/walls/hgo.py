@@ -33,6 +33,7 @@ import math
 import attrs
 import numpy as np
 
+from ..errors import InvalidParameterError
 from ..fields import positive, real
 from .hyperelastic import HyperelasticWall, ThickWall, ThinWall
 
@@ -64,8 +65,6 @@ class HolzapfelGasserOgden(HyperelasticWall):
     @classmethod
     def preset(cls, name: str, **overrides):
         """A wall of a published parameter set of :data:`PRESETS` (e.g. ``"rabbit-carotid-media"``)."""
-        from ..errors import InvalidParameterError
-
         if name not in PRESETS:
             raise InvalidParameterError("preset", "{" + ", ".join(PRESETS) + "}", name)
         return cls(**{**PRESETS[name], **overrides})

@@ -47,13 +47,15 @@ import numpy as np
 from scipy import differentiate
 
 from .._quadrature import adaptive, adaptive_to_pole, warn_unconverged
+from ..errors import InvalidParameterError
+from ..geometry import Tube
 from ..fields import choice, evaluate, flat_points, model_at, positive, take
 from .base import WallModel
 
 #: scipy.differentiate tolerances: as tight as the error estimate allows
 _DIFF_TOL = dict(rtol=1e-12, atol=0.0)
 
-__all__ = ["HyperelasticWall", "ThinWall", "ThickWall", "THICKNESS_CONVENTIONS", "axial_stretch"]
+__all__ = ["HyperelasticWall", "ThinWall", "ThickWall", "THICKNESS_CONVENTIONS", "axial_stretch", "InstalledTube"]
 
 THICKNESS_CONVENTIONS = ("reference", "current")
 
@@ -136,9 +138,15 @@ class HyperelasticWall(WallModel):
         lz = getattr(self, "axial_stretch", 1.0)
         if np.ndim(lz) == 0 and lz == 1.0:
             return tube
+        if isinstance(tube, InstalledTube):          # a solution's tube, solved again: already installed
+            if np.array_equal(np.broadcast_to(tube.axial_stretch, np.shape(lz)), lz):
+                return tube
+            raise InvalidParameterError("tube", "a stress-free Tube", tube,
+                                        f"it is installed at the axial stretch {tube.axial_stretch}, not {lz}")
         shrink = 1.0 / np.sqrt(lz)
-        return attrs.evolve(tube, radius=tube.radius * shrink, thickness=tube.thickness * shrink,
-                            length=tube.length * lz)
+        return InstalledTube(radius=tube.radius * shrink, thickness=tube.thickness * shrink,
+                             length=tube.length * lz, axial_stretch=lz)
+
 
     def _collapse_stretch(self, tb):
         # plane strain: the invariants are symmetric in lambda <-> 1/lambda, so a material that
@@ -285,3 +293,11 @@ class ThickWall(HyperelasticWall):
         lam_o = np.sqrt(1.0 + (lam * lam - 1.0) / b)
         return self._thick_integrand(lam) - self._thick_integrand(lam_o) * lam / (b * lam_o)
 
+
+@attrs.frozen(kw_only=True)
+class InstalledTube(Tube):
+    r"""A tube as installed at an axial stretch (what :attr:`tubefsi.Solution.tube` is for a wall
+    with ``axial_stretch``): radius and thickness over :math:`\sqrt{\lambda_z}`, length times
+    :math:`\lambda_z`; solving again with it and the same wall does not install it twice."""
+
+    axial_stretch: float = positive(doc="the axial stretch it is installed at")
