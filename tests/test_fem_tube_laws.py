@@ -274,7 +274,8 @@ def test_thick_law_matches_fem_of_the_walls_own_energy(name, params):
 
 BUILTIN_THICK = [pytest.param(name, kw, id=f"{name}-{i}")
                  for name in ("thick-neo-hookean", "thick-mooney-rivlin")
-                 for i, kw in enumerate(walls[name]._examples)]
+                 for i, kw in enumerate(walls[name]._examples)
+                 if kw.get("axial_stretch", 1.0) == 1.0]      # felupe's plane-strain ring: no pre-stretch
 
 
 @pytest.mark.parametrize("tb", [0.3, 1.0])

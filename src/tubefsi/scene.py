@@ -124,7 +124,8 @@ class Scene:
         fast path of :func:`tubefsi.solve`)."""
         new = object.__new__(cls)
         for name, value in (("rheology", rheology), ("wall", wall), ("tube", tube), ("outlet_pressure", 0.0),
-                            ("external_pressure", 0.0), ("gauge_outlet_pressure", 0.0), ("shape", ()), ("outlet_strain", 0.0), ("outlet_stretch", 1.0),
+                            ("external_pressure", 0.0), ("gauge_outlet_pressure", 0.0), ("shape", ()),
+                            ("outlet_strain", 0.0), ("outlet_stretch", 1.0),
                             ("log_stretch_max", log_stretch_max)):
             object.__setattr__(new, name, value)
         return new

@@ -403,7 +403,8 @@ class WallModel(abc.ABC):
         low = np.asarray(self._min_stretch(tb) if np.any(lam < 1) else 1.0, dtype=float)
         values, top, low = np.broadcast_arrays(lam, np.asarray(self._max_stretch(tb), dtype=float), low)
         with np.errstate(invalid="ignore"):
-            ok = np.isfinite(values) & (values >= low) & (values > 0) & (values < top)
+            # (a few ulps below the minimum stretch pass: the inverse at min_pressure is rounded)
+            ok = np.isfinite(values) & (values >= low * (1.0 - 8 * np.finfo(float).eps)) & (values > 0) & (values < top)
         if not np.all(ok):
             i = int(np.argmax(~ok.ravel()))
             t, b = float(top.flat[i]), float(low.flat[i])
