@@ -24,13 +24,13 @@ import sys
 import types
 
 from .errors import (AccuracyWarning, ConvergenceError, InvalidParameterError, ModelValidityWarning,
-                     NoSteadyStateError, StretchRangeError, TubefsiError)
+                     NoSteadyStateError, StretchRangeError, TubefsiError, BucklingError)
 
 __all__ = [
     "dimensionless", "fields", "Tube", "solve", "max_flow_rate", "select_coupler", "Solution", "registry",
     "advise", "Advice", "Diagnostics", "ModelValidityWarning", "fit", "FitResult", "Network", "NetworkSolution",
     "TubefsiError", "InvalidParameterError", "NoSteadyStateError", "ConvergenceError", "AccuracyWarning",
-    "StretchRangeError",
+    "StretchRangeError", "BucklingError",
 ]
 
 __version__ = "0.1.0"

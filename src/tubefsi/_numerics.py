@@ -248,3 +248,32 @@ def as_output(value, scalar: bool):
     if scalar and a.size == 1:
         return float(a.reshape(()))
     return a
+
+
+def solve_signed(F, dF, target, *, guess, lower=None, upper=None, **kw):
+    r""":func:`solve_increasing` for targets of either sign (``F`` increasing, ``F(0) = 0``).
+
+    Positive targets are solved as they are; negative ones on the reflected problem
+    :math:`-F(-x) = -\text{target}`, which is increasing with a root :math:`-x > 0`, below
+    ``-lower`` (``lower``: the bound of the negative roots, e.g. a strain of -1). ``F`` and ``dF``
+    take ``(x, index)`` as for :func:`solve_increasing`. Returns ``(x, ok)``.
+    """
+    target = np.asarray(target, dtype=float)
+    shape = target.shape
+    t = target.ravel()
+    g = np.broadcast_to(np.asarray(guess, dtype=float), shape).ravel()
+    neg = np.flatnonzero(t < 0)
+    if neg.size == 0:
+        return solve_increasing(F, dF, target, guess=guess, upper=upper, **kw)
+    x, ok = np.zeros(t.size), np.ones(t.size, dtype=bool)
+    pos = np.flatnonzero(t >= 0)
+    if pos.size:
+        up = None if upper is None else np.broadcast_to(np.asarray(upper, dtype=float), shape).ravel()[pos]
+        x[pos], ok[pos] = solve_increasing(lambda y, i: F(y, pos[i]), lambda y, i: dF(y, pos[i]), t[pos],
+                                           guess=g[pos], upper=up, **kw)
+    low = None if lower is None else -np.broadcast_to(np.asarray(lower, dtype=float), shape).ravel()[neg]
+    y, ok[neg] = solve_increasing(lambda y, i: -F(-y, neg[i]), lambda y, i: dF(-y, neg[i]), -t[neg],
+                                  guess=np.abs(g[neg]) if low is None else np.minimum(np.abs(g[neg]), 0.5 * low),
+                                  upper=low, **kw)
+    x[neg] = -y
+    return x.reshape(shape), ok.reshape(shape)

@@ -262,12 +262,14 @@ def diagnostics(solution, *, density=None, warn=True) -> Diagnostics:
         messages.append(f"thin-wall theory with t/a = {float(np.max(tb)):.3g} > 0.1: use the thick wall")
     limit = np.asarray(wall.limit_pressure(tb), dtype=float)
     with np.errstate(invalid="ignore"):
-        p_frac = float(np.nanmax(np.asarray(solution.outlet_pressure + st.pressure_drop) / limit, initial=0.0))
+        p_frac = float(np.nanmax(np.asarray(solution.scene.outlet_pressure + st.pressure_drop) / limit,   # transmural
+                                 initial=0.0))
     if p_frac > 0.9:
         messages.append(f"inlet pressure at {100 * p_frac:.1f} % of the limit pressure {float(np.min(limit)):.4g} Pa: "
                         "the tube is close to unbounded inflation")
     q_max = np.asarray(max_flow_rate(solution.rheology, wall, tube, outlet_pressure=solution.outlet_pressure,
-                                     coupler=solution.coupler), dtype=float)
+                                     external_pressure=solution.external_pressure, coupler=solution.coupler),
+                       dtype=float)
     with np.errstate(invalid="ignore"):
         q_frac = float(np.nanmax(np.asarray(st.flow_rate) / q_max, initial=0.0))
     if q_frac > 0.9:

@@ -16,6 +16,7 @@ __all__ = [
     "TubefsiError",
     "InvalidParameterError",
     "NoSteadyStateError",
+    "BucklingError",
     "ConvergenceError",
     "StretchRangeError",
     "AccuracyWarning",
@@ -131,3 +132,24 @@ def warn_user(message: str, category: type[Warning]) -> None:
     while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(_PACKAGE_DIR):
         frame, level = frame.f_back, level + 1
     warnings.warn(message, category, stacklevel=level)
+
+
+class BucklingError(NoSteadyStateError):
+    """A transmural pressure below the most negative one the wall holds: an axisymmetric tube
+    buckles there (the tube law no longer applies), or a tube law ends.
+
+    Attributes
+    ----------
+    quantity : str
+        ``"transmural_pressure"``.
+    limit : float
+        The lowest admissible transmural pressure (Pa, negative): minus the buckling pressure.
+    """
+
+    def __init__(self, limit: float, value=None, detail: str = ""):
+        self.quantity = "transmural_pressure"
+        self.limit = float(limit)
+        got = "" if value is None else f" (got {_short(value)})"
+        extra = f"; {detail}" if detail else ""
+        TubefsiError.__init__(self, f"no steady state: the transmural pressure must stay above {self.limit:.10g} Pa"
+                              f" (minus the buckling pressure){got}{extra}")

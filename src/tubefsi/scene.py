@@ -1,7 +1,10 @@
 r"""The scene: resolved models, the tube and the boundary state; and what a coupler returns.
 
 A :class:`Scene` is everything a coupler needs except the load: the rheology, the wall,
-the tube and the outlet pressure, plus the outlet state derived from them once. Build one
+the tube and the outlet pressure, plus the outlet state derived from them once. The wall
+responds to the transmural pressure: with an external pressure :math:`p_e` the scene's
+``outlet_pressure`` is the transmural :math:`p(L) - p_e`, which is all a coupler sees (the
+fluid does not feel a uniform offset), and ``gauge_outlet_pressure`` keeps the fluid's own. Build one
 with :func:`make_scene`, which accepts registered names, classes or instances and
 validates every argument. A coupler returns a :class:`State`: arrays of one shape.
 """
@@ -14,7 +17,7 @@ import attrs
 import numpy as np
 
 from ._validation import as_array
-from .errors import InvalidParameterError, NoSteadyStateError
+from .errors import BucklingError, InvalidParameterError, NoSteadyStateError
 from .geometry import Tube
 from .registry import rheologies as _rheologies
 from .registry import walls as _walls
@@ -56,6 +59,11 @@ def _value_eq(a, b) -> bool:
 class Scene:
     r"""A rheology, a wall, a tube and an outlet pressure: everything but the load.
 
+    ``outlet_pressure`` is the *transmural* pressure at the outlet, :math:`p(L) - p_e` (what the
+    wall sees and the couplers use); ``external_pressure`` is :math:`p_e` and
+    ``gauge_outlet_pressure`` the fluid's outlet pressure :math:`p(L)` (by default
+    ``outlet_pressure + external_pressure``; :func:`make_scene` passes the exact value).
+
     Build it with :func:`make_scene` (which validates). Every model parameter, every tube field
     and the outlet pressure may be an array: the scene's :attr:`shape` is their broadcast shape,
     and the loads of a solve broadcast against it. The outlet state is derived once:
@@ -79,6 +87,8 @@ class Scene:
     wall: WallModel
     tube: Tube
     outlet_pressure: float = attrs.field(default=0.0, eq=attrs.cmp_using(eq=_value_eq), hash=False)
+    external_pressure: float = attrs.field(default=0.0, eq=attrs.cmp_using(eq=_value_eq), hash=False)
+    gauge_outlet_pressure: float = attrs.field(default=None, eq=False, hash=False)
 
     shape: tuple = attrs.field(init=False, eq=False)
     outlet_strain: float = attrs.field(init=False, eq=False, hash=False)
@@ -86,8 +96,12 @@ class Scene:
     log_stretch_max: float = attrs.field(init=False, eq=False, hash=False)
 
     def __attrs_post_init__(self):
+        if self.gauge_outlet_pressure is None:
+            gauge = np.add(self.outlet_pressure, self.external_pressure)
+            object.__setattr__(self, "gauge_outlet_pressure", float(gauge) if np.ndim(gauge) == 0 else gauge)
         shape = np.broadcast_shapes(parameter_shape(self.rheology), parameter_shape(self.wall),
-                                    parameter_shape(self.tube), np.shape(self.outlet_pressure))
+                                    parameter_shape(self.tube), np.shape(self.outlet_pressure),
+                                    np.shape(self.external_pressure), np.shape(self.gauge_outlet_pressure))
         object.__setattr__(self, "shape", shape)
         # the hoop strain at the outlet, once: every J evaluation needs it
         p_out, tb = self.outlet_pressure, self.tb
@@ -110,7 +124,8 @@ class Scene:
         fast path of :func:`tubefsi.solve`)."""
         new = object.__new__(cls)
         for name, value in (("rheology", rheology), ("wall", wall), ("tube", tube), ("outlet_pressure", 0.0),
-                            ("shape", ()), ("outlet_strain", 0.0), ("outlet_stretch", 1.0),
+                            ("external_pressure", 0.0), ("gauge_outlet_pressure", 0.0), ("shape", ()),
+                            ("outlet_strain", 0.0), ("outlet_stretch", 1.0),
                             ("log_stretch_max", log_stretch_max)):
             object.__setattr__(new, name, value)
         return new
@@ -194,7 +209,8 @@ def _evolve_arrays(scene, transform):
     for name, value in (("rheology", models(scene.rheology)), ("wall", models(scene.wall)),
                         ("tube", models(scene.tube))):
         object.__setattr__(new, name, value)
-    for name in ("outlet_pressure", "outlet_strain", "outlet_stretch", "log_stretch_max"):
+    for name in ("outlet_pressure", "external_pressure", "gauge_outlet_pressure", "outlet_strain", "outlet_stretch",
+                 "log_stretch_max"):
         value = getattr(scene, name)
         object.__setattr__(new, name, transform(np.asarray(value)) if np.ndim(value) else value)
     probe = transform(np.zeros(scene.shape)) if scene.shape else None
@@ -206,6 +222,7 @@ def _refresh(scene):
     """A scene whose derived shape is recomputed after a model was made scalar in place."""
     shape = np.broadcast_shapes(parameter_shape(scene.rheology), parameter_shape(scene.wall),
                                 parameter_shape(scene.tube), np.shape(scene.outlet_pressure),
+                                np.shape(scene.external_pressure), np.shape(scene.gauge_outlet_pressure),
                                 np.shape(scene.outlet_strain), np.shape(scene.log_stretch_max))
     object.__setattr__(scene, "shape", shape)
     return scene
@@ -276,22 +293,33 @@ def _resolve(kind, value, base, registry):
     return value
 
 
-def make_scene(rheology, wall, tube, *, outlet_pressure=0.0) -> Scene:
-    """Resolve and validate the models, the tube and the outlet pressure into a :class:`Scene`.
+def make_scene(rheology, wall, tube, *, outlet_pressure=0.0, external_pressure=0.0) -> Scene:
+    """Resolve and validate the models, the tube and the outlet and external pressures into a
+    :class:`Scene` (whose ``outlet_pressure`` is the transmural one, ``outlet_pressure -
+    external_pressure``).
 
     Raises
     ------
     InvalidParameterError
-        For an unknown name, a wrong type or an outlet pressure outside ``[0, inf)``.
+        For an unknown name, a wrong type, an outlet pressure outside ``[0, inf)``, a non-finite
+        external pressure, or a negative transmural outlet pressure on a wall that only inflates.
     NoSteadyStateError
-        If the outlet pressure already reaches the wall's limit pressure.
+        If the transmural outlet pressure already reaches the wall's limit pressure.
+    BucklingError
+        If it is below the wall's minimum pressure (minus its buckling pressure).
     """
     rheology = resolve("rheology", rheology)
     wall = resolve("wall", wall)
     if not isinstance(tube, Tube):
         raise InvalidParameterError("tube", "a tubefsi.Tube", tube)
+    tube = wall._installed_tube(tube)        # an axial pre-stretch installs the tube longer and narrower
     p_out = as_array("outlet_pressure", outlet_pressure, "[0, inf)", lambda a: a >= 0)
     p_out = float(p_out) if p_out.ndim == 0 else p_out
+    p_e = as_array("external_pressure", external_pressure, "the real numbers", lambda a: a == a)
+    p_e = float(p_e) if p_e.ndim == 0 else p_e
+    gauge = p_out
+    if np.any(p_e != 0):
+        p_out = _transmural(wall, tube.reduced_thickness, p_out, p_e)
     lim = wall.limit_pressure(tube.reduced_thickness)
     beyond = np.asarray(p_out >= lim)
     if np.any(beyond):
@@ -299,4 +327,32 @@ def make_scene(rheology, wall, tube, *, outlet_pressure=0.0) -> Scene:
         raise NoSteadyStateError("pressure", float(np.broadcast_to(lim, beyond.shape)[i]),
                                  float(np.broadcast_to(p_out, beyond.shape)[i]),
                                  "the outlet pressure already reaches it", name="the outlet pressure")
-    return Scene(rheology=rheology, wall=wall, tube=tube, outlet_pressure=p_out)
+    if np.ndim(p_e) == 0 and p_e == 0:
+        return Scene(rheology=rheology, wall=wall, tube=tube, outlet_pressure=p_out)
+    return Scene(rheology=rheology, wall=wall, tube=tube, outlet_pressure=p_out, external_pressure=p_e,
+                 gauge_outlet_pressure=gauge)
+
+
+def _transmural(wall, tb, p_out, p_e):
+    """The transmural outlet pressure ``p_out - p_e``, checked against the wall's minimum pressure
+    (the outlet has the lowest pressure of the tube: only there can it buckle)."""
+    transmural = np.subtract(p_out, p_e)
+    transmural = float(transmural) if np.ndim(transmural) == 0 else transmural
+    negative = np.asarray(transmural < 0)
+    if not np.any(negative):
+        return transmural
+    low = np.asarray(wall.min_pressure(tb), dtype=float)
+    shape = np.broadcast_shapes(negative.shape, low.shape)
+    low, values = np.broadcast_to(low, shape), np.broadcast_to(transmural, shape)
+    inflating = (values < 0) & (low == 0)
+    if np.any(inflating):
+        i = np.unravel_index(int(np.argmax(inflating.ravel())), shape) if shape else ()
+        raise InvalidParameterError("external_pressure", "(-inf, outlet_pressure]",
+                                    float(np.broadcast_to(p_e, shape)[i]),
+                                    f"{type(wall).__name__} holds no negative transmural pressure")
+    below = values < low
+    if np.any(below):
+        i = np.unravel_index(int(np.argmax(below.ravel())), shape) if shape else ()
+        raise BucklingError(float(low[i]), float(values[i]),
+                            "the transmural outlet pressure, outlet_pressure - external_pressure, is below it")
+    return transmural

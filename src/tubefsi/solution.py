@@ -61,8 +61,13 @@ class Solution:
 
     @property
     def outlet_pressure(self) -> float:
-        """Outlet (gauge, transmural) pressure (Pa)."""
-        return self.scene.outlet_pressure
+        """Outlet (gauge) pressure of the fluid, p(L) (Pa)."""
+        return self.scene.gauge_outlet_pressure
+
+    @property
+    def external_pressure(self) -> float:
+        """External pressure p_e (Pa); the wall responds to p - p_e."""
+        return self.scene.external_pressure
 
     @property
     def flow_rate(self):
@@ -77,7 +82,7 @@ class Solution:
     @property
     def inlet_pressure(self):
         """Inlet pressure p(0) = outlet pressure + pressure drop (Pa)."""
-        return as_output(self.scene.outlet_pressure + self.state.pressure_drop, self.scalar)
+        return as_output(self.scene.gauge_outlet_pressure + self.state.pressure_drop, self.scalar)
 
     @property
     def inlet_displacement(self):

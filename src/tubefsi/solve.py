@@ -66,7 +66,7 @@ def select_coupler(rheology, wall, coupler="auto") -> Coupler:
 
 
 def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="auto",
-          outlet_pressure=0.0, on_infeasible="raise", density=None, progress=False) -> Solution:
+          outlet_pressure=0.0, external_pressure=0.0, on_infeasible="raise", density=None, progress=False) -> Solution:
     r"""Solve steady flow of ``rheology`` through ``tube`` with wall ``wall``.
 
     Exactly one of ``flow_rate`` (flow-controlled) and ``pressure_drop``
@@ -87,7 +87,12 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
         ``"auto"`` takes the cheapest coupler that supports the pair and meets the
         accuracy contract (``closed-form`` where it exists, else ``quadrature``).
     outlet_pressure : float or array_like
-        Transmural pressure at the outlet, p(L) >= 0 (Pa).
+        Gauge pressure of the fluid at the outlet, p(L) >= 0 (Pa).
+    external_pressure : float or array_like
+        Pressure outside the tube, p_e (Pa; any sign): the wall responds to the transmural
+        pressure p - p_e. A negative transmural pressure is admitted down to the wall's
+        :meth:`~tubefsi.walls.WallModel.min_pressure` (minus the buckling pressure of an
+        axisymmetric wall, unbounded for ``shapiro``), else :class:`~tubefsi.BucklingError`.
     on_infeasible : {"raise", "nan"}
         What a point beyond a limit (the maximum flow rate, the limit pressure) gets:
         ``"raise"`` (the default) raises :class:`NoSteadyStateError` for the whole call;
@@ -120,11 +125,12 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
     """
     if (type(flow_rate) is float and pressure_drop is None and type(coupler) is str and coupler == "auto"
             and type(outlet_pressure) is float and outlet_pressure == 0.0 and on_infeasible == "raise"
-            and density is None and progress is False):
+            and density is None and progress is False
+            and type(external_pressure) is float and external_pressure == 0.0):
         fast = _scalar_flow(rheology, wall, tube, flow_rate)
         if fast is not None:
             return fast
-    scene = make_scene(rheology, wall, tube, outlet_pressure=outlet_pressure)
+    scene = make_scene(rheology, wall, tube, outlet_pressure=outlet_pressure, external_pressure=external_pressure)
     if (flow_rate is None) == (pressure_drop is None):
         raise InvalidParameterError("flow_rate / pressure_drop", "exactly one of the two",
                                     None, "give flow_rate= or pressure_drop=, not both or neither")
@@ -204,7 +210,7 @@ def _scalar_flow(rheology, wall, tube, q):
     does not apply; the general path then answers (and builds the table for the next call)."""
     if not (_is(type(rheology), Rheology) and _is(type(wall), WallModel) and type(tube) is Tube):
         return None
-    if not (q > 0.0 and q < math.inf) or wall.is_rigid:
+    if not (q > 0.0 and q < math.inf) or wall.is_rigid or wall._installed_tube(tube) is not tube:
         return None
     k = rheology.radius_exponent
     a, t, L = tube.radius, tube.thickness, tube.length
@@ -269,7 +275,7 @@ def _feasible(coupler, scene, load, controlled, *, raise_):
     return ~beyond
 
 
-def max_flow_rate(rheology, wall, tube, *, outlet_pressure=0.0, coupler="auto"):
+def max_flow_rate(rheology, wall, tube, *, outlet_pressure=0.0, external_pressure=0.0, coupler="auto"):
     r"""The largest flow rate with a steady state (m^3/s); ``inf`` where every flow rate has one.
 
     Finite only for a wall with a limit pressure (thick or thin-current
@@ -278,7 +284,7 @@ def max_flow_rate(rheology, wall, tube, *, outlet_pressure=0.0, coupler="auto"):
     :math:`L\,\phi(q_{max}) = \int_0^\infty s P'(s)/\psi(as)\,du`. Array parameters broadcast
     (an array of the scene's shape comes back).
     """
-    scene = make_scene(rheology, wall, tube, outlet_pressure=outlet_pressure)
+    scene = make_scene(rheology, wall, tube, outlet_pressure=outlet_pressure, external_pressure=external_pressure)
     chosen = select_coupler(scene.rheology, scene.wall, coupler)
     if scene.shape == ():
         return float(chosen.max_flow_rate(scene))

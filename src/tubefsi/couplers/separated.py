@@ -448,7 +448,7 @@ class SeparatedVariables(Coupler):
         pts = scene.at(index)
         e_in = pts.wall._strain(pts.outlet_pressure + dp, pts.tb)
         v = np.log1p((e_in - pts.outlet_strain) / pts.outlet_stretch)
-        loaded = (np.asarray(pts.outlet_pressure) + np.zeros(dp.shape)) > 0
+        loaded = (np.asarray(pts.outlet_pressure) + np.zeros(dp.shape)) != 0      # transmural: may be < 0
         polish = np.flatnonzero(loaded & (dp > 0))
         if polish.size == 0:
             return v

@@ -9,7 +9,11 @@ and the base class derives the rest: the inverse by a safeguarded Newton iterati
 bracketing fallback, the stiffness :math:`dP/d\lambda` by numerical differentiation. The
 contract suite :mod:`tubefsi.testing` checks that every path agrees.
 
-tubefsi models inflation: stretches :math:`\lambda \ge 1`, pressures :math:`p \ge 0`.
+By default a wall models inflation only: stretches :math:`\lambda \ge 1`, pressures
+:math:`p \ge 0`. A wall that also holds a negative transmural pressure (an external pressure
+above the internal one) says down to which pressure with ``_min_pressure``: the axisymmetric
+walls down to their buckling pressure, a collapsible tube law (Shapiro) without bound
+(``docs/walls_beyond.md``, section "External pressure and collapse").
 """
 
 from __future__ import annotations
@@ -23,11 +27,11 @@ import numpy as np
 from scipy import differentiate
 from scipy.optimize import elementwise
 
-from .._numerics import solve_increasing
+from .._numerics import solve_signed
 from .._quadrature import quiet
 from .._validation import as_array
 from ..fields import evaluate, flat_points, model_at, take
-from ..errors import ConvergenceError, InvalidParameterError, NoSteadyStateError
+from ..errors import BucklingError, ConvergenceError, InvalidParameterError, NoSteadyStateError
 
 #: scipy.differentiate tolerances: as tight as the error estimate allows
 _DIFF_TOL = dict(rtol=1e-12, atol=0.0)
@@ -57,6 +61,13 @@ class WallModel(abc.ABC):
     ``_stiffness(stretch, tb)``                             :math:`dP/d\lambda` by ``scipy.differentiate``
     ``_limit_pressure(tb)``                                 ``inf`` (no limit pressure)
     ``_max_stretch(tb)``                                    ``inf`` (no locking stretch, no peak)
+    ``_min_pressure(tb)``                                   0 (inflation only); the most negative transmural
+                                                            pressure the law holds (a buckling pressure,
+                                                            ``-inf`` for a collapsible tube law)
+    ``_min_stretch(tb)``                                    the stretch at ``_min_pressure`` (1 at 0, 0 at
+                                                            ``-inf``, else the tube law's inverse)
+    ``_installed_tube(tube)``                               the tube itself; the installed tube of a wall
+                                                            under axial pre-stretch
     ``_stiffness_decay_exponent(tb)``                       :math:`\kappa` in :math:`P' \sim \lambda^{-\kappa}`,
                                                             estimated (only used with a limit pressure)
     ``_power_law_integral(log_ratio, stretch, k, tb)``      None; a closed form of the separated integral
@@ -136,6 +147,18 @@ class WallModel(abc.ABC):
     def max_stretch(self, reduced_thickness):
         """The largest admissible stretch (``inf`` unless the material locks)."""
         return evaluate(self, lambda wall, tb: wall._max_stretch(tb) + 0.0 * tb,
+                        _check_thickness(reduced_thickness))
+
+    def min_pressure(self, reduced_thickness):
+        r"""The most negative transmural pressure the wall holds (Pa): 0 for a wall that only
+        inflates, minus the buckling pressure of an axisymmetric wall, ``-inf`` for a collapsible
+        tube law."""
+        return evaluate(self, lambda wall, tb: wall._min_pressure(tb) + 0.0 * tb,
+                        _check_thickness(reduced_thickness))
+
+    def min_stretch(self, reduced_thickness):
+        """The smallest admissible stretch: the stretch at :meth:`min_pressure`."""
+        return evaluate(self, lambda wall, tb: wall._min_stretch(tb) + 0.0 * tb,
                         _check_thickness(reduced_thickness))
 
     def small_strain_modulus(self, reduced_thickness):
@@ -227,6 +250,28 @@ class WallModel(abc.ABC):
     def _max_stretch(self, tb):
         return math.inf
 
+    def _min_pressure(self, tb):
+        return 0.0
+
+    def _installed_tube(self, tube):
+        """The tube the flow sees, from the stress-free one (an axial pre-stretch changes it); the
+        tube law's stretch is relative to its lumen."""
+        return tube
+
+    def _collapse_stretch(self, tb):
+        """The stretch the law is never evaluated at or below (0; a material that also locks in
+        compression raises it); the root finders of the collapsing branch stay above it."""
+        return 0.0
+
+    def _min_stretch(self, tb):
+        p = np.asarray(self._min_pressure(tb), dtype=float) + 0.0 * np.asarray(tb, dtype=float)
+        if np.all(p == 0):
+            return 1.0 + 0.0 * p
+        finite = np.isfinite(p)
+        with quiet():
+            e = self._strain(np.where(finite, p, 0.0), tb)
+        return np.where(p == 0, 1.0, np.where(finite, 1.0 + e, 0.0))
+
     # -- for the tables of whole curves (``tubefsi.couplers._tables``): P = scale * P_hat(shape)
     def _pressure_scale(self):
         """The modulus the tube law is proportional to (``P = scale * P_hat``); 1 unless overridden."""
@@ -259,6 +304,27 @@ class WallModel(abc.ABC):
         def f(e, p, i):
             return model_at(wall, i)._pressure_at_strain(e, take(tb, i)) - p
 
+        negative = p < 0
+        if np.any(negative):                     # the collapsing branch: strains in (min_stretch - 1, 0)
+            out = np.zeros(p.shape)
+            if not np.all(negative):
+                pos = np.flatnonzero(~negative)
+                out[pos] = model_at(wall, pos)._invert_pressure(p[pos], take(tb, pos))
+            neg = np.flatnonzero(negative)
+            bound = np.asarray(wall._collapse_stretch(tb), dtype=float) + 0.0 * p
+            xmin = np.nextafter(bound[neg], 1.0) - 1.0        # inside the law's domain (the pressure is checked)
+            with quiet():
+                bracket = elementwise.bracket_root(f, np.maximum(-np.minimum(-p[neg] / scale[neg], 0.5), 0.5 * xmin),
+                                                   np.zeros(neg.size), xmin=xmin, xmax=0.0, args=(p[neg], neg))
+                res = elementwise.find_root(f, bracket.bracket, args=(p[neg], neg),
+                                            tolerances=dict(xrtol=2 * np.finfo(float).eps, xatol=1e-300))
+            if not np.all(bracket.success & res.success):
+                bad = neg[int(np.argmax(~(bracket.success & res.success)))]
+                raise BucklingError(float(np.broadcast_to(wall._min_pressure(tb), p.shape)[bad]), float(p[bad]),
+                                    "the tube law never reaches it")
+            out[neg] = res.x
+            return out.reshape(shape)
+
         finite = np.isfinite(emax)
         guess = np.minimum(np.maximum(p / scale, 1e-300), np.where(finite, 0.5 * emax, np.inf))
         # never evaluate the law at a locking stretch (where it is singular): the largest strain
@@ -288,15 +354,19 @@ class WallModel(abc.ABC):
         finite = np.isfinite(emax)
         upper = np.where(finite, 0.999999 * emax, np.inf) if np.any(finite) else None
         guess = np.where(finite, np.minimum(p / scale, 0.5 * emax), p / scale)
+        lower = None
+        if np.any(p < 0):                        # collapsing: strains above -1 (the pressure is checked)
+            lower = np.asarray(self._collapse_stretch(tb), dtype=float) - 1.0 + 0.0 * p
+            guess = np.maximum(guess, 0.5 * lower)
         try:
             with quiet():                        # trial strains: no warnings (the answer is checked below)
-                e, ok = solve_increasing(lambda x, i: model_at(self, i)._pressure_at_strain(x, take(tb, i)),
-                                         lambda x, i: model_at(self, i)._stiffness(1.0 + x, take(tb, i)),
-                                         p, guess=guess, upper=upper, xmax=1e15, maxiter=100)
+                e, ok = solve_signed(lambda x, i: model_at(self, i)._pressure_at_strain(x, take(tb, i)),
+                                     lambda x, i: model_at(self, i)._stiffness(1.0 + x, take(tb, i)),
+                                     p, guess=guess, lower=lower, upper=upper, xmax=1e15, maxiter=100)
         except ConvergenceError:
             return None
         with np.errstate(all="ignore"):
-            converged = ok & np.isfinite(e) & (np.abs(self._pressure_at_strain(e, tb) - p) <= 1e-12 * p)
+            converged = ok & np.isfinite(e) & (np.abs(self._pressure_at_strain(e, tb) - p) <= 1e-12 * np.abs(p))
         return e if np.all(converged) else None
 
     def _invert_strain(self, strain, tb):
@@ -309,9 +379,13 @@ class WallModel(abc.ABC):
             return model_at(wall, i)._strain(p, take(tb, i)) - e
 
         lim = np.asarray(wall._limit_pressure(tb), dtype=float) + 0.0 * e
-        hi = np.maximum(e, 1e-300) * 10.0
-        bracket = elementwise.bracket_root(f, np.zeros_like(e), hi, xmin=0.0,
-                                           xmax=np.where(np.isfinite(lim), lim, np.inf), args=(e, index))
+        low = np.asarray(wall._min_pressure(tb), dtype=float) + 0.0 * e
+        hi = np.maximum(np.abs(e), 1e-300) * 10.0
+        neg = e < 0                              # the collapsing branch brackets below zero
+        bracket = elementwise.bracket_root(f, np.where(neg, np.maximum(-hi, low / 2), 0.0), np.where(neg, 0.0, hi),
+                                           xmin=np.where(neg, low, 0.0),
+                                           xmax=np.where(neg, 0.0, np.where(np.isfinite(lim), lim, np.inf)),
+                                           args=(e, index))
         res = elementwise.find_root(f, bracket.bracket, args=(e, index),
                                     tolerances=dict(xrtol=2 * np.finfo(float).eps, xatol=1e-300))
         return np.where(e == 0, 0.0, res.x).reshape(shape)
@@ -325,25 +399,38 @@ class WallModel(abc.ABC):
     def _check_stretch(self, lam, tb):
         """``lam`` (flat, aligned with the wall's parameters) checked against ``[1, max_stretch)``."""
         lam = np.asarray(lam, dtype=float)
-        values, top = np.broadcast_arrays(lam, np.asarray(self._max_stretch(tb), dtype=float))
+        # (the minimum stretch may cost an inverse: only asked for where a stretch is below 1)
+        low = np.asarray(self._min_stretch(tb) if np.any(lam < 1) else 1.0, dtype=float)
+        values, top, low = np.broadcast_arrays(lam, np.asarray(self._max_stretch(tb), dtype=float), low)
         with np.errstate(invalid="ignore"):
-            ok = np.isfinite(values) & (values >= 1) & (values < top)
+            # (a few ulps below the minimum stretch pass: the inverse at min_pressure is rounded)
+            ok = np.isfinite(values) & (values >= low * (1.0 - 8 * np.finfo(float).eps)) & (values > 0) & (values < top)
         if not np.all(ok):
             i = int(np.argmax(~ok.ravel()))
-            t = float(top.flat[i])
-            raise InvalidParameterError("stretch", "[1, inf)" if t == math.inf else f"[1, {t:.10g})",
+            t, b = float(top.flat[i]), float(low.flat[i])
+            lo = "(0" if b == 0 else f"[{b:.10g}"
+            raise InvalidParameterError("stretch", f"{lo}, inf)" if t == math.inf else f"{lo}, {t:.10g})",
                                         float(values.flat[i]))
         return lam
 
     def _check_pressure(self, p, tb):
-        """``p`` (flat, aligned) checked against ``[0, limit_pressure)``."""
+        """``p`` (flat, aligned) checked against ``[min_pressure, limit_pressure)``."""
         p = np.asarray(p, dtype=float)
-        values, lim = np.broadcast_arrays(p, np.asarray(self._limit_pressure(tb), dtype=float))
+        values, lim, low = np.broadcast_arrays(p, np.asarray(self._limit_pressure(tb), dtype=float),
+                                               np.asarray(self._min_pressure(tb) if np.any(p < 0) else 0.0,
+                                                          dtype=float))
         with np.errstate(invalid="ignore"):
-            bad = ~(values >= 0)
+            bad = np.isnan(values) | ((values < 0) & (low == 0))   # a wall that only inflates
+            below = (values < low) & (low < 0)
             beyond = values >= lim
         if np.any(bad):
-            raise InvalidParameterError("pressure", "[0, inf)", float(values.flat[int(np.argmax(bad.ravel()))]))
+            i = int(np.argmax(bad.ravel()))
+            raise InvalidParameterError("pressure", "[0, inf)" if low.flat[i] == 0 else "the real numbers",
+                                        float(values.flat[i]))
+        if np.any(below):
+            i = int(np.argmax(below.ravel()))
+            raise BucklingError(float(low.flat[i]), float(values.flat[i]),
+                                f"{type(self).__name__} buckles (it is no longer axisymmetric)")
         if np.any(beyond):
             i = int(np.argmax(beyond.ravel()))
             raise NoSteadyStateError("pressure", float(lim.flat[i]), float(values.flat[i]),

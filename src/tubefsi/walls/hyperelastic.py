@@ -47,15 +47,23 @@ import numpy as np
 from scipy import differentiate
 
 from .._quadrature import adaptive, adaptive_to_pole, warn_unconverged
-from ..fields import choice, evaluate, flat_points, model_at, take
+from ..errors import InvalidParameterError
+from ..geometry import Tube
+from ..fields import choice, evaluate, flat_points, model_at, positive, take
 from .base import WallModel
 
 #: scipy.differentiate tolerances: as tight as the error estimate allows
 _DIFF_TOL = dict(rtol=1e-12, atol=0.0)
 
-__all__ = ["HyperelasticWall", "ThinWall", "ThickWall", "THICKNESS_CONVENTIONS"]
+__all__ = ["HyperelasticWall", "ThinWall", "ThickWall", "THICKNESS_CONVENTIONS", "axial_stretch", "InstalledTube"]
 
 THICKNESS_CONVENTIONS = ("reference", "current")
+
+
+def axial_stretch():
+    """The ``axial_stretch`` parameter of a material that supports an axial pre-stretch
+    (``docs/walls_beyond.md``, section "Axial pre-stretch"): positive, default 1."""
+    return positive(default=1.0, doc="axial pre-stretch lambda_z: installed / stress-free length")
 
 
 class HyperelasticWall(WallModel):
@@ -82,6 +90,10 @@ class HyperelasticWall(WallModel):
     """
 
     __slots__ = ()
+
+    #: Whether the material is isotropic (then its small-strain limit is the linear wall with
+    #: E = 3 mu, nu = 1/2); fibre-reinforced materials set False.
+    isotropic = True
 
     def dW(self, stretch):
         r"""Reduced strain-energy derivative :math:`\hat W'(\lambda)` (Pa), broadcast with the parameters."""
@@ -118,6 +130,32 @@ class HyperelasticWall(WallModel):
 
     def _max_stretch(self, tb):
         return self._locking_stretch()
+
+    def _installed_tube(self, tube):
+        r"""The tube as installed at the axial stretch :math:`\lambda_z` (``axial_stretch``, for the
+        materials that have it): radius and thickness over :math:`\sqrt{\lambda_z}` (incompressible),
+        length times :math:`\lambda_z`; the tube itself at :math:`\lambda_z = 1`."""
+        lz = getattr(self, "axial_stretch", 1.0)
+        if np.ndim(lz) == 0 and lz == 1.0:
+            return tube
+        if isinstance(tube, InstalledTube):          # a solution's tube, solved again: already installed
+            if np.array_equal(np.broadcast_to(tube.axial_stretch, np.shape(lz)), lz):
+                return tube
+            raise InvalidParameterError("tube", "a stress-free Tube", tube,
+                                        f"it is installed at the axial stretch {tube.axial_stretch}, not {lz}")
+        shrink = 1.0 / np.sqrt(lz)
+        return InstalledTube(radius=tube.radius * shrink, thickness=tube.thickness * shrink,
+                             length=tube.length * lz, axial_stretch=lz)
+
+
+    def _collapse_stretch(self, tb):
+        # plane strain: the invariants are symmetric in lambda <-> 1/lambda, so a material that
+        # locks at lambda_max locks in compression at 1/lambda_max
+        return 1.0 / np.asarray(self._locking_stretch(), dtype=float)
+
+    def _ring_modulus(self, tb):
+        r""":math:`\mu_0 = \hat W''(1)/4`, the small-strain shear modulus, aligned with ``tb``."""
+        return 0.25 * np.asarray(self._d2W(np.ones(np.shape(tb))), dtype=float)
 
     def _thick_integrand(self, s):
         r""":math:`\hat W'(s)/(s^2-1)`; override with a form free of the removable singularity."""
@@ -190,6 +228,11 @@ class ThinWall(HyperelasticWall):
             out[small] = es * result.value
         return out.reshape(shape)
 
+    def _min_pressure(self, tb):
+        r"""Minus the long-ring buckling pressure :math:`\mu_0\bar t^3` (:math:`E = 3\mu_0`,
+        :math:`\nu = 1/2` in :math:`E t^3/(4(1-\nu^2)a^3)`; ``docs/walls_beyond.md``, section "Buckling")."""
+        return -self._ring_modulus(tb) * tb**3
+
     def _stiffness(self, stretch, tb):
         if self.thickness_convention == "reference":
             return tb * self._d2W(stretch)
@@ -214,17 +257,21 @@ class ThickWall(HyperelasticWall):
         x = e * (2.0 + e)                                   # lam^2 - 1
         log_lam_o = 0.5 * np.log1p(x / b)
         width = 0.5 * np.log1p(x * (b - 1.0) / (b + x))     # ln(lam / lam_o), no cancellation
+        # a collapsing tube (lam < 1) has width < 0: integrate -f(-u) over [0, -width]
+        sign = np.where(e < 0, -1.0, 1.0)
+        width = np.abs(width)
         lam_max = np.asarray(wall._locking_stretch(), dtype=float) + 0.0 * e
         with np.errstate(divide="ignore", invalid="ignore"):
-            pole = np.where(np.isfinite(lam_max), np.log(lam_max) - log_lam_o, np.inf)   # the lock, in u
+            pole = np.where(np.isfinite(lam_max) & (e >= 0), np.log(lam_max) - log_lam_o, np.inf)   # the lock, in u
             gap = np.where(np.isfinite(lam_max), -np.log1p((e - (lam_max - 1.0)) / lam_max),  # ln(lam_max/lam)
                            np.inf)
 
         log_lam_o = np.broadcast_to(log_lam_o, e.shape)
 
         def f(u, idx):
-            s = np.exp(log_lam_o[idx, None] + u)
-            return s * model_at(wall, idx, column=True)._thick_integrand(s)
+            sg = sign[idx, None]
+            s = np.exp(log_lam_o[idx, None] + sg * u)
+            return sg * s * model_at(wall, idx, column=True)._thick_integrand(s)
 
         result = adaptive_to_pole(f, 0.0, width, pole, gap=gap, rtol=self._RTOL)
         if not np.all(result.converged):
@@ -234,9 +281,23 @@ class ThickWall(HyperelasticWall):
     def _pressure_needs_quadrature(self) -> bool:
         return type(self)._pressure_at_strain is ThickWall._pressure_at_strain
 
+    def _min_pressure(self, tb):
+        r"""Minus the long-ring buckling pressure taken at the outer radius,
+        :math:`\mu_0\bar t^3/(1+\bar t)^3` (a conservative bound; ``docs/walls_beyond.md``, section
+        "Buckling")."""
+        return -self._ring_modulus(tb) * (tb / (1.0 + tb)) ** 3
+
     def _stiffness(self, stretch, tb):
         lam = np.asarray(stretch, dtype=float)
         b = (1.0 + tb) ** 2
         lam_o = np.sqrt(1.0 + (lam * lam - 1.0) / b)
         return self._thick_integrand(lam) - self._thick_integrand(lam_o) * lam / (b * lam_o)
 
+
+@attrs.frozen(kw_only=True)
+class InstalledTube(Tube):
+    r"""A tube as installed at an axial stretch (what :attr:`tubefsi.Solution.tube` is for a wall
+    with ``axial_stretch``): radius and thickness over :math:`\sqrt{\lambda_z}`, length times
+    :math:`\lambda_z`; solving again with it and the same wall does not install it twice."""
+
+    axial_stretch: float = positive(doc="the axial stretch it is installed at")

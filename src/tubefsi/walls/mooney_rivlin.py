@@ -3,7 +3,9 @@ r"""Mooney–Rivlin walls.
 Strain energy :math:`W = c_1(I_1 - 3) + c_2(I_2 - 3)`. Under plane strain
 :math:`I_1 = I_2 = \lambda^2 + \lambda^{-2} + 1`, so
 :math:`\hat W'(\lambda) = 2(c_1 + c_2)(\lambda - \lambda^{-3})`: only :math:`c_1 + c_2`
-matters, and it must be positive (:math:`c_2 < 0` is common). The tube laws are
+matters, and it must be positive (:math:`c_2 < 0` is common). Under an axial pre-stretch
+:math:`\lambda_z` the law is the neo-Hookean one of the installed tube with
+:math:`\mu = 2(c_1/\lambda_z + c_2\lambda_z)`, which must be positive too. The tube laws are
 the neo-Hookean ones with shear modulus :math:`\mu = 2(c_1 + c_2)`
 (see :mod:`tubefsi.walls.neo_hookean`).
 """
@@ -15,7 +17,7 @@ import numpy as np
 
 from ..fields import real
 from ..errors import InvalidParameterError
-from .hyperelastic import HyperelasticWall, ThickWall, ThinWall
+from .hyperelastic import HyperelasticWall, ThickWall, ThinWall, axial_stretch
 from .neo_hookean import _ThickForms, _ThinForms
 
 __all__ = ["MooneyRivlin", "ThinMooneyRivlin", "ThickMooneyRivlin"]
@@ -27,6 +29,7 @@ class MooneyRivlin(HyperelasticWall):
 
     c1: float = real(unit="Pa", doc="first Mooney–Rivlin constant (c1 + c2 > 0)")
     c2: float = real(unit="Pa", doc="second Mooney–Rivlin constant, often negative (c1 + c2 > 0)")
+    axial_stretch: float = axial_stretch()
 
     def __attrs_post_init__(self):
         total = np.asarray(self.c1 + self.c2)
@@ -35,11 +38,22 @@ class MooneyRivlin(HyperelasticWall):
             raise InvalidParameterError("c1 + c2", "(0, inf)", float(total[tuple(bad)]),
                                         "the small-strain shear modulus 2 (c1 + c2) must be positive"
                                         + (f" (entry {tuple(int(i) for i in bad)})" if total.ndim else ""))
+        installed = np.asarray(self.c1 / self.axial_stretch + self.c2 * self.axial_stretch)
+        if not np.all(installed > 0):
+            bad = np.argwhere(~(installed > 0))[0] if installed.ndim else ()
+            raise InvalidParameterError("c1/axial_stretch + c2*axial_stretch", "(0, inf)",
+                                        float(installed[tuple(bad)]),
+                                        "the installed tube's shear modulus must be positive")
 
     @property
     def shear_modulus(self) -> float:
         """Small-strain shear modulus :math:`\\mu = 2(c_1 + c_2)` (Pa)."""
         return 2.0 * (self.c1 + self.c2)
+
+    def _installed_modulus(self):
+        r""":math:`2(c_1/\lambda_z + c_2\lambda_z)`: the neo-Hookean modulus of the installed tube."""
+        lz = self.axial_stretch
+        return 2.0 * (self.c1 / lz + self.c2 * lz)
 
 
 @attrs.frozen(kw_only=True)
@@ -54,4 +68,4 @@ class ThinMooneyRivlin(_ThinForms, ThinWall, MooneyRivlin):
 class ThickMooneyRivlin(_ThickForms, ThickWall, MooneyRivlin):
     r"""Thick-walled Mooney–Rivlin tube: :math:`P = (c_1+c_2)[f(x_o) - f(x_i)]`, :math:`f(x) = x + \ln x`."""
 
-    _examples = ({"c1": 1.5e3, "c2": -0.5e3}, {"c1": 1e3, "c2": 1e3})
+    _examples = ({"c1": 1.5e3, "c2": -0.5e3}, {"c1": 1e3, "c2": 1e3, "axial_stretch": 1.2})

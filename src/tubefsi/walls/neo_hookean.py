@@ -4,6 +4,12 @@ Strain energy :math:`W = \tfrac{\mu}{2}(I_1 - 3)`. In plane strain
 :math:`I_1 - 3 = (\lambda - 1/\lambda)^2`, so :math:`\hat W'(\lambda) = \mu(\lambda - \lambda^{-3})`.
 Mooney–Rivlin reduces to the same law with :math:`\mu = 2(c_1 + c_2)`.
 
+With an axial pre-stretch :math:`\lambda_z` (the tube clamped at the installed length
+:math:`\lambda_z L`; ``docs/walls_beyond.md``, section "Axial pre-stretch") the lumen at zero
+pressure is :math:`a/\sqrt{\lambda_z}` and the wall thickness :math:`t/\sqrt{\lambda_z}`; in the
+stretch :math:`\lambda = R\sqrt{\lambda_z}/a` of that installed tube every law below holds with
+:math:`\mu/\lambda_z` for :math:`\mu` (Mooney–Rivlin: :math:`2(c_1/\lambda_z + c_2\lambda_z)`).
+
 Tube laws (:math:`x = \lambda^2 - 1`, :math:`b = (1+\bar t)^2`, :math:`d = b - 1`):
 
 * thin, reference thickness: :math:`P = \mu\bar t(\lambda - \lambda^{-3})`, no limit;
@@ -20,32 +26,33 @@ import math
 import attrs
 import numpy as np
 
-from .._numerics import expm1_ratio, log1p_ratio, solve_increasing
+from .._numerics import expm1_ratio, log1p_ratio, solve_signed
 from ..fields import positive
-from .hyperelastic import HyperelasticWall, ThickWall, ThinWall
+from .hyperelastic import HyperelasticWall, ThickWall, ThinWall, axial_stretch
 
 __all__ = ["NeoHookean", "ThinNeoHookean", "ThickNeoHookean"]
 
 
 class _NeoHookeanLaw:
-    """Closed forms in terms of ``self.shear_modulus`` (mixed into the concrete classes)."""
+    """Closed forms in terms of ``self._installed_modulus()`` (mixed into the concrete classes): the
+    shear modulus over the axial stretch, the law of the installed tube (module docstring)."""
 
     __slots__ = ()
 
     def _pressure_scale(self):
-        return self.shear_modulus
+        return self._installed_modulus()
 
     def _shape_key(self):
         return (getattr(self, "thickness_convention", "thick"),)
 
     def _dW(self, stretch):
-        return self.shear_modulus * (stretch - stretch**-3)
+        return self._installed_modulus() * (stretch - stretch**-3)
 
     def _d2W(self, stretch):
-        return self.shear_modulus * (1.0 + 3.0 * stretch**-4)
+        return self._installed_modulus() * (1.0 + 3.0 * stretch**-4)
 
     def _thick_integrand(self, s):
-        return self.shear_modulus * (s * s + 1.0) / s**3
+        return self._installed_modulus() * (s * s + 1.0) / s**3
 
 
 class _ThinForms(_NeoHookeanLaw):
@@ -58,32 +65,32 @@ class _ThinForms(_NeoHookeanLaw):
         lam = 1.0 + e
         quartic = e * (4.0 + e * (6.0 + e * (4.0 + e)))          # lam^4 - 1
         if self.thickness_convention == "reference":
-            return self.shear_modulus * tb * quartic / lam**3
-        return self.shear_modulus * tb * quartic / lam**4
+            return self._installed_modulus() * tb * quartic / lam**3
+        return self._installed_modulus() * tb * quartic / lam**4
 
     def _stiffness(self, stretch, tb):
         if self.thickness_convention == "reference":
-            return self.shear_modulus * tb * (1.0 + 3.0 * stretch**-4)
-        return 4.0 * self.shear_modulus * tb * stretch**-5
+            return self._installed_modulus() * tb * (1.0 + 3.0 * stretch**-4)
+        return 4.0 * self._installed_modulus() * tb * stretch**-5
 
     def _strain(self, pressure, tb):
-        k = np.asarray(pressure, dtype=float) / (self.shear_modulus * tb)
+        k = np.asarray(pressure, dtype=float) / (self._installed_modulus() * tb)
         if self.thickness_convention == "current":
             return np.expm1(-0.25 * np.log1p(-k))
-        e, _ = solve_increasing(
+        e, _ = solve_signed(
             lambda e, i: e * (4.0 + e * (6.0 + e * (4.0 + e))) / (1.0 + e) ** 3,
             lambda e, i: 1.0 + 3.0 * (1.0 + e) ** -4,
-            k, guess=np.where(k < 1.0, 0.25 * k, k))
+            k, guess=np.where(k < 1.0, 0.25 * k, k), lower=-1.0)
         return e
 
     def _limit_pressure(self, tb):
-        return math.inf if self.thickness_convention == "reference" else self.shear_modulus * tb
+        return math.inf if self.thickness_convention == "reference" else self._installed_modulus() * tb
 
     def _stiffness_decay_exponent(self, tb):
         return 0.0 if self.thickness_convention == "reference" else 5.0
 
     def _power_law_integral(self, log_ratio, outlet_stretch, exponent, tb):
-        k, s0, mt = exponent, outlet_stretch, self.shear_modulus * tb
+        k, s0, mt = exponent, outlet_stretch, self._installed_modulus() * tb
         if self.thickness_convention == "reference":
             return mt * (s0 ** (k + 1) * expm1_ratio(k + 1, log_ratio)
                          + 3.0 * s0 ** (k - 3) * expm1_ratio(k - 3, log_ratio))
@@ -93,7 +100,7 @@ class _ThinForms(_NeoHookeanLaw):
         if self.thickness_convention == "reference":
             return None
         k = exponent
-        return log1p_ratio(k - 4, integral / (4.0 * self.shear_modulus * tb * outlet_stretch ** (k - 4)))
+        return log1p_ratio(k - 4, integral / (4.0 * self._installed_modulus() * tb * outlet_stretch ** (k - 4)))
 
 
 class _ThickForms(_NeoHookeanLaw):
@@ -104,26 +111,26 @@ class _ThickForms(_NeoHookeanLaw):
         b = (1.0 + tb) ** 2
         d = tb * (2.0 + tb)
         x = e * (2.0 + e)
-        return 0.5 * self.shear_modulus * (np.log1p(x * d / (b + x)) + x * d / ((1.0 + x) * (b + x)))
+        return 0.5 * self._installed_modulus() * (np.log1p(x * d / (b + x)) + x * d / ((1.0 + x) * (b + x)))
 
     def _stiffness(self, stretch, tb):
         lam2 = stretch * stretch
         d = tb * (2.0 + tb)
-        return self.shear_modulus * stretch * d * (lam2 * (d + 2.0) + d) / (lam2 * lam2 * (lam2 + d) ** 2)
+        return self._installed_modulus() * stretch * d * (lam2 * (d + 2.0) + d) / (lam2 * lam2 * (lam2 + d) ** 2)
 
     def _strain(self, pressure, tb):
         # the law per unit modulus: no parameter but t/a, which is gathered for the active points
-        shape = np.broadcast_shapes(np.shape(pressure), np.shape(tb), np.shape(self.shear_modulus))
-        k = np.broadcast_to(np.asarray(pressure, dtype=float) / self.shear_modulus, shape).ravel()
+        shape = np.broadcast_shapes(np.shape(pressure), np.shape(tb), np.shape(self._installed_modulus()))
+        k = np.broadcast_to(np.asarray(pressure, dtype=float) / self._installed_modulus(), shape).ravel()
         tb = np.broadcast_to(np.asarray(tb, dtype=float), shape).ravel()
         unit = _UNIT_THICK
-        e, _ = solve_increasing(lambda e, i: unit._pressure_at_strain(e, tb[i]),
-                                lambda e, i: unit._stiffness(1.0 + e, tb[i]),
-                                k, guess=k / unit._stiffness(np.ones(k.shape), tb))
+        e, _ = solve_signed(lambda e, i: unit._pressure_at_strain(e, tb[i]),
+                            lambda e, i: unit._stiffness(1.0 + e, tb[i]),
+                            k, guess=k / unit._stiffness(np.ones(k.shape), tb), lower=-1.0)
         return e.reshape(shape)
 
     def _limit_pressure(self, tb):
-        return self.shear_modulus * np.log1p(tb)
+        return self._installed_modulus() * np.log1p(tb)
 
     def _stiffness_decay_exponent(self, tb):
         return 5.0
@@ -134,6 +141,10 @@ class NeoHookean(HyperelasticWall):
     r"""Neo-Hookean material, :math:`W = \tfrac{\mu}{2}(I_1 - 3)` (abstract: pick a theory)."""
 
     shear_modulus: float = positive(unit="Pa", doc="small-strain shear modulus mu")
+    axial_stretch: float = axial_stretch()
+
+    def _installed_modulus(self):
+        return self.shear_modulus / self.axial_stretch
 
 
 @attrs.frozen(kw_only=True)
@@ -141,7 +152,7 @@ class ThinNeoHookean(_ThinForms, ThinWall, NeoHookean):
     r"""Thin-walled neo-Hookean tube: :math:`P = \mu\bar t(\lambda - \lambda^{-3})` (reference)
     or :math:`\mu\bar t(1 - \lambda^{-4})` (current thickness)."""
 
-    _examples = ({"shear_modulus": 2e3}, {"shear_modulus": 2e3, "thickness_convention": "current"})
+    _examples = ({"shear_modulus": 2e3}, {"shear_modulus": 2e3, "thickness_convention": "current", "axial_stretch": 1.1})
 
 
 @attrs.frozen(kw_only=True)

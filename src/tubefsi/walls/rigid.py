@@ -30,6 +30,12 @@ class Rigid(WallModel):
     def _stiffness_decay_exponent(self, tb):
         return 0.0
 
+    def _min_pressure(self, tb):
+        return -math.inf        # no pressure deforms it
+
+    def _min_stretch(self, tb):
+        return 1.0
+
     def pressure(self, stretch, reduced_thickness):
         """Not a function: any pressure keeps a rigid tube at ``stretch = 1``."""
         raise InvalidParameterError("stretch", "{} (a rigid wall's pressure is not a function of stretch)",

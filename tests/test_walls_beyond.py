@@ -1,0 +1,421 @@
+"""Walls beyond the uniform clamped tube (``docs/walls_beyond.md``): end conditions of linear
+walls, the Shapiro collapsible tube, external pressure, axial pre-stretch.
+
+Every reference is computed here independently of the code under test (mpmath at 30 digits).
+"""
+
+from __future__ import annotations
+
+import math
+
+import mpmath as mp
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import tubefsi
+import tubefsi.testing
+
+walls = tubefsi.registry.walls
+mp.mp.dps = 30
+
+
+# ------------------------------------------------------------------ 1. linear end conditions
+def lame_strain(p, E, nu, tb, ends):
+    r"""Hoop strain of the inner surface from the generalized-plane-strain Lamé problem, in
+    displacements: :math:`u_r = A r + B/r`, :math:`\varepsilon_z = e`, 3-D Hooke's law with the Lamé
+    constants, :math:`\sigma_r(a) = -p`, :math:`\sigma_r(b) = 0` and the axial condition of
+    ``ends`` (closed: axial force :math:`p\pi a^2`; open: none; clamped: :math:`e = 0`), solved as
+    a 3x3 linear system in mpmath (none of the closed forms of ``linear.py``)."""
+    E, nu, p = mp.mpf(E), mp.mpf(nu), mp.mpf(p)
+    lam = E * nu / ((1 + nu) * (1 - 2 * nu)) if nu != 0.5 else None
+    mu = E / (2 * (1 + nu))
+    a, b = mp.mpf(1), 1 + mp.mpf(tb)
+
+    # stresses are linear in (A, B, e); rows: sigma_r(a) + p = 0, sigma_r(b) = 0, axial condition
+    def sig_r(r):   # coefficients of A, B, e
+        return [2 * (lam + mu), -2 * mu / r**2, lam]
+
+    sig_z = [2 * lam, mp.mpf(0), lam + 2 * mu]
+    rows = [sig_r(a), sig_r(b)]
+    rhs = [-p, mp.mpf(0)]
+    if ends == "clamped":
+        rows.append([0, 0, 1])
+        rhs.append(0)
+    else:       # uniform sigma_z over the annulus pi (b^2 - a^2): force p pi a^2 (closed) or 0 (open)
+        rows.append(sig_z)
+        rhs.append(p * a**2 / (b**2 - a**2) if ends == "closed" else 0)
+    A, B, _ = mp.lu_solve(mp.matrix(rows), mp.matrix(rhs))
+    return A + B / a**2
+
+
+@pytest.mark.parametrize("ends", ["closed", "open", "clamped"])
+@pytest.mark.parametrize("kind", ["thick-linear", "thin-linear"])
+@pytest.mark.parametrize("nu", [-0.3, 0.0, 0.3, 0.45])
+def test_linear_end_conditions_match_lame(kind, ends, nu):
+    E, p = 2.5e5, 7.0
+    wall = walls[kind](youngs_modulus=E, poisson_ratio=nu, end_condition=ends)
+    for tb in (1e-3, 0.2, 1.5):
+        if kind == "thick-linear":
+            ref = lame_strain(p, E, nu, tb, ends)
+        else:   # the thin wall is the t/a -> 0 limit: K(tb) extrapolated from tiny tb
+            h = mp.mpf("1e-12")
+            ref = lame_strain(p, E, nu, h, ends) * h / tb
+        assert wall.strain(p, tb) == pytest.approx(float(ref), rel=1e-13)
+
+
+def test_linear_end_conditions_thin_limits_and_incompressible_coincide():
+    for ends, k in (("closed", 1 - 0.3 / 2), ("open", 1.0), ("clamped", 1 - 0.3**2)):
+        thin = walls["thin-linear"](youngs_modulus=1.0, poisson_ratio=0.3, end_condition=ends)
+        assert thin.strain(1.0, 1.0) == pytest.approx(k, rel=1e-15)
+    # nu = 1/2: closed ends carry no axial strain, so closed = clamped (the hyperelastic limit)
+    closed, clamped = (walls["thick-linear"](youngs_modulus=3.0, poisson_ratio=0.5, end_condition=e)
+                       for e in ("closed", "clamped"))
+    neo = walls["thick-neo-hookean"](shear_modulus=1.0)
+    for tb in (0.1, 1.0):
+        assert clamped.small_strain_modulus(tb) == pytest.approx(closed.small_strain_modulus(tb), rel=1e-15)
+        assert clamped.small_strain_modulus(tb) == pytest.approx(neo.small_strain_modulus(tb), rel=1e-12)
+
+
+def test_end_condition_validates_and_enters_the_table_key():
+    with pytest.raises(tubefsi.InvalidParameterError, match="end_condition"):
+        walls["thin-linear"](youngs_modulus=1.0, poisson_ratio=0.3, end_condition="capped")
+    tube = tubefsi.Tube(radius=1e-4, thickness=3e-5, length=1e-2)
+    fluid = tubefsi.registry.rheologies["newtonian"](viscosity=1e-3)
+    drops = {}
+    for ends in ("closed", "open", "clamped"):
+        wall = walls["thick-linear"](youngs_modulus=1e4, poisson_ratio=0.3, end_condition=ends)
+        for _ in range(3):          # the third call is served by the cached table / scalar path
+            drops.setdefault(ends, []).append(tubefsi.solve(fluid, wall, tube, flow_rate=1e-9).pressure_drop)
+    for ends, values in drops.items():
+        assert max(values) - min(values) <= 1e-13 * values[0]
+    assert len({v[-1] for v in drops.values()}) == 3
+
+
+# ------------------------------------------------------------------ 2-3. Shapiro, external pressure
+TUBE = tubefsi.Tube(radius=1e-4, thickness=3e-5, length=1e-2)
+NEWTONIAN = tubefsi.registry.rheologies["newtonian"](viscosity=1e-3)
+POWER_LAW = tubefsi.registry.rheologies["power-law"](consistency=0.017, index=0.7)
+
+
+def mp_gradient(fluid, q, R):
+    """G(q, R) of a power law (Newtonian: n = 1, m = mu), from the flow law in mpmath."""
+    n = mp.mpf(getattr(fluid, "index", 1.0))
+    m = mp.mpf(getattr(fluid, "consistency", getattr(fluid, "viscosity", None)))
+    return 2 * m * ((3 * n + 1) * mp.mpf(q) / (mp.pi * n)) ** n * R ** -(3 * n + 1)
+
+
+def mp_root(f, lo, hi):
+    """The root of an increasing ``f`` in ``[lo, hi]``: bisection to 1e-12 of the bracket, then
+    the secant method from the two ends (mpmath's default)."""
+    for _ in range(25):
+        mid = (lo + hi) / 2
+        lo, hi = (mid, hi) if f(mid) < 0 else (lo, mid)
+    return mp.findroot(f, (lo, hi))
+
+
+def mp_reference(law, slope, fluid, tube, q, p_transmural_out, z=(), antiderivative=None):
+    """``(dp, inlet strain, [R(z)])`` of the separated problem in mpmath: the outlet stretch from
+    the tube law ``law`` (a root), the inlet stretch from
+    :math:`\\int_{\\lambda_{out}}^{\\lambda_{in}} P'(s)/G(q, as)\\,ds = L` (a root of mpmath's
+    quadrature, or of ``antiderivative(s)`` of :math:`s^k P'(s)` for a power law, :math:`k = 3n+1`)."""
+    a, L = mp.mpf(tube.radius), mp.mpf(tube.length)
+    lam_out = mp_root(lambda s: law(s) - p_transmural_out, mp.mpf("0.01"), mp.mpf(10))
+
+    def H(lam):
+        if antiderivative is not None:       # G = phi(q) R^-k: the integral is a^k/phi [F(lam) - F(lam_out)]
+            return (antiderivative(lam) - antiderivative(lam_out)) / mp_gradient(fluid, q, a)
+        return mp.quad(lambda s: slope(s) / mp_gradient(fluid, q, a * s), [lam_out, lam])
+
+    def stretch_at(length):      # bracketed: the rise above the outlet doubled until H passes length
+        hi = lam_out * mp.mpf("1.001")
+        while H(hi) < length:
+            hi = lam_out + 2 * (hi - lam_out)
+        return mp_root(lambda lam: H(lam) - length, lam_out, hi)
+
+    lam_in = stretch_at(L)
+    radii = [a * stretch_at(L - mp.mpf(zz)) for zz in z]
+    return law(lam_in) - law(lam_out), lam_in - 1, radii
+
+
+def shapiro_law(K, fluid, n1=10, n2=1.5):
+    """Shapiro's law, its slope and the antiderivative of :math:`s^k P'(s)`,
+    :math:`K[2n_1 s^{k+2n_1}/(k+2n_1) + 2n_2 s^{k-2n_2}/(k-2n_2)]`, in mpmath."""
+    K, n1, n2 = mp.mpf(K), mp.mpf(n1), mp.mpf(n2)
+    k = 3 * mp.mpf(getattr(fluid, "index", 1.0)) + 1
+    return (lambda s: K * (s ** (2 * n1) - s ** (-2 * n2)),
+            lambda s: K * (2 * n1 * s ** (2 * n1 - 1) + 2 * n2 * s ** (-2 * n2 - 1)),
+            lambda s: K * (2 * n1 * s ** (k + 2 * n1) / (k + 2 * n1) + 2 * n2 * s ** (k - 2 * n2) / (k - 2 * n2)))
+
+
+@pytest.mark.parametrize("fluid", [NEWTONIAN, POWER_LAW], ids=["newtonian", "power-law"])
+@pytest.mark.parametrize("p_e, q", [(0.0, 2e-10),        # inflated
+                                    (60.0, 1e-10),       # outlet collapsed, inlet inflated
+                                    (900.0, 1e-11),      # both ends collapsed
+                                    (5e3, 2e-12)])       # deep collapse (area ratio ~ 0.1)
+def test_shapiro_under_external_pressure_matches_mpmath(fluid, p_e, q):
+    K, p_out = 50.0, 10.0
+    wall = walls["shapiro"](tube_stiffness=K)
+    z = np.array([0.2, 0.7]) * TUBE.length
+    law, slope, antiderivative = shapiro_law(K, fluid)
+    dp, e_in, radii = mp_reference(law, slope, fluid, TUBE, q, mp.mpf(p_out) - p_e, z, antiderivative)
+    for coupler in ("auto", "quadrature"):          # the closed form, and the engine's quadrature
+        sol = tubefsi.solve(fluid, wall, TUBE, flow_rate=q, outlet_pressure=p_out, external_pressure=p_e,
+                            coupler=coupler)
+        assert sol.pressure_drop == pytest.approx(float(dp), rel=1e-11)
+        assert sol.inlet_displacement == pytest.approx(float(e_in * TUBE.radius), rel=1e-11)
+        np.testing.assert_allclose(sol.radius(z), [float(r) for r in radii], rtol=1e-11)
+    assert sol.inlet_pressure == pytest.approx(p_out + float(dp), rel=1e-14)
+    assert sol.outlet_pressure == p_out and sol.external_pressure == p_e
+    if p_e >= 900:
+        assert sol.inlet_pressure < p_e          # both ends collapsed
+    back = tubefsi.solve(fluid, wall, TUBE, pressure_drop=sol.pressure_drop, outlet_pressure=p_out,
+                         external_pressure=p_e)
+    assert back.flow_rate == pytest.approx(q, rel=1e-11)
+
+
+def test_thick_neo_hookean_under_external_pressure_matches_mpmath():
+    mu, tb = 2e3, TUBE.reduced_thickness
+    wall = walls["thick-neo-hookean"](shear_modulus=mu)
+    b = (1 + mp.mpf(tb)) ** 2
+
+    def law(lam):       # the Lamé integral of dW/(s^2 - 1) = mu (s^2 + 1)/s^3, by quadrature
+        lam_o = mp.sqrt(1 + (lam**2 - 1) / b)
+        return mp.quad(lambda s: mu * (s**2 + 1) / s**3, [lam_o, lam])
+
+    def slope(lam):     # Leibniz: g(lam) - g(lam_o) dlam_o/dlam, dlam_o/dlam = lam/(b lam_o)
+        lam_o = mp.sqrt(1 + (lam**2 - 1) / b)
+        return mu * ((lam**2 + 1) / lam**3 - (lam_o**2 + 1) / lam_o**3 * lam / (b * lam_o))
+
+    p_e = 0.9 * -wall.min_pressure(tb)      # just above the buckling bound
+    for q, fluid in ((3e-11, NEWTONIAN), (1e-9, POWER_LAW)):
+        sol = tubefsi.solve(fluid, wall, TUBE, flow_rate=q, external_pressure=p_e)
+        with mp.workdps(20):                # nested quadratures: 20 digits are plenty for 1e-11
+            dp, e_in, _ = mp_reference(law, slope, fluid, TUBE, q, -mp.mpf(p_e))
+        assert sol.pressure_drop == pytest.approx(float(dp), rel=1e-11)
+        assert sol.inlet_displacement == pytest.approx(float(e_in * TUBE.radius), rel=1e-11)
+
+
+@settings(deadline=None, max_examples=15)
+@given(p_out=st.floats(0.0, 50.0), p_e=st.floats(-30.0, 200.0), q=st.floats(1e-12, 1e-9),
+       name=st.sampled_from(["shapiro", "thin-neo-hookean", "thick-linear"]))
+def test_external_pressure_is_a_shift_of_the_outlet_pressure(p_out, p_e, q, name):
+    """External pressure p_e with outlet pressure p_out + p_e is the tube under outlet pressure
+    p_out (the transmural pressures agree; the gauge pressures differ by p_e)."""
+    wall = examples_of(name)
+    if p_out - (-p_e if p_e < 0 else 0) < 0 or p_out + max(p_e, 0) < 0:
+        return
+    try:
+        ref = tubefsi.solve(NEWTONIAN, wall, TUBE, flow_rate=q, outlet_pressure=p_out)
+    except tubefsi.NoSteadyStateError:
+        return
+    if p_out + p_e < 0:
+        return
+    sol = tubefsi.solve(NEWTONIAN, wall, TUBE, flow_rate=q, outlet_pressure=p_out + p_e, external_pressure=p_e)
+    rel = 4e-16 * abs(p_e) / max(sol.pressure_drop, 1e-300)      # the rounding of p_out + p_e - p_e
+    cond = max(1.0, abs(p_out + p_e) / max(p_out, 1e-300))
+    assert sol.pressure_drop == pytest.approx(ref.pressure_drop, rel=1e-12 * cond + rel * 10)
+    assert sol.inlet_pressure == pytest.approx(ref.inlet_pressure + p_e, rel=1e-12, abs=1e-12 * abs(p_e))
+
+
+def examples_of(name):
+    return tubefsi.testing.examples("walls", name)[0]
+
+
+def test_buckling_bounds_and_errors():
+    tb = 0.2
+    thin = walls["thin-linear"](youngs_modulus=1e4, poisson_ratio=0.3)
+    assert thin.min_pressure(tb) == pytest.approx(-1e4 * tb**3 / (4 * (1 - 0.09)), rel=1e-15)
+    thick = walls["thick-linear"](youngs_modulus=1e4, poisson_ratio=0.3)
+    assert thick.min_pressure(tb) == pytest.approx(-1e4 * (tb / 1.2) ** 3 / (4 * (1 - 0.09)), rel=1e-15)
+    for name in ("thin-neo-hookean", "thin-mooney-rivlin"):           # mu t^3/a^3, mu = 2 (c1 + c2)
+        w = examples_of(name)
+        mu = w.shear_modulus
+        assert w.min_pressure(tb) == pytest.approx(-mu * tb**3, rel=1e-14)
+    assert walls["shapiro"](tube_stiffness=1.0).min_pressure(tb) == -math.inf
+    with pytest.raises(tubefsi.BucklingError) as info:
+        tubefsi.solve(NEWTONIAN, thin, TUBE, flow_rate=1e-10, external_pressure=-1.01 * thin.min_pressure(0.3))
+    assert info.value.limit == pytest.approx(thin.min_pressure(0.3))
+    assert isinstance(info.value, tubefsi.NoSteadyStateError)
+    for bad in (math.nan, math.inf, "x"):
+        with pytest.raises(tubefsi.InvalidParameterError, match="external_pressure"):
+            tubefsi.solve(NEWTONIAN, thin, TUBE, flow_rate=1e-10, external_pressure=bad)
+    # arrays broadcast like the outlet pressure, entry by entry
+    p_e = np.array([[0.0], [1.0], [5.0]])
+    q = np.array([1e-10, 3e-10])
+    sol = tubefsi.solve(NEWTONIAN, thin, TUBE, flow_rate=q, external_pressure=p_e)
+    assert sol.pressure_drop.shape == (3, 2)
+    for i, j in np.ndindex(3, 2):
+        one = tubefsi.solve(NEWTONIAN, thin, TUBE, flow_rate=float(q[j]), external_pressure=float(p_e[i, 0]))
+        assert sol.pressure_drop[i, j] == pytest.approx(one.pressure_drop, rel=1e-13)
+    assert tubefsi.max_flow_rate(POWER_LAW, "thick-neo-hookean" if False else examples_of("thick-neo-hookean"),
+                                 TUBE, external_pressure=5.0) > tubefsi.max_flow_rate(
+        POWER_LAW, examples_of("thick-neo-hookean"), TUBE)
+
+
+# ------------------------------------------------------------------ 4. axial pre-stretch
+def physical_dW(name, lz):
+    r""":math:`\hat W'(s; \lambda_z) = d/ds\,W(1/(s\lambda_z), s, \lambda_z)` of the 3-D energies, by
+    mpmath differentiation (neo-Hookean: :math:`\mu/2(I_1 - 3)`; Mooney–Rivlin with c2)."""
+    lz = mp.mpf(lz)
+
+    def energy(s):
+        l1, l2, l3 = 1 / (s * lz), s, lz
+        i1 = l1**2 + l2**2 + l3**2
+        i2 = (l1 * l2) ** 2 + (l2 * l3) ** 2 + (l1 * l3) ** 2
+        if name == "neo-hookean":
+            return mp.mpf(2e3) / 2 * (i1 - 3)
+        return mp.mpf(1e3) * (i1 - 3) + mp.mpf(-300) * (i2 - 3)
+
+    c1, c2 = (mp.mpf(1e3), mp.mpf(0)) if name == "neo-hookean" else (mp.mpf(1e3), mp.mpf(-300))
+
+    def dW(s):      # by hand: 2 c1 (s - s^-3 lz^-2) + 2 c2 (lz^2 s - s^-3) (mu = 2 c1 for neo-Hookean)
+        return 2 * c1 * (s - s**-3 / lz**2) + 2 * c2 * (lz**2 * s - s**-3)
+
+    for s in (mp.mpf("0.7"), mp.mpf("1.9")):   # ... checked against the energy once
+        assert abs(dW(s) - mp.diff(energy, s)) < mp.mpf(10) ** (5 - mp.mp.dps)
+    return dW
+
+
+def make(name, theory, lz, convention="reference"):
+    kw = dict(shear_modulus=2e3) if name == "neo-hookean" else dict(c1=1e3, c2=-300.0)
+    if theory == "thin":
+        kw["thickness_convention"] = convention
+    return walls[f"{theory}-{name}"](axial_stretch=lz, **kw)
+
+
+@pytest.mark.parametrize("name", ["neo-hookean", "mooney-rivlin"])
+@pytest.mark.parametrize("lz", [0.8, 1.0, 1.25, 1.6])
+def test_axial_stretch_tube_laws_match_mpmath(name, lz):
+    r"""The installed tube's law (stretch :math:`\lambda = R\sqrt{\lambda_z}/a`) against the thick
+    integral :math:`\int_{s_o}^{s_i}\hat W'(s)/(\lambda_z s^2 - 1)\,ds` of the 3-D energy
+    (mpmath), :math:`s_i = \lambda/\sqrt{\lambda_z}`, and against the generic thick integral; the
+    thin laws against :math:`\bar t\hat W'(s_i)/\sqrt{\lambda_z}` (reference) and
+    :math:`\bar t\hat W'(s_i)/(\lambda_z s_i)` (current)."""
+    from tubefsi.walls.hyperelastic import ThickWall
+
+    dW = physical_dW(name, lz)
+    thick = make(name, "thick", lz)
+    thin = {c: make(name, "thin", lz, c) for c in ("reference", "current")}
+    for tb in (0.05, 0.3, 1.2):
+        B = (1 + mp.mpf(tb)) ** 2
+        for lam in (1.0 + 0.5 * (thick.min_stretch(tb) - 1.0), 1.01, 1.5, 3.0):     # a collapsing one too
+            s_i = mp.mpf(lam) / mp.sqrt(lz)
+            s_o = mp.sqrt((1 + (lz * s_i**2 - 1) / B) / lz)
+            ref = mp.quad(lambda s: dW(s) / (lz * s**2 - 1), [s_o, s_i])
+            assert thick.pressure(lam, tb) == pytest.approx(float(ref), rel=1e-13)
+            generic = float(ThickWall._pressure_at_strain(thick, np.array([lam - 1.0]), tb)[0])
+            assert generic == pytest.approx(float(ref), rel=1e-13)
+            assert thin["reference"].pressure(lam, tb) == pytest.approx(float(tb * dW(s_i) / mp.sqrt(lz)), rel=1e-13)
+            assert thin["current"].pressure(lam, tb) == pytest.approx(float(tb * dW(s_i) / (lz * s_i)), rel=1e-13)
+
+
+@pytest.mark.parametrize("lz", [1.3])
+def test_pre_stretched_tube_in_situ_matches_mpmath(lz):
+    """solve() with axial_stretch: the installed tube (lumen a/sqrt(lz) at zero pressure, length
+    lz L) with the thick neo-Hookean law of the 3-D energy, against mpmath."""
+    wall = make("neo-hookean", "thick", lz)
+    sol0 = tubefsi.solve(NEWTONIAN, wall, TUBE, flow_rate=0.0)
+    assert sol0.radius(0.0) == pytest.approx(TUBE.radius / math.sqrt(lz), rel=1e-15)
+    assert sol0.tube.length == pytest.approx(lz * TUBE.length, rel=1e-15)
+    again = tubefsi.solve(NEWTONIAN, wall, sol0.tube, flow_rate=1e-9)         # not installed twice
+    assert again.pressure_drop == tubefsi.solve(NEWTONIAN, wall, TUBE, flow_rate=1e-9).pressure_drop
+    with pytest.raises(tubefsi.InvalidParameterError, match="tube"):
+        tubefsi.solve(NEWTONIAN, make("neo-hookean", "thick", 1.1), sol0.tube, flow_rate=1e-9)
+    dW = physical_dW("neo-hookean", lz)
+    tb = TUBE.reduced_thickness
+    B = (1 + mp.mpf(tb)) ** 2
+
+    def law(lam):
+        s_i = lam / mp.sqrt(lz)
+        s_o = mp.sqrt((1 + (lz * s_i**2 - 1) / B) / lz)
+        return mp.quad(lambda s: dW(s) / (lz * s**2 - 1), [s_o, s_i])
+
+    def slope(lam):         # d/dlam of the integral (Leibniz), ds_o/dlam = lam/(B lz s_o) ... in s_i units
+        s_i = lam / mp.sqrt(lz)
+        s_o = mp.sqrt((1 + (lz * s_i**2 - 1) / B) / lz)
+        return (dW(s_i) / (lz * s_i**2 - 1) - dW(s_o) / (lz * s_o**2 - 1) * s_i / (B * s_o)) / mp.sqrt(lz)
+
+    installed = tubefsi.Tube(radius=TUBE.radius / math.sqrt(lz), thickness=TUBE.thickness / math.sqrt(lz),
+                             length=TUBE.length * lz)
+    q = 1e-9
+    sol = tubefsi.solve(NEWTONIAN, wall, TUBE, flow_rate=q, outlet_pressure=20.0)
+    with mp.workdps(20):
+        dp, e_in, _ = mp_reference(law, slope, NEWTONIAN, installed, q, mp.mpf(20))
+    assert sol.pressure_drop == pytest.approx(float(dp), rel=1e-11)
+    assert sol.radius(0.0) == pytest.approx(float((1 + e_in) * installed.radius), rel=1e-11)
+
+
+@settings(deadline=None, max_examples=10)
+@given(delta=st.floats(-1e-6, 1e-6), name=st.sampled_from(["thick-neo-hookean", "thin-mooney-rivlin"]),
+       q=st.floats(1e-11, 1e-8))
+def test_axial_stretch_tends_to_todays_walls(delta, name, q):
+    """lambda_z -> 1 gives the plane-strain wall: the pressure drop moves by O(delta)."""
+    base = examples_of(name)
+    near = attrs_evolve(base, axial_stretch=1.0 + delta)
+    ref = tubefsi.solve(NEWTONIAN, base, TUBE, flow_rate=q).pressure_drop
+    got = tubefsi.solve(NEWTONIAN, near, TUBE, flow_rate=q).pressure_drop
+    assert abs(got / ref - 1) <= 10 * abs(delta) + 1e-13
+
+
+def attrs_evolve(model, **changes):
+    import attrs
+
+    return attrs.evolve(model, **changes)
+
+
+def test_axial_stretch_validates():
+    for bad in (0.0, -1.0, math.nan, math.inf):
+        with pytest.raises(tubefsi.InvalidParameterError, match="axial_stretch"):
+            walls["thick-neo-hookean"](shear_modulus=1.0, axial_stretch=bad)
+    with pytest.raises(tubefsi.InvalidParameterError, match="axial_stretch"):   # 2 (c1/lz + c2 lz) <= 0
+        walls["thick-mooney-rivlin"](c1=1.0, c2=-0.3, axial_stretch=2.0)
+    names = [p.name for p in tubefsi.fields.parameters(walls["thin-neo-hookean"])]
+    assert "axial_stretch" in names
+
+
+# ------------------------------------------------------------------ 5. HGO arterial walls
+def hgo_dW(mu, k1, k2, beta):
+    r""":math:`\hat W'(s)` of the 3-D HGO energy on the plane-strain path (stretches
+    :math:`1/s, s, 1`), by mpmath differentiation; a fibre term only where :math:`I_4 > 1`."""
+    mu, k1, k2, c = mp.mpf(mu), mp.mpf(k1), mp.mpf(k2), mp.cos(mp.mpf(beta))
+
+    def energy(s):
+        i1 = s**-2 + s**2 + 1
+        i4 = s**2 * c**2 + (1 - c**2)
+        fibre = k1 / (2 * k2) * (mp.exp(k2 * (i4 - 1) ** 2) - 1) if i4 > 1 else 0
+        return mu / 2 * (i1 - 3) + 2 * fibre
+
+    return lambda s: mp.diff(energy, s)
+
+
+@pytest.mark.parametrize("preset", ["rabbit-carotid-media", "rabbit-carotid-adventitia"])
+def test_hgo_tube_laws_match_mpmath(preset):
+    from tubefsi.walls.hgo import PRESETS
+
+    p = PRESETS[preset]
+    dW = hgo_dW(p["shear_modulus"], p["fibre_stiffness"], p["fibre_exponent"], p["fibre_angle"])
+    thick = walls["thick-hgo"].preset(preset)
+    thin = walls["thin-hgo"].preset(preset, thickness_convention="current")
+    for tb in (0.1, 0.5):
+        B = (1 + mp.mpf(tb)) ** 2
+        for lam in (1.0 + 0.5 * (thick.min_stretch(tb) - 1.0), 1.02, 1.4, 2.0):
+            lam_o = mp.sqrt(1 + (mp.mpf(lam) ** 2 - 1) / B)
+            ref = mp.quad(lambda s: dW(s) / (s**2 - 1), [lam_o, lam])
+            assert thick.pressure(lam, tb) == pytest.approx(float(ref), rel=1e-12)
+            assert thin.pressure(lam, tb) == pytest.approx(float(tb * dW(mp.mpf(lam)) / lam), rel=1e-12)
+    with pytest.raises(tubefsi.InvalidParameterError, match="preset"):
+        walls["thick-hgo"].preset("bovine")
+    with pytest.raises(tubefsi.InvalidParameterError, match="fibre_angle"):
+        walls["thick-hgo"](shear_modulus=1.0, fibre_stiffness=1.0, fibre_exponent=1.0, fibre_angle=2.0)
+
+
+class TestStiffHGO(tubefsi.testing.AccuracyContract):
+    """A stiff fibre law (k2 = 20, fibres near the hoop) against the brute force."""
+
+    @pytest.fixture(params=tubefsi.testing.accuracy_cases(
+        [walls["thin-hgo"](shear_modulus=1e3, fibre_stiffness=1e4, fibre_exponent=20.0, fibre_angle=0.3)],
+        [POWER_LAW]))
+    def case(self, request):
+        return request.param
