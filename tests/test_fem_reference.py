@@ -152,6 +152,12 @@ def test_bad_input_is_refused_with_the_parameter_named():
     with pytest.raises(tubefsi.InvalidParameterError, match="wall"):
         tfem.solve_axisymmetric(fluid, walls["thick-linear"](youngs_modulus=3e4, poisson_ratio=0.5), tube,
                                 flow_rate=1e-9)
+    with pytest.raises(tubefsi.InvalidParameterError, match="flow_rate"):
+        tfem.solve_axisymmetric(fluid, wall, tube, flow_rate=[1e-9, 2e-9])
+    with pytest.raises(tubefsi.InvalidParameterError, match="rheology"):
+        tfem.solve_axisymmetric(rheologies["newtonian"](viscosity=[1e-3, 2e-3]), wall, tube, flow_rate=1e-9)
+    with pytest.raises(tubefsi.InvalidParameterError, match="wall"):
+        tfem.solve_axisymmetric(fluid, walls["thick-neo-hookean"](shear_modulus=[1e4, 2e4]), tube, flow_rate=1e-9)
     with pytest.raises(tubefsi.InvalidParameterError, match="tube"):
         tfem.solve_axisymmetric(fluid, wall, tubefsi.Tube(radius=[A, 2 * A], thickness=0.3 * A, length=10 * A),
                                 flow_rate=1e-9)

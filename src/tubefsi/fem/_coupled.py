@@ -132,9 +132,12 @@ def solve_axisymmetric(rheology, wall, tube, *, flow_rate, resolution=4, outlet_
     AxisymmetricSolution
     """
     t0 = time.perf_counter()
-    q = float(flow_rate)
-    if not q > 0.0:
-        raise InvalidParameterError("flow_rate", "(0, inf)", flow_rate)
+    if np.size(flow_rate) != 1 or not float(np.asarray(flow_rate).reshape(())) > 0.0:
+        raise InvalidParameterError("flow_rate", "one flow rate in (0, inf) m^3/s", flow_rate)
+    q = float(np.asarray(flow_rate).reshape(()))
+    if np.ndim(rheology.apparent_viscosity(1.0)) != 0:
+        raise InvalidParameterError("rheology", "a rheology with scalar parameters", repr(rheology),
+                                    "tubefsi.fem solves one scene at a time")
     if int(resolution) != resolution or resolution < 1:
         raise InvalidParameterError("resolution", "integers >= 1", resolution)
     fields = (tube.radius, tube.thickness, tube.length)

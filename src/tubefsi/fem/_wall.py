@@ -19,6 +19,7 @@ converges the residual relative to the reactions to ``tol``.
 
 from __future__ import annotations
 
+import attrs
 import numpy as np
 
 import felupe as fem
@@ -33,6 +34,10 @@ __all__ = ["AxisymmetricWall", "material"]
 
 def material(wall):
     """felupe's 3-D isochoric model of ``wall``'s material, and its shear modulus (Pa)."""
+    if any(np.size(getattr(wall, f.name)) != 1 for f in attrs.fields(type(wall))
+           if isinstance(getattr(wall, f.name), (float, int, np.ndarray, list, tuple))):
+        raise InvalidParameterError("wall", "a wall with scalar parameters", repr(wall),
+                                    "tubefsi.fem solves one scene at a time")
     if getattr(wall, "axial_stretch", 1.0) != 1.0:
         raise InvalidParameterError("wall.axial_stretch", "{1} (tubefsi.fem clamps the tube at its "
                                     "stress-free length)", wall.axial_stretch)
