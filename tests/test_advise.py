@@ -92,3 +92,28 @@ def test_diagnostics_quiet_when_assumptions_hold():
     wide = tubefsi.solve(BLOOD, walls["thin-linear"](youngs_modulus=1e3, poisson_ratio=0.5), stubby, flow_rate=1e-4)
     msgs = " ".join(wide.diagnostics(warn=False).warnings)
     assert "slender" in msgs and "linear wall" in msgs
+
+
+def test_diagnostics_quote_the_validity_maps_end_effect_error():
+    """The expected modelling error of the pressure drop is the validity map's end-layer estimate
+    (3n+1) eps_in (0.3 a + 0.2 t)/L, and it is within 25 % of what the finite-element reference
+    measured (docs/validity_map.csv, written by examples/validity_map.py) for the map's thick-wall
+    scenes at small strain and a/L <= 0.05."""
+    import csv
+    from pathlib import Path
+
+    fluid = tubefsi.registry.rheologies["power-law"](consistency=1e-2, index=0.5)
+    tube = tubefsi.Tube(radius=1e-3, thickness=3e-4, length=4e-2)
+    sol = tubefsi.solve(fluid, walls["thick-neo-hookean"](shear_modulus=1e4), tube, flow_rate=1e-7)
+    diag = sol.diagnostics(warn=False)
+    eps = sol.inlet_displacement / 1e-3
+    assert diag.expected_model_error == pytest.approx((3 * 0.5 + 1) * eps * (0.3e-3 + 0.2 * 3e-4) / 4e-2, rel=1e-9)
+    assert "expected model error" in str(diag)
+    path = Path(__file__).resolve().parents[1] / "docs" / "validity_map.csv"
+    rows = [r for r in csv.DictReader(path.open()) if "thick" in r["scene"] and float(r["strain"]) <= 0.05
+            and float(r["a_over_L"]) <= 0.05]
+    assert len(rows) >= 12
+    for r in rows:
+        a_over_l, tb, n, strain = (float(r[k]) for k in ("a_over_L", "t_over_a", "n", "strain"))
+        estimate = tubefsi.validity.end_effect_error(n, strain, 1.0, tb, 1.0 / a_over_l)
+        assert estimate == pytest.approx(abs(float(r["error"])), rel=0.25), r["scene"]

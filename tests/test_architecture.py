@@ -27,6 +27,7 @@ LAYERS = [
     {"tubefsi.solution", "tubefsi.validity", "tubefsi.export"},
     {"tubefsi.solve"},
     {"tubefsi.advise", "tubefsi.fit", "tubefsi.dimensionless", "tubefsi.network"},
+    {"tubefsi.fem"},
     {"tubefsi.chapter", "tubefsi.plotting"},
     {"tubefsi.cli", "tubefsi.testing", "tubefsi"},
 ]

@@ -232,10 +232,12 @@ class Diagnostics:
     reduced_reynolds_number: float | None   # Re * R / L, what lubrication needs small
     warnings: tuple
     deformed_slenderness: float = math.nan   # largest R_in / L: the deformed tube's
+    expected_model_error: float = math.nan   # |dp_tubefsi / dp_exact - 1| from clamped ends (validity map)
 
     def __str__(self) -> str:
         rows = [("slenderness a/L", self.slenderness), ("deformed slenderness R/L", self.deformed_slenderness),
                 ("max hoop strain", self.max_strain),
+                ("expected model error", self.expected_model_error),
                 ("p_in / limit pressure", self.inlet_pressure_fraction),
                 ("q / max flow rate", self.flow_rate_fraction),
                 ("Reynolds number", self.reynolds_number), ("reduced Reynolds Re R/L", self.reduced_reynolds_number)]
@@ -280,4 +282,24 @@ def diagnostics(solution, *, density=None, warn=True) -> Diagnostics:
     return Diagnostics(slenderness=eps, max_strain=found.max_strain, inlet_pressure_fraction=p_frac,
                        flow_rate_fraction=q_frac, reynolds_number=found.reynolds_number,
                        reduced_reynolds_number=found.reduced_reynolds_number, warnings=tuple(messages),
-                       deformed_slenderness=found.deformed_slenderness)
+                       deformed_slenderness=found.deformed_slenderness,
+                       expected_model_error=_expected_model_error(solution))
+
+
+def _expected_model_error(solution) -> float:
+    """Largest end-effect error of the pressure drop over the solution's points
+    (:func:`tubefsi.validity.end_effect_error`, ``docs/validity.md``); NaN for a tube whose
+    fields vary along z (the map covers uniform tubes only) or a rigid wall (no inflation)."""
+    tube, st = solution.tube, solution.state
+    if any(callable(v) for v in (tube.radius, tube.thickness, tube.length)):
+        return math.nan
+    q = np.asarray(st.flow_rate, dtype=float)
+    strain = np.asarray(st.inlet_strain, dtype=float)
+    r_in = np.asarray(tube.radius, dtype=float) * (1.0 + strain)
+    ok = np.isfinite(q) & np.isfinite(strain) & (q > 0)
+    if not np.any(ok):
+        return 0.0 if np.all(np.isfinite(q)) else math.nan
+    with np.errstate(invalid="ignore", divide="ignore"):
+        k = solution.rheology._flow_index(np.where(ok, q, 1.0), np.broadcast_to(r_in, q.shape))
+        err = validity.end_effect_error(k, strain, tube.radius, tube.thickness, tube.length)
+    return float(np.max(np.where(ok, err, 0.0)))

@@ -300,7 +300,9 @@ class Solution:
         limit pressure and to the maximum flow rate, and (given the fluid's
         ``density`` in kg/m^3) the Metzner–Reed Reynolds number; each failed
         assumption is a :class:`~tubefsi.advise.ModelValidityWarning` (unless
-        ``warn=False``) and a line in the result's ``warnings``.
+        ``warn=False``) and a line in the result's ``warnings``. ``expected_model_error``
+        is the relative error of the pressure drop that the clamped ends cause, as the
+        finite-element validity map measured it (``docs/validity.md``).
         """
         from .advise import diagnostics
 

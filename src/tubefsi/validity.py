@@ -31,12 +31,29 @@ import numpy as np
 from .errors import ModelValidityWarning, warn_user
 from .walls.linear import ThickLinear, ThinLinear
 
-__all__ = ["SLENDERNESS", "REDUCED_REYNOLDS", "Validity", "check", "warn"]
+__all__ = ["SLENDERNESS", "REDUCED_REYNOLDS", "END_LAYER", "Validity", "check", "end_effect_error", "warn"]
 
 #: Largest deformed slenderness :math:`R/L` for lubrication theory.
 SLENDERNESS = 0.1
 #: Largest reduced Reynolds number :math:`Re\,R/L` for inertia to be negligible.
 REDUCED_REYNOLDS = 0.1
+#: Coefficients :math:`(c_a, c_t)` of the clamped inlet's end-layer length
+#: :math:`\ell_{end} = c_a a + c_t t`, measured by the validity map (``docs/validity.md``:
+#: 0.30, 0.36, 0.50 :math:`a` at :math:`t/a` = 0.05, 0.3, 1 and 5 % strain).
+END_LAYER = (0.3, 0.2)
+
+
+def end_effect_error(flow_index, inlet_strain, radius, thickness, length):
+    r"""Expected relative error of the reduced pressure drop from clamped ends, by the validity map.
+
+    :math:`|\delta| \approx (3k+1)\,\varepsilon_{in}\,\ell_{end}/L`, :math:`\ell_{end}` from
+    :data:`END_LAYER`, :math:`k` the local flow index (:math:`n` for a power law): the first-order
+    term in :math:`a/L` of the fit in ``docs/validity.md``, within 20 % of every map scene at small
+    strain (the reduced model *under*-predicts). Not included: the wall theory's own error (thin
+    walls, :math:`O(\bar t)`; 0.2 % at 30 % strain) and inertia. Broadcasts; SI units.
+    """
+    k, eps, a, t, L = (np.asarray(v, dtype=float) for v in (flow_index, inlet_strain, radius, thickness, length))
+    return (3.0 * k + 1.0) * np.abs(eps) * (END_LAYER[0] * a + END_LAYER[1] * t) / L
 
 
 @attrs.frozen
