@@ -117,3 +117,15 @@ def test_diagnostics_quote_the_validity_maps_end_effect_error():
         a_over_l, tb, n, strain = (float(r[k]) for k in ("a_over_L", "t_over_a", "n", "strain"))
         estimate = tubefsi.validity.end_effect_error(n, strain, 1.0, tb, 1.0 / a_over_l)
         assert estimate == pytest.approx(abs(float(r["error"])), rel=0.25), r["scene"]
+
+
+def test_advice_quotes_the_validity_map():
+    """advise reports the requested model's own end-effect error (docs/validity.md), the same
+    number as the solution's diagnostics, and prints it."""
+    fluid = rheologies["power-law"](consistency=0.017, index=0.7)
+    wall = walls["thick-neo-hookean"](shear_modulus=2e3)
+    tube = tubefsi.Tube(radius=1e-4, thickness=3e-5, length=1e-2)
+    advice = tubefsi.advise(fluid, wall, tube, flow_rate=1e-9)
+    expected = tubefsi.solve(fluid, wall, tube, flow_rate=1e-9).diagnostics(warn=False).expected_model_error
+    assert 0 < advice.expected_model_error == pytest.approx(expected, rel=1e-12)
+    assert "validity map" in str(advice)

@@ -58,6 +58,9 @@ class Advice:
     candidates: tuple
     recommended: Candidate
     tolerance: float
+    #: The requested model's own expected error in the pressure drop from its clamped ends, by
+    #: the measured validity map (``docs/validity.md``; NaN where the map does not apply).
+    expected_model_error: float = math.nan
 
     def __str__(self) -> str:
         curve = np.ndim(self.requested.pressure_drop) > 0
@@ -70,6 +73,9 @@ class Advice:
             dp = float(np.max(c.pressure_drop))
             lines.append(f"{c.label:{width}s} {dp:22.6g} {c.relative_difference:13.2e}  {ok}{mark}"
                          + (f" ({c.note})" if c.note else ""))
+        if math.isfinite(self.expected_model_error):
+            lines.append(f"expected error of the reduced model itself (clamped ends, validity map): "
+                         f"{self.expected_model_error:.2g}")
         return "\n".join(lines)
 
 
@@ -184,10 +190,10 @@ def advise(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, toleranc
         raise InvalidParameterError("rheology / wall / tube", "scalar parameters (advise compares one scene)",
                                     None, f"got parameters of shape {scene.shape}; call advise per scene")
     if flow_rate is None:
-        flow_rate = solve(rheology, wall, tube, pressure_drop=pressure_drop,
-                          outlet_pressure=outlet_pressure).flow_rate
+        own = solve(rheology, wall, tube, pressure_drop=pressure_drop, outlet_pressure=outlet_pressure)
+        flow_rate = own.flow_rate
     else:  # the requested model must solve: its errors are the caller's, not a candidate's
-        solve(rheology, wall, tube, flow_rate=flow_rate, outlet_pressure=outlet_pressure)
+        own = solve(rheology, wall, tube, flow_rate=flow_rate, outlet_pressure=outlet_pressure)
     load = ("flow_rate", flow_rate)
     results = []
     reference = None
@@ -217,7 +223,8 @@ def advise(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, toleranc
                   for rank, label, fluid, w, dp, sec, note in results)
     requested = next(c for c in cands if c.wall is wall and c.rheology is rheology)
     recommended = next(c for c in cands if c.relative_difference <= tolerance)
-    return Advice(requested=requested, candidates=cands, recommended=recommended, tolerance=tolerance)
+    return Advice(requested=requested, candidates=cands, recommended=recommended, tolerance=tolerance,
+                  expected_model_error=_expected_model_error(own))
 
 
 @attrs.frozen
