@@ -406,3 +406,24 @@ def test_networkx_round_trip():
     # a networkx layout when no node has coordinates
     bare = Network.from_networkx(simple, rheology=FLUID).solve()
     assert bare.plot() is not None
+
+
+def test_a_generic_fluid_with_mixed_walls_and_a_dead_end():
+    """Carreau–Yasuda blood (the generic, non-separable path) through three wall groups; the dead
+    end's tiny pressure drops are where the single-tube solve gives no flow rate (the network
+    takes the secant of a probe drop there, ``docs/network.md``)."""
+    blood = rheologies["carreau-yasuda"](**rheologies["carreau-yasuda"]._examples[0])
+    net = Network(rheology=blood)
+    net.add_tube("in", "j", walls["thick-linear"](youngs_modulus=6e3, poisson_ratio=0.5), TUBE)
+    net.add_tube("j", "a", WALL, TUBE)
+    net.add_tube("j", "b", walls["thin-neo-hookean"](shear_modulus=2e4), TUBE)
+    net.add_tube("j", "dead", WALL, TUBE)
+    net.set_pressure("in", 300.0).set_pressure("a", 0.0).set_pressure("b", 40.0)
+    result = net.solve()
+    assert _worst_balance(result) <= 1e-12
+    assert abs(result.flow_rate[("j", "dead")]) <= 1e-12 * result.flow_rate[("in", "j")]
+    for name in (("in", "j"), ("j", "a"), ("j", "b")):    # each tube obeys its own law
+        t = net._tubes[name]
+        pu, pv = result.pressure[t.u], result.pressure[t.v]
+        single = tubefsi.solve(blood, t.wall, t.tube, pressure_drop=pu - pv, outlet_pressure=pv)
+        assert result.flow_rate[name] == pytest.approx(single.flow_rate, rel=1e-12)
