@@ -31,7 +31,7 @@ zero; the flow it would carry is below :math:`10^{-30/n}` of the network's.)
 
 A trial pressure beyond what a wall's tube law reaches halves the step; a flow rate the
 single-tube solve cannot give at a drop far below the pressures (NaN, the generic rheology path)
-is the secant of a probe drop (:meth:`_Solver._tiny_drops`). A node with an inflow and a single
+is the secant of a probe drop (``docs/network.md``). A node with an inflow and a single
 tube is no unknown: that tube is solved flow-controlled at the end.
 
 Converged means that the mass balance of every free node is below ``rtol`` times the
