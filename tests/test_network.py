@@ -224,7 +224,8 @@ def _reference_y(wall_params, tubes, n, m, p_fixed, inflow=None, dps=30):
         lo = max(p1, p2) * (1 + mpf(10) ** -20) + mpf(10) ** -20
         if inflow is None:
             p0 = mpf(p_fixed[0])
-            pj = mp.findroot(lambda x: q(0, p0, x) - q(1, x, p1) - q(2, x, p2), (lo, p0), solver="anderson")
+            hi = min(p0, min(refs[1].limit_pressure(), refs[2].limit_pressure()) * (1 - mpf(10) ** -12))
+            pj = mp.findroot(lambda x: q(0, p0, x) - q(1, x, p1) - q(2, x, p2), (lo, hi), solver="anderson")
         else:
             target = mpf(inflow)
             pj = mp.findroot(lambda x: q(1, x, p1) + q(2, x, p2) - target, (lo, limit * (1 - mpf(10) ** -6)),
