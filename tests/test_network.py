@@ -428,3 +428,10 @@ def test_a_generic_fluid_with_mixed_walls_and_a_dead_end():
         pu, pv = result.pressure[t.u], result.pressure[t.v]
         single = tubefsi.solve(blood, t.wall, t.tube, pressure_drop=pu - pv, outlet_pressure=pv)
         assert result.flow_rate[name] == pytest.approx(single.flow_rate, rel=1e-12)
+
+
+def test_the_package_pickles_by_name():
+    """dask and multiprocessing send functions that refer to ``tubefsi`` to other processes."""
+    import pickle
+
+    assert pickle.loads(pickle.dumps(tubefsi)) is tubefsi
