@@ -45,7 +45,7 @@ test-latest:
 	test -x $(LATEST)/bin/python || $(PYTHON) -m venv $(LATEST)
 	$(LATEST)/bin/python -m pip install --quiet --upgrade pip setuptools wheel
 	$(LATEST)/bin/python -m pip install --quiet --upgrade --upgrade-strategy eager \
-	  -e '.[test,verify,docs,network]' $(foreach p,$(PLUGINS),-e $(dir $(p)))
+	  -e '.[test,verify,fem,docs,network,pandas,xarray,progress,units,parallel]' $(foreach p,$(PLUGINS),-e $(dir $(p)))
 	MPLBACKEND=Agg $(LATEST)/bin/python -m pytest -q -p no:cacheprovider
 
 # uv, at a fixed version in a throw-away venv, writes the lock from PyPI (not pip's indexes)

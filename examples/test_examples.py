@@ -227,3 +227,24 @@ def test_validity_map_quick_is_first_order_in_slenderness(tmp_path, capsys):
     assert order == pytest.approx(1.0, abs=0.3)
     with open(tmp_path / "validity_map.csv", newline="") as fh:
         assert len(list(csv.DictReader(fh))) == 2
+
+
+# ---------------------------------------------------------------------------- network_study.py
+def test_network_study_maps_batches_over_dask(tmp_path, capsys):
+    pytest.importorskip("dask.bag")
+    pytest.importorskip("distributed")
+    study = load("network_study")
+    assert study.main([str(tmp_path), "--samples", "60", "--batch", "30"]) == 0
+    text = capsys.readouterr().out
+    (count, _), = numbers(r"FLOAT networks in FLOAT s on a dask LocalCluster of 2 workers", text)
+    (failed,), = numbers(r"FLOAT without a steady state", text)
+    assert count == 60 and failed == 0
+    with open(tmp_path / "study.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert [int(r["sample"]) for r in rows] == list(range(60))
+    # the same samples solved one by one, serially, give the same split (the batches are
+    # disjoint unions: their components do not interact)
+    moduli, index = study.draw(60)
+    one = study.solve_batch((7, moduli[7:8], index[7:8]))[0]
+    assert float(rows[7]["split_fraction"]) == pytest.approx(one[1], rel=1e-12)
+    assert 0.5 < float(rows[7]["split_fraction"]) < 1.0

@@ -67,6 +67,11 @@ _FUNCTIONS = ("solve", "advise", "fit")
 
 
 class _Package(types.ModuleType):
+    def __reduce__(self):
+        # pickled by name, as a plain module is (cloudpickle, dask and multiprocessing send
+        # functions that refer to ``tubefsi`` to other processes)
+        return importlib.import_module, (self.__name__,)
+
     def __setattr__(self, name, value):
         # importing the submodule ``tubefsi.solve`` sets the package attribute ``solve`` to that
         # module; keep the public function there instead, as an eager import would
