@@ -783,7 +783,10 @@ def scene_outcomes(n, rheologies=None, walls=None, couplers=None, *, time_limit=
                 value = fraction * min(q_max, q_ref) if math.isfinite(q_max) else fraction * q_ref
             return _scene_check(fluid, wall, tube, coupler, load, value, outlet)
 
-        outcomes.append(run_probe(Probe(f"scene:{coupler}", label, call, check=lambda why: why), time_limit * 6))
+        # a scene is about ten public calls; the ODE coupler (a reference, one integration per point
+        # and per shooting step) gets three times as long
+        bound = time_limit * (18 if coupler == "ode" else 6)
+        outcomes.append(run_probe(Probe(f"scene:{coupler}", label, call, check=lambda why: why), bound))
 
     one()
     return outcomes
