@@ -596,7 +596,7 @@ def _known_probes():
             out.append(Probe(f"wall:{name}", "known: pressure(1e300, 0.3)", lambda w=wall: w.pressure(1e300, 0.3),
                              check=lambda p, w=wall: None if 0 < p <= w.limit_pressure(0.3) else f"p={p!r}"))
         thin = W["thin-neo-hookean"](shear_modulus=2e3)
-        out.append(Probe("wall:thin-neo-hookean", "known: stretch(1e300 Pa)", lambda: thin.stretch(1e300, 0.3),
+        out.append(Probe("wall:thin-neo-hookean", "known: stretch(1e300 Pa)", lambda w=thin: w.stretch(1e300, 0.3),
                          check=lambda lam: None if abs(lam - 1e300 / 600.0) <= 1e-12 * lam else f"stretch {lam!r}"))
     if have("bingham", "thick-neo-hookean"):
         fluid = R["bingham"](yield_stress=0.5, plastic_viscosity=0.05)
@@ -615,25 +615,25 @@ def _known_probes():
         twin = W["thin-ogden"](moduli=(2e3,), exponents=(2.0,))
         nh = W["thin-neo-hookean"](shear_modulus=2e3)
         out.append(Probe("solve", "known: thin Ogden alpha=2 = thin neo-Hookean at dp=1e-8",
-                         lambda f=fluid: (solve(f, twin, tube, pressure_drop=1e-8).flow_rate,
-                                          solve(f, nh, tube, pressure_drop=1e-8).flow_rate),
+                         lambda f=fluid, a=twin, b=nh: (solve(f, a, tube, pressure_drop=1e-8).flow_rate,
+                                                        solve(f, b, tube, pressure_drop=1e-8).flow_rate),
                          check=lambda q: None if abs(q[0] - q[1]) <= 1e-12 * q[1] else f"q={q[0]!r} vs {q[1]!r}"))
         tiny = W["thin-ogden"](moduli=(2e3,), exponents=(1e-16,))
         out.append(Probe("wall:thin-ogden", "known: exponent 1e-16 limits",
-                         lambda: (tiny.limit_pressure(0.3), tiny.max_stretch(0.3)), allow_inf=True,
+                         lambda w=tiny: (w.limit_pressure(0.3), w.max_stretch(0.3)), allow_inf=True,
                          check=lambda r: None if r[0] > 0 and (math.isfinite(r[1]) or math.isinf(r[0]))
                          else f"limit_pressure {r[0]!r} with max_stretch {r[1]!r}"))
     if have("thick-gent", "power-law"):
         fluid = R["power-law"](consistency=0.017, index=0.7)
         gent = W["thick-gent"](shear_modulus=2e3, locking_parameter=10.0)
         out.append(Probe("solve", "known: thick Gent Jm=10 at dp=1e5",
-                         lambda f=fluid: solve(f, gent, tube, pressure_drop=1e5)))
+                         lambda f=fluid, w=gent: solve(f, w, tube, pressure_drop=1e5)))
     for name in ("carreau", "cross", "ellis", "carreau-yasuda"):
         if have(name, "thick-neo-hookean"):
             fluid = R[name](**R[name]._examples[0])
             nh = W["thick-neo-hookean"](shear_modulus=2e3)
             out.append(Probe("solve", f"known: {name} dp=1e-11 (inlet strain < 2e-14)",
-                             lambda f=fluid: solve(f, nh, tube, pressure_drop=1e-11),
+                             lambda f=fluid, w=nh: solve(f, w, tube, pressure_drop=1e-11),
                              check=lambda sol, f=fluid: None if abs(sol.flow_rate / f.flow_rate(
                                  tube.radius, 1e-11 / tube.length) - 1) < 1e-10 else f"q={sol.flow_rate!r}"))
     if have("carreau", "thick-gent"):
@@ -645,7 +645,7 @@ def _known_probes():
         fung = W["thick-fung"](shear_modulus=1082.1, stiffening=3.1333)
         long = Tube(radius=3.2235e-3, thickness=3.54e-4, length=1.4378)
         out.append(Probe("solve", "known: carreau-yasuda thick Fung q=1.734e-11",
-                         lambda f=fluid: solve(f, fung, long, flow_rate=1.734e-11)))
+                         lambda f=fluid, w=fung, t=long: solve(f, w, t, flow_rate=1.734e-11)))
     return out
 
 
