@@ -188,7 +188,7 @@ def advise(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, toleranc
                           outlet_pressure=outlet_pressure).flow_rate
     else:  # the requested model must solve: its errors are the caller's, not a candidate's
         solve(rheology, wall, tube, flow_rate=flow_rate, outlet_pressure=outlet_pressure)
-    if not np.all(np.asarray(flow_rate) > 0):       # nothing to compare: every candidate gives 0
+    if not np.any(np.asarray(flow_rate) > 0):       # nothing to compare: every candidate gives 0
         raise InvalidParameterError("flow_rate" if pressure_drop is None else "pressure_drop", "(0, inf)",
                                     flow_rate if pressure_drop is None else pressure_drop,
                                     "advice compares the pressure drops of a flowing tube; this load gives no flow")
