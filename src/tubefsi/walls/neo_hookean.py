@@ -57,18 +57,23 @@ class _NeoHookeanLaw:
 
 def _reference_unit(strain):
     r""":math:`\lambda - \lambda^{-3}` at :math:`\lambda = 1 + \varepsilon`: as
-    :math:`(\lambda^4 - 1)/\lambda^3` from the strain at small strain, directly at large (no
-    overflow of :math:`\lambda^4` up to the largest double)."""
+    :math:`(\lambda^4 - 1)/\lambda^3` from the strain (no cancellation at small strain), directly
+    past :math:`\varepsilon = 10^{70}` (where :math:`\lambda^4` would overflow)."""
     e = np.asarray(strain, dtype=float)
     with np.errstate(over="ignore", invalid="ignore"):
         lam = 1.0 + e
         small = e * (4.0 + e * (6.0 + e * (4.0 + e))) / lam**3
-        return np.where(e > 1.0, lam - lam**-3, small)
+        return np.where(e > 1e70, lam - lam**-3, small)
 
 
 def _current_unit(strain):
-    r""":math:`1 - \lambda^{-4}` at :math:`\lambda = 1 + \varepsilon`, as :math:`-\mathrm{expm1}(-4\,\mathrm{log1p}\,\varepsilon)`."""
-    return -np.expm1(-4.0 * np.log1p(np.asarray(strain, dtype=float)))
+    r""":math:`1 - \lambda^{-4}` at :math:`\lambda = 1 + \varepsilon`, as :math:`(\lambda^4 - 1)/\lambda^4`
+    (directly past :math:`\varepsilon = 10^{70}`)."""
+    e = np.asarray(strain, dtype=float)
+    with np.errstate(over="ignore", invalid="ignore"):
+        lam = 1.0 + e
+        small = e * (4.0 + e * (6.0 + e * (4.0 + e))) / lam**4
+        return np.where(e > 1e70, 1.0 - lam**-4, small)
 
 
 class _ThinForms(_NeoHookeanLaw):
@@ -125,8 +130,10 @@ class _ThickForms(_NeoHookeanLaw):
         d = tb * (2.0 + tb)
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             x = e * (2.0 + e)                                  # lam^2 - 1 (inf past 1e154: fine below)
-            ratio = np.where(x > 1.0, 1.0 / (1.0 + b / x), x / (b + x))
-        return 0.5 * self._installed_modulus() * (np.log1p(ratio * d) + ratio * d / (1.0 + x))
+            huge = x > 1e150
+            ratio = np.where(huge, 1.0 / (1.0 + b / x), x / (b + x))
+            last = np.where(huge, ratio * d / (1.0 + x), x * d / ((1.0 + x) * (b + x)))
+        return 0.5 * self._installed_modulus() * (np.log1p(ratio * d) + last)
 
     def _stiffness(self, stretch, tb):
         lam2 = stretch * stretch
