@@ -16,7 +16,7 @@ LATEST := .venv-latest
 UV_VERSION := 0.13.9
 LOCK_FLAGS ?= --upgrade
 
-.PHONY: demo test docs install test-latest lock clean
+.PHONY: demo test fuzz docs install test-latest lock clean
 
 $(STAMP): $(LOCK) pyproject.toml $(PLUGINS)
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -32,6 +32,13 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	MPLBACKEND=Agg $(PY) -m pytest -q -p no:cacheprovider
+
+# the long fuzz campaign (docs/verification.md, "Fuzzing"): every bad-input probe of every
+# registered model and entry point and FUZZ_SCENES random valid scenes; prints the counts per
+# category and entry point and the wall time, exits nonzero on any breach
+FUZZ_SCENES ?= 300
+fuzz: $(STAMP)
+	MPLBACKEND=Agg $(PY) -m tubefsi.testing.fuzz --scenes $(FUZZ_SCENES)
 
 # the documentation site (warnings are errors); figures are regenerated first
 docs: $(STAMP)

@@ -31,7 +31,8 @@ def expm1_ratio(k, x):
     """
     x = np.asarray(x, dtype=float)
     if np.ndim(k) == 0:
-        return x * 1.0 if k == 0.0 else np.expm1(k * x) / k
+        with np.errstate(over="ignore"):    # beyond double range: inf, refused by the callers' checks
+            return x * 1.0 if k == 0.0 else np.expm1(k * x) / k
     k = np.asarray(k, dtype=float)
     zero = k == 0.0
     with np.errstate(invalid="ignore", divide="ignore"):

@@ -14,13 +14,29 @@ from ._units import to_si
 from .errors import InvalidParameterError
 
 
+def real_array(name, value, admissible):
+    """``value`` as a float array: a real number or an array of them. Booleans, strings, complex
+    numbers, ``None`` and other objects raise :class:`InvalidParameterError` (NumPy would turn
+    ``"1"`` into 1.0, ``True`` into 1.0 and drop an imaginary part). A pint Quantity is converted
+    to its SI magnitude first."""
+    value = to_si(name, value)
+    if isinstance(value, (bool, np.bool_, str, bytes)) or value is None:
+        raise InvalidParameterError(name, admissible, value, "give a real number (SI units) or an array of them")
+    if type(value) is float or type(value) is int:
+        return np.asarray(float(value))
+    try:
+        a = np.asarray(value)
+    except Exception:
+        raise InvalidParameterError(name, admissible, value) from None
+    if a.dtype.kind not in "iuf":
+        raise InvalidParameterError(name, admissible, value if a.ndim == 0 else f"an array of {a.dtype}",
+                                    "give a real number (SI units) or an array of them")
+    return a.astype(float, copy=False)
+
+
 def as_load(name, value, *, allow_zero=True):
     """Convert a flow rate / pressure to a float array; reject negative, NaN, inf."""
-    value = to_si(name, value)
-    try:
-        a = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise InvalidParameterError(name, "[0, inf)", value) from None
+    a = real_array(name, value, "[0, inf)")
     bad = ~np.isfinite(a) | (a < 0) | ((a == 0) if not allow_zero else False)
     if np.any(bad):
         first = a[bad].flat[0] if a.ndim else a.item()
@@ -32,11 +48,7 @@ def as_load(name, value, *, allow_zero=True):
 
 def as_array(name, value, admissible, predicate):
     """Convert to a float array and check ``predicate`` elementwise."""
-    value = to_si(name, value)
-    try:
-        a = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise InvalidParameterError(name, admissible, value) from None
+    a = real_array(name, value, admissible)
     with np.errstate(invalid="ignore"):
         ok = np.isfinite(a) & predicate(a)
     if not np.all(ok):
@@ -47,10 +59,10 @@ def as_array(name, value, admissible, predicate):
 
 def positive_scalar(name, value) -> float:
     """A finite float ``> 0``."""
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InvalidParameterError(name, "(0, inf)", value) from None
+    a = real_array(name, value, "(0, inf)")
+    if a.ndim:
+        raise InvalidParameterError(name, "(0, inf)", value, "a single number")
+    v = float(a)
     if not (math.isfinite(v) and v > 0):
         raise InvalidParameterError(name, "(0, inf)", v)
     return v
@@ -58,10 +70,7 @@ def positive_scalar(name, value) -> float:
 
 def nonnegative_array(name, value):
     """A float array of finite entries ``>= 0``."""
-    try:
-        a = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise InvalidParameterError(name, "[0, inf)", value) from None
+    a = real_array(name, value, "[0, inf)")
     if not np.all(np.isfinite(a) & (a >= 0)):
         raise InvalidParameterError(name, "[0, inf)", a[~(np.isfinite(a) & (a >= 0))].flat[0]
                                     if a.ndim else a.item())

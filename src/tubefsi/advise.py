@@ -184,7 +184,7 @@ def advise(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, toleranc
     rheology, wall = scene.rheology, scene.wall
     if (flow_rate is None) == (pressure_drop is None):
         raise InvalidParameterError("flow_rate / pressure_drop", "exactly one of the two", None)
-    if not (isinstance(tolerance, (int, float)) and math.isfinite(tolerance) and tolerance >= 0):
+    if not (isinstance(tolerance, (int, float)) and not isinstance(tolerance, bool) and math.isfinite(tolerance) and tolerance >= 0):
         raise InvalidParameterError("tolerance", "[0, inf)", tolerance)
     if scene.shape != ():
         raise InvalidParameterError("rheology / wall / tube", "scalar parameters (advise compares one scene)",
@@ -194,6 +194,10 @@ def advise(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, toleranc
         flow_rate = own.flow_rate
     else:  # the requested model must solve: its errors are the caller's, not a candidate's
         own = solve(rheology, wall, tube, flow_rate=flow_rate, outlet_pressure=outlet_pressure)
+    if not np.any(np.asarray(flow_rate) > 0):       # nothing to compare: every candidate gives 0
+        raise InvalidParameterError("flow_rate" if pressure_drop is None else "pressure_drop", "(0, inf)",
+                                    flow_rate if pressure_drop is None else pressure_drop,
+                                    "advice compares the pressure drops of a flowing tube; this load gives no flow")
     load = ("flow_rate", flow_rate)
     results = []
     reference = None

@@ -604,6 +604,9 @@ def main(argv=None) -> int:
         return _error(exc.args[0] if exc.args else exc)
     except BrokenPipeError:  # `tubefsi list | head`
         return 0
+    except OSError as exc:  # an output path that cannot be written: the user's to fix, not a bug
+        where = f" {exc.filename}" if getattr(exc, "filename", None) else ""
+        return _error(f"cannot write{where}: {exc.strerror or exc}")
     except Exception as exc:  # a bug of ours: still one line, but say what it was
         return _error(f"internal error ({type(exc).__name__}: {exc}); please report it")
 

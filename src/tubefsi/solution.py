@@ -261,7 +261,7 @@ class Solution:
 
     def velocity(self, r, z):
         """Axial velocity v(r, z) (m/s) at radial position ``r`` in [0, R(z)] (m)."""
-        r_arr = np.asarray(r, dtype=float)
+        r_arr = as_array("r", r, "[0, R(z)] (m)", lambda a: a >= 0)
         strain, _, q = self._profile(z)
         big_r = self.tube.radius * (1.0 + strain)
         g = self.rheology.pressure_gradient(q, big_r)

@@ -141,7 +141,11 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
     runner = checked(chosen)            # a self-checking coupler is re-solved finer (AccuracyWarning)
     controlled = "flow_rate" if flow_rate is not None else "pressure_drop"
     load = as_load(controlled, flow_rate if flow_rate is not None else pressure_drop)
-    shape = np.broadcast_shapes(scene.shape, load.shape)
+    try:
+        shape = np.broadcast_shapes(scene.shape, load.shape)
+    except ValueError:
+        raise InvalidParameterError(controlled, f"arrays that broadcast with the parameters' shape {scene.shape}",
+                                    load, f"shape {load.shape}") from None
     if rho is not None and np.broadcast_shapes(shape, rho.shape) != shape:
         raise InvalidParameterError("density", f"an array that broadcasts to the result's shape {shape}", rho)
     flat = scene.flat(shape)
@@ -161,6 +165,8 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
                 # solve first, and look for the limit (a quadrature to infinity) only if one did
                 try:
                     state = method(chunk, values[idx])
+                except OverflowError:         # a scene beyond double precision: a typed error
+                    raise _beyond_range(controlled, values[idx], "an intermediate quantity overflows") from None
                 except (NoSteadyStateError, StretchRangeError) as error:   # the limit decides which
                     if _feasible(runner, chunk, values[idx], controlled, raise_=on_infeasible == "raise") is None:
                         raise error
@@ -177,11 +183,18 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
                 shown.update(idx.size)
                 continue
             sub = chunk if go.size == idx.size else (chunk.take(go) if chunk.size > 1 else chunk)
-            state = method(sub, values[idx][go])
+            try:
+                state = method(sub, values[idx][go])
+            except OverflowError:             # a scene beyond double precision: a typed error
+                raise _beyond_range(controlled, values[idx][go], "an intermediate quantity overflows") from None
             for name in out:
                 out[name][idx[go]] = np.broadcast_to(np.asarray(getattr(state, name), dtype=float), go.shape)
             shown.update(idx.size)
     shown.close()
+    finite = np.isfinite(out["pressure_drop"]) & np.isfinite(out["flow_rate"]) & np.isfinite(out["inlet_strain"])
+    if not np.all(finite | ~feasible):
+        i = int(np.argmax(~finite & feasible))
+        raise _beyond_range(controlled, values[i:i + 1], "the result is not a finite double")
     if density is not None:
         density = float(rho) if rho.ndim == 0 else np.broadcast_to(rho, shape).ravel()
     warn(check(flat, out["flow_rate"], out["inlet_strain"], density=density))
@@ -190,6 +203,14 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
                     coupler_name=registry.couplers.name_of(chosen) or type(chosen).__name__,
                     feasible=None if np.all(feasible) else feasible.reshape(shape), density=density,
                     controlled=controlled)
+
+
+def _beyond_range(controlled, values, why):
+    """The typed error of a load (with its scene) whose solution leaves double precision."""
+    return InvalidParameterError(controlled, "loads whose solution is within double precision",
+                                 float(np.ravel(values)[0]) if np.size(values) else None,
+                                 f"{why} (outlet pressure and load must keep every pressure, stretch and "
+                                 "flow rate below 1.8e308)")
 
 
 _SUBCLASS: dict = {}

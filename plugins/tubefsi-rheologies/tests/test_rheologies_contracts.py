@@ -10,6 +10,7 @@ import tubefsi
 from tubefsi import registry
 from tubefsi.couplers import Quadrature
 from tubefsi.testing import AccuracyContract, CouplerContract, RheologyContract, examples
+from tubefsi.testing.fuzz import FuzzContract
 
 NAMES = ["carreau", "carreau-yasuda", "cross", "ellis", "bingham", "casson", "herschel-bulkley"]
 FLUIDS = [fluid for name in NAMES for fluid in examples("rheologies", name)]
@@ -91,3 +92,10 @@ def test_whole_curve_is_one_vectorized_call():
     for i in (1, 700, 1999):
         single = tubefsi.solve(fluid, wall, tube, flow_rate=float(q[i])).pressure_drop
         assert single == pytest.approx(curve.pressure_drop[i], rel=1e-12)
+
+
+class TestFuzz(FuzzContract):                  # typed errors or checked finite values, in bounded time
+    rheologies = tuple(NAMES)
+    walls = ()
+    couplers = ()
+    scenes = 8

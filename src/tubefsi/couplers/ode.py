@@ -33,6 +33,7 @@ from scipy import integrate, optimize
 
 from ..errors import ConvergenceError, InvalidParameterError, NoSteadyStateError
 from ..scene import State
+from ._options import flag, tolerance
 from .base import Coupler
 from .quadrature import Quadrature
 
@@ -59,12 +60,13 @@ class ODE(Coupler):
     """Integrate dp/dz = -G(q, R(p)) with SciPy (reference path, one ODE per point)."""
 
     method: str = attrs.field(default="LSODA", validator=_check_method)
-    rtol: float | None = attrs.field(default=None)
-    atol: float | None = attrs.field(default=None)
+    rtol: float | None = tolerance(0.0, 0.1, default=None, optional=True, doc="relative tolerance (None: the default)")
+    atol: float | None = tolerance(0.0, 1e300, default=None, optional=True,
+                                   doc="absolute tolerance (None: the default)")
     #: Re-integrate at 1/100 of the tolerances and warn (AccuracyWarning) where the two
     #: results differ by more than ten times the tolerance: the global error of a
     #: local-error-controlled integrator can exceed its tolerance, e.g. near a limit.
-    check_error: bool = attrs.field(default=True, converter=bool)
+    check_error: bool = flag(default=True, doc="re-integrate at 1/100 of the tolerances and compare")
 
     cost_rank: ClassVar[int] = 1000
     meets_accuracy_contract: ClassVar[bool] = False

@@ -14,6 +14,8 @@ from typing import ClassVar, final
 import attrs
 import numpy as np
 
+from ..fields import real
+from ._options import flag, integer, tolerance
 from .separated import SeparatedVariables
 
 __all__ = ["Quadrature"]
@@ -31,10 +33,11 @@ class Quadrature(SeparatedVariables):
     compares it with the adaptive rule and warns (``AccuracyWarning``) above 1e-8.
     """
 
-    order: int | None = attrs.field(default=None, converter=attrs.converters.optional(int))
-    panel_width: float = attrs.field(default=2.0, converter=float)
-    rtol: float = attrs.field(default=1e-14, converter=float)
-    check_error: bool = attrs.field(default=True, converter=bool)
+    order: int | None = integer(1, 200, default=None, optional=True, doc="fixed Gauss-Legendre order, or None")
+    panel_width: float = real(low=0.01, high=100.0, low_open=False, high_open=False, default=2.0,
+                              doc="panel width of a fixed rule (log-stretch)")
+    rtol: float = tolerance(1e-15, 0.1, default=1e-14, doc="relative tolerance of the adaptive rule")
+    check_error: bool = flag(default=True, doc="check a fixed rule against the adaptive one")
 
     cost_rank: ClassVar[int] = 10
 

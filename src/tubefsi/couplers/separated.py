@@ -43,7 +43,7 @@ from scipy.optimize import elementwise
 
 from .._numerics import EPS, integrate_graded, solve_increasing
 from .._quadrature import adaptive_to_pole, quiet, warn_unconverged
-from ..errors import NoSteadyStateError, StretchRangeError
+from ..errors import ConvergenceError, InvalidParameterError, NoSteadyStateError, StretchRangeError
 from ..scene import Points, Scene, State
 from ._tables import SeparatedTable, fit_chebyshev
 from .base import Coupler
@@ -57,6 +57,21 @@ _PROBE_LOG_STRETCH = math.log(1e8)
 #: A runaway solve within this relative distance of the maximum flow rate is at the limit (to
 #: the accuracy of q_max): NoSteadyStateError, not StretchRangeError.
 _AT_THE_LIMIT = 1e-11
+
+
+def _at_rest(pts, state, z, strain, rise):
+    r"""A fluid at rest below its yield stress (``q = 0`` under a pressure drop) carries any gradient
+    below the yield gradient: the profile is taken linear, :math:`p = p_{out} + \Delta p\,(1 - z/L)`,
+    with the tube law's strain, so that it starts at the inlet pressure."""
+    dp = np.asarray(state.pressure_drop, dtype=float)
+    rest = (np.asarray(state.flow_rate) == 0) & (dp > 0)
+    if not np.any(rest):
+        return strain, rise
+    rise = np.where(rest, dp * (1.0 - z / pts.length), rise)
+    if not pts.wall.is_rigid:
+        p = np.asarray(pts.outlet_pressure) + rise + 0.0 * dp
+        strain = np.where(rest, pts.wall._strain(p, pts.tb), strain)
+    return strain, rise
 
 
 def _pick(value, index):
@@ -496,7 +511,8 @@ class SeparatedVariables(Coupler):
         def f(log_q, v, i, log_l):
             return np.log(self._J(scene, v, i, np.exp(log_q))) - log_l
 
-        hi = np.log(q_hi) * (1 + 1e-15) + 1e-15
+        hi = np.log(q_hi)
+        hi = hi + 1e-15 * np.abs(hi) + 1e-15        # above q_hi whatever the sign of ln q_hi
         with np.errstate(divide="ignore"):
             lo = np.log(q_lo)
         lo = lo - 1e-12 * np.abs(lo)
@@ -525,7 +541,7 @@ class SeparatedVariables(Coupler):
         L = pts.length
         if scene.wall.is_rigid:
             gradient = np.where(q == 0, 0.0, pts.rheology._pressure_gradient(q, pts.radius))
-            return np.zeros(q.shape) + pts.outlet_strain, (L - z) * gradient
+            return _at_rest(pts, state, z, np.zeros(q.shape) + pts.outlet_strain, (L - z) * gradient)
         frac = (L - z) / L
         target = np.where(q == 0, 0.0, frac * self.target(pts, q))
         v = np.where(frac == 1.0, v_in, 0.0)
@@ -551,7 +567,7 @@ class SeparatedVariables(Coupler):
         if np.any(rest):                     # the inlet itself and zero flow
             sub = np.flatnonzero(rest)
             rise[sub] = self.pressure_rise(scene, v[sub], sub)
-        return self.strain_at(pts, v) + 0.0 * v, rise
+        return _at_rest(pts, state, z, self.strain_at(pts, v) + 0.0 * v, rise)
 
     def length_integral(self, scene: Scene, state: State, weight, *, uniform=False):
         r""":math:`\int_0^L w(q, R(z))\,dz`: :math:`L\,w` where ``w`` does not depend on R (or the wall
@@ -633,16 +649,30 @@ class SeparatedVariables(Coupler):
 
         a = float(np.asarray(pts.radius).ravel()[0])
         g0 = max(float(np.asarray(pts.wall._limit_pressure(pts.tb)).ravel()[0]) / L, 4.0 * tau_y / a)
-        log_q = math.log(float(pts.rheology._flow_rate(np.asarray([a]), np.asarray([g0]))[0]))
+        with np.errstate(all="ignore"):       # a start within the fluid's representable flow
+            for _ in range(40):
+                q0 = float(pts.rheology._flow_rate(np.asarray([a]), np.asarray([g0]))[0])
+                if math.isfinite(q0) and q0 > 0 or g0 <= 4.0 * tau_y / a:
+                    break
+                g0 = max(1e-10 * g0, 4.0 * tau_y / a)
+        if not (math.isfinite(q0) and q0 > 0):
+            raise ConvergenceError(f"the maximum flow rate search finds no finite flow rate of {scene.rheology!r} "
+                                   f"below the limit pressure gradient {g0:.6g} Pa/m")
+        log_q = math.log(q0)
         if not math.isfinite(excess(log_q)):
             return math.inf  # G(q, R) falls off too fast in R: every flow rate has a steady state
         lo, hi = log_q, log_q
-        while excess(lo) < 0:
+        while excess(lo) < 0:              # steps of e^2: the doubles' range is crossed in ~700
             lo -= 2.0
-        while excess(hi) > 0:
-            hi += 2.0
-            if hi - log_q > 200:
-                return math.inf
+            if log_q - lo > 1500:
+                raise ConvergenceError(f"the maximum flow rate search of {scene.rheology!r} does not bracket it")
+        try:
+            while excess(hi) > 0:
+                hi += 2.0
+                if hi - log_q > 200:
+                    return math.inf
+        except InvalidParameterError:      # beyond the flow the fluid's law represents: none bigger
+            return math.inf
         return math.exp(optimize.brentq(excess, lo, hi, xtol=1e-15, rtol=4 * np.finfo(float).eps))
 
     def _raise_runaway(self, scene, q, ok, index=None):

@@ -117,13 +117,17 @@ class Rheology(abc.ABC):
         under pressure gradient :math:`G = -dp/dz` (Pa/m)."""
         r = as_array("radius", radius, "(0, inf)", lambda a: a > 0)
         g = as_array("pressure_gradient", pressure_gradient, "[0, inf)", lambda a: a >= 0)
-        return self._evaluate(lambda m, r, g: _masked(m, "_flow_rate", g > 0, r, g), r, g)
+        out = self._evaluate(lambda m, r, g: _masked(m, "_flow_rate", g > 0, r, g), r, g)
+        _finite_result("pressure_gradient", g, "flow rate", out)
+        return out
 
     def pressure_gradient(self, flow_rate, radius):
         r"""Pressure gradient :math:`G(q, R) = -dp/dz` (Pa/m) that drives ``flow_rate`` (m^3/s)."""
         q = as_array("flow_rate", flow_rate, "[0, inf)", lambda a: a >= 0)
         r = as_array("radius", radius, "(0, inf)", lambda a: a > 0)
-        return self._evaluate(lambda m, q, r: _masked(m, "_pressure_gradient", q > 0, q, r), q, r)
+        out = self._evaluate(lambda m, q, r: _masked(m, "_pressure_gradient", q > 0, q, r), q, r)
+        _finite_result("flow_rate", q, "pressure gradient", out)
+        return out
 
     def velocity(self, r, radius, pressure_gradient):
         r"""Axial velocity (m/s) at radial position ``r`` (0 <= r <= radius)."""
@@ -144,7 +148,7 @@ class Rheology(abc.ABC):
         tau_y = float(self.yield_stress)
         scale = float(np.asarray(self._shear_rate(np.asarray([tau_y + 1.0]))).ravel()[0])
         guess = tau_y + (g / scale if scale > 0 else g)        # the Newtonian law through tau_y + 1
-        return _solve_increasing(self._shear_rate, g, guess, 0.0, lower=tau_y)
+        return _solve_increasing(self._shear_rate, g, guess, 0.0, lower=tau_y, name="shear_rate")
 
     def _shear_rate(self, stress):
         if not _overrides(self, "_stress"):
@@ -333,11 +337,21 @@ def _masked(model, hook, mask, *args):
     return out
 
 
+def _finite_result(name, value, what, result):
+    """Raise :class:`InvalidParameterError` naming ``name`` where ``result`` is not a finite double."""
+    ok = np.isfinite(result)
+    if not np.all(ok):
+        i = int(np.argmax(~np.ravel(ok)))
+        raise InvalidParameterError(name, f"values whose {what} is a finite double",
+                                    float(np.broadcast_to(value, np.shape(result)).ravel()[i]),
+                                    f"the {what} would be {np.ravel(result)[i]!r}")
+
+
 def _positive(x):
     return np.maximum(x, np.finfo(float).tiny)
 
 
-def _solve_increasing(law, target, guess, floor, lower=0.0):
+def _solve_increasing(law, target, guess, floor, lower=0.0, name="stress"):
     r"""``x > lower`` with ``law(x) = target`` elementwise, for an increasing law with
     ``law(lower+) = floor < target``: a bracket by steps doubling in :math:`\ln(x - lower)` from
     ``guess``, geometric bisection down to a ratio of 2, then Illinois (regula falsi) steps to a
@@ -382,6 +396,13 @@ def _solve_increasing(law, target, guess, floor, lower=0.0):
             lo[down[below]], flo[down[below]] = x[below], v[below]
             hi[down[~below]], fhi[down[~below]] = x[~below], v[~below]
             d[down[~below & (x <= tiny)]] = tiny
+    top = np.flatnonzero(hi >= big)
+    if top.size:             # the root lies past the largest double the law is evaluated at?
+        beyond = f(np.full(top.size, big), top) < 0
+        if np.any(beyond):
+            at_big = float(np.asarray(law(lower + big), dtype=float).ravel()[0])
+            raise InvalidParameterError(name, f"[0, {at_big:.6g}] (the law's value at {big:g})",
+                                        float(t[top[np.argmax(beyond)]]), "beyond the range of double precision")
     side = np.zeros(n, dtype=int)             # the end kept last time: -1 low, +1 high (Illinois)
     for _ in range(200):
         live = np.flatnonzero((hi - lo > 4.0 * np.finfo(float).eps * hi) & (flo < 0) & (fhi > 0))

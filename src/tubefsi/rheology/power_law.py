@@ -12,10 +12,28 @@ import math
 import attrs
 import numpy as np
 
+from ..errors import InvalidParameterError
 from ..fields import positive
 from .base import Rheology
 
 __all__ = ["PowerLaw"]
+
+
+_TINY = float(np.finfo(float).tiny)
+_HUGE = 1.0 / _TINY
+
+
+def _representable(value, load, name, what):
+    """Raise unless ``value`` (a factor of G) is a normal double wherever ``load > 0``: a factor that
+    underflows or overflows would make the pressure drop 0, NaN or inf (``docs/verification.md``,
+    "Fuzzing")."""
+    with np.errstate(invalid="ignore"):
+        bad = (np.asarray(load) > 0) & ~((np.asarray(value) >= _TINY) & (np.asarray(value) < math.inf))
+    if np.any(bad):
+        q = float(np.ravel(np.broadcast_to(load, np.shape(bad)))[np.argmax(np.ravel(bad))])
+        raise InvalidParameterError(name, f"values for which {what} is within double precision "
+                                    f"[{_TINY:.3g}, {_HUGE:.3g}]", q, "the pressure gradient would underflow "
+                                    "or overflow")
 
 
 class _PowerLawForms(Rheology):
@@ -32,14 +50,30 @@ class _PowerLawForms(Rheology):
 
     def _flow_factor(self, flow_rate):
         n = self.index
-        return 2.0 * self.consistency * ((3.0 * n + 1.0) * flow_rate / (math.pi * n)) ** n
+        try:
+            out = 2.0 * self.consistency * ((3.0 * n + 1.0) * flow_rate / (math.pi * n)) ** n
+        except OverflowError:
+            out = math.inf
+        _representable(out, flow_rate, "flow_rate", f"2 m [(3n+1) q / (pi n)]^n, n = {n!r}")
+        return out
 
     def _flow_factor_inverse(self, factor):
         n = self.index
         return math.pi * n / (3.0 * n + 1.0) * (factor / (2.0 * self.consistency)) ** (1.0 / n)
 
     def _radius_factor(self, radius):
-        return radius ** -(3.0 * self.index + 1.0)
+        try:
+            out = radius ** -(3.0 * self.index + 1.0)
+        except OverflowError:
+            out = math.inf
+        with np.errstate(invalid="ignore"):
+            big = out > _HUGE                    # its reciprocal (the engine divides by it) underflows
+        if np.any(big):
+            r = float(np.ravel(np.broadcast_to(radius, np.shape(out)))[np.argmax(np.ravel(big))])
+            raise InvalidParameterError(
+                "index", f"(0, {(-math.log(_TINY) / abs(math.log(r)) - 1.0) / 3.0:.6g}) at radius {r:g} m",
+                self.index, "R^-(3n+1) leaves the range of double precision")
+        return out
 
     @property
     def radius_exponent(self) -> float:

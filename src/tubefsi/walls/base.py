@@ -29,7 +29,7 @@ from scipy.optimize import elementwise
 
 from .._numerics import solve_signed
 from .._quadrature import quiet
-from .._validation import as_array
+from .._validation import as_array, real_array
 from ..fields import evaluate, flat_points, model_at, take
 from ..errors import BucklingError, ConvergenceError, InvalidParameterError, NoSteadyStateError
 
@@ -108,7 +108,7 @@ class WallModel(abc.ABC):
         def fn(wall, lam, tb):
             return wall._pressure_at_strain(wall._check_stretch(lam, tb) - 1.0, tb)
 
-        return evaluate(self, fn, _as_floats("stretch", stretch), tb)
+        return _finite("stretch", stretch, "pressure", evaluate(self, fn, _as_floats("stretch", stretch), tb))
 
     def stretch(self, pressure, reduced_thickness):
         r"""Hoop stretch :math:`\lambda = R/a` under transmural pressure ``pressure`` (Pa)."""
@@ -128,7 +128,7 @@ class WallModel(abc.ABC):
         def fn(wall, p, tb):
             return wall._strain(wall._check_pressure(p, tb), tb)
 
-        return evaluate(self, fn, _as_floats("pressure", pressure), tb)
+        return _finite("pressure", pressure, "strain", evaluate(self, fn, _as_floats("pressure", pressure), tb))
 
     def stiffness(self, stretch, reduced_thickness):
         r"""Tube-law slope :math:`dP/d\lambda` (Pa)."""
@@ -338,7 +338,12 @@ class WallModel(abc.ABC):
             with quiet():
                 top = float(model_at(wall, index[bad:bad + 1])._pressure_at_strain(
                     xmax[bad:bad + 1] * 0.999999, take(tb, index[bad:bad + 1]))[0])
-            limit = min(top, float(np.broadcast_to(wall._limit_pressure(tb), p.shape)[bad]))
+            limit = float(np.broadcast_to(wall._limit_pressure(tb), p.shape)[bad])
+            if top < limit:     # not a physical limit: the stretch cannot be told from its lock
+                raise InvalidParameterError(
+                    "pressure", f"[0, {top:.10g}] Pa", float(p[bad]),
+                    f"beyond it the stretch is the largest the wall admits, {float(np.ravel(lam_max)[bad]):.10g}, to "
+                    "double precision" if finite[bad] else "beyond it the strain exceeds 1e15")
             raise NoSteadyStateError("pressure", limit, float(p[bad]), "the tube law never reaches it")
         with quiet():
             res = elementwise.find_root(f, bracket.bracket, args=(p, index),
@@ -420,7 +425,7 @@ class WallModel(abc.ABC):
                                                np.asarray(self._min_pressure(tb) if np.any(p < 0) else 0.0,
                                                           dtype=float))
         with np.errstate(invalid="ignore"):
-            bad = np.isnan(values) | ((values < 0) & (low == 0))   # a wall that only inflates
+            bad = np.isnan(values) | (values == math.inf) | ((values < 0) & (low == 0))   # a wall that only inflates
             below = (values < low) & (low < 0)
             beyond = values >= lim
         if np.any(bad):
@@ -438,17 +443,32 @@ class WallModel(abc.ABC):
         return p
 
 
+#: The admissible reduced thickness t/a: every tube law is evaluated in double precision there
+#: (``(1 + t/a)^2`` and ``t/a`` times a modulus stay far inside its range).
+THICKNESS_RANGE = (1e-100, 1e100)
+
+
+def _finite(name, value, result_name, result):
+    """``result`` if every entry is finite, else an :class:`InvalidParameterError` naming the
+    argument whose value takes the result beyond double precision (or gives it no value)."""
+    r = np.asarray(result)
+    if np.all(np.isfinite(r)):
+        return result
+    bad = int(np.argmax(~np.isfinite(r).ravel()))
+    v = np.broadcast_to(np.asarray(value, dtype=float), r.shape).ravel()[bad]
+    raise InvalidParameterError(name, f"values whose {result_name} is a finite double", float(v),
+                                f"the {result_name} would be {r.ravel()[bad]!r}")
+
+
 def _check_thickness(reduced_thickness):
-    """The reduced thickness t/a: finite and > 0 (a float or an array)."""
-    return as_array("reduced_thickness", reduced_thickness, "(0, inf)", lambda a: a > 0)
+    """The reduced thickness t/a, in :data:`THICKNESS_RANGE` (a float or an array)."""
+    low, high = THICKNESS_RANGE
+    return as_array("reduced_thickness", reduced_thickness, f"[{low:g}, {high:g}]", lambda a: (a >= low) & (a <= high))
 
 
 def _as_floats(name, value):
     """A float array of ``value``; the range is checked by the caller (it depends on the wall)."""
-    try:
-        a = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise InvalidParameterError(name, "the real numbers", value) from None
+    a = real_array(name, value, "the real numbers")
     if not np.all(np.isfinite(a) | (a == np.inf)):
         raise InvalidParameterError(name, "the real numbers", float(a[np.isnan(a)].flat[0]) if a.ndim else float(a))
     return a

@@ -55,18 +55,36 @@ class _NeoHookeanLaw:
         return self._installed_modulus() * (s * s + 1.0) / s**3
 
 
+def _reference_unit(strain):
+    r""":math:`\lambda - \lambda^{-3}` at :math:`\lambda = 1 + \varepsilon`: as
+    :math:`(\lambda^4 - 1)/\lambda^3` from the strain (no cancellation at small strain), directly
+    past :math:`\varepsilon = 10^{70}` (where :math:`\lambda^4` would overflow)."""
+    e = np.asarray(strain, dtype=float)
+    with np.errstate(over="ignore", invalid="ignore"):
+        lam = 1.0 + e
+        small = e * (4.0 + e * (6.0 + e * (4.0 + e))) / lam**3
+        return np.where(e > 1e70, lam - lam**-3, small)
+
+
+def _current_unit(strain):
+    r""":math:`1 - \lambda^{-4}` at :math:`\lambda = 1 + \varepsilon`, as :math:`(\lambda^4 - 1)/\lambda^4`
+    (directly past :math:`\varepsilon = 10^{70}`)."""
+    e = np.asarray(strain, dtype=float)
+    with np.errstate(over="ignore", invalid="ignore"):
+        lam = 1.0 + e
+        small = e * (4.0 + e * (6.0 + e * (4.0 + e))) / lam**4
+        return np.where(e > 1e70, 1.0 - lam**-4, small)
+
+
 class _ThinForms(_NeoHookeanLaw):
     __slots__ = ()
 
     closed_form_integral = True
 
     def _pressure_at_strain(self, strain, tb):
-        e = np.asarray(strain, dtype=float)
-        lam = 1.0 + e
-        quartic = e * (4.0 + e * (6.0 + e * (4.0 + e)))          # lam^4 - 1
         if self.thickness_convention == "reference":
-            return self._installed_modulus() * tb * quartic / lam**3
-        return self._installed_modulus() * tb * quartic / lam**4
+            return self._installed_modulus() * tb * _reference_unit(strain)
+        return self._installed_modulus() * tb * _current_unit(strain)
 
     def _stiffness(self, stretch, tb):
         if self.thickness_convention == "reference":
@@ -78,7 +96,7 @@ class _ThinForms(_NeoHookeanLaw):
         if self.thickness_convention == "current":
             return np.expm1(-0.25 * np.log1p(-k))
         e, _ = solve_signed(
-            lambda e, i: e * (4.0 + e * (6.0 + e * (4.0 + e))) / (1.0 + e) ** 3,
+            lambda e, i: _reference_unit(e),
             lambda e, i: 1.0 + 3.0 * (1.0 + e) ** -4,
             k, guess=np.where(k < 1.0, 0.25 * k, k), lower=-1.0)
         return e
@@ -110,8 +128,12 @@ class _ThickForms(_NeoHookeanLaw):
         e = np.asarray(strain, dtype=float)
         b = (1.0 + tb) ** 2
         d = tb * (2.0 + tb)
-        x = e * (2.0 + e)
-        return 0.5 * self._installed_modulus() * (np.log1p(x * d / (b + x)) + x * d / ((1.0 + x) * (b + x)))
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            x = e * (2.0 + e)                                  # lam^2 - 1 (inf past 1e154: fine below)
+            huge = x > 1e150
+            ratio = np.where(huge, 1.0 / (1.0 + b / x), x / (b + x))
+            last = np.where(huge, ratio * d / (1.0 + x), x * d / ((1.0 + x) * (b + x)))
+        return 0.5 * self._installed_modulus() * (np.log1p(ratio * d) + last)
 
     def _stiffness(self, stretch, tb):
         lam2 = stretch * stretch

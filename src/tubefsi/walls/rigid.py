@@ -38,5 +38,6 @@ class Rigid(WallModel):
 
     def pressure(self, stretch, reduced_thickness):
         """Not a function: any pressure keeps a rigid tube at ``stretch = 1``."""
+        self._check_thickness(reduced_thickness)
         raise InvalidParameterError("stretch", "{} (a rigid wall's pressure is not a function of stretch)",
                                     stretch)

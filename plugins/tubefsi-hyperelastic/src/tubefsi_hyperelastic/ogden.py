@@ -43,6 +43,18 @@ def _check_terms(instance, attribute, value):
         raise InvalidParameterError("exponents", "nonzero numbers", value)
 
 
+def _slope_terms(a, k, s):
+    r""":math:`(a - k)s^a + (a + k)s^{-a}`, the bracket of a term's slope (:math:`k = 1`: :math:`\hat W''`,
+    :math:`k = 2`: the thin current-thickness law). For :math:`|a| < k/2` as
+    :math:`2a[\cosh(au) - k\sinh(au)/a]`, :math:`u = \ln s`, whose two terms do not cancel there
+    (the direct form loses everything as :math:`a \to 0`); elsewhere directly (where the hyperbolic
+    form would cancel, :math:`a = k` at large stretch)."""
+    if abs(a) < 0.5 * k:
+        u = np.log(s)
+        return 2.0 * a * (np.cosh(a * u) - k * np.sinh(a * u) / a)
+    return (a - k) * s**a + (a + k) * s ** (-a)
+
+
 @attrs.frozen(kw_only=True)
 class Ogden(LimitPoint, HyperelasticWall):
     """Ogden material (abstract: pick a theory, :class:`ThinOgden` or :class:`ThickOgden`)."""
@@ -76,7 +88,7 @@ class Ogden(LimitPoint, HyperelasticWall):
         return sum(c * s ** (-a - 1.0) * np.expm1(2.0 * a * u) for c, a in self._terms())
 
     def _d2W(self, s):
-        return sum(c * ((a - 1.0) * s ** (a - 2.0) + (a + 1.0) * s ** (-a - 2.0)) for c, a in self._terms())
+        return sum(c * _slope_terms(a, 1.0, s) for c, a in self._terms()) / (s * s)
 
     def _thick_integrand(self, s):
         u = np.log(s)
@@ -117,7 +129,7 @@ class ThinOgden(ThinWall, Ogden):
             return tb * self._d2W(stretch)
         # d/dlam (dW/lam) = sum c [(a-2) s^(a-3) + (a+2) s^(-a-3)]: no cancellation at large stretch
         s = stretch
-        return tb * sum(c * ((a - 2.0) * s ** (a - 3.0) + (a + 2.0) * s ** (-a - 3.0)) for c, a in self._terms())
+        return tb * sum(c * _slope_terms(a, 2.0, s) for c, a in self._terms()) / s**3
 
 
 @attrs.frozen(kw_only=True)
