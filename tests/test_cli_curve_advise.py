@@ -24,7 +24,8 @@ def test_curve_csv_matches_solve(capsys):
     assert rows[0][0] == "pressure_drop (Pa)" and len(rows) == 8
     q = np.geomspace(1e-10, 1e-8, 7)
     expected = tubefsi.solve(FLUID, WALL, TUBE, flow_rate=q).pressure_drop
-    np.testing.assert_allclose([float(r[0]) for r in rows[1:]], expected, rtol=1e-15)
+    # the first call may solve directly and the next one from the table it paid for (1e-13 apart)
+    np.testing.assert_allclose([float(r[0]) for r in rows[1:]], expected, rtol=1e-13)
 
 
 def test_curve_json_and_plot(tmp_path, capsys):
@@ -33,7 +34,7 @@ def test_curve_json_and_plot(tmp_path, capsys):
     data = json.loads(capsys.readouterr().out)
     assert data["coupler"] == "quadrature" and data["pressure_drop"] == [0.0, 125.0, 250.0, 375.0, 500.0]
     back = tubefsi.solve(FLUID, WALL, TUBE, pressure_drop=np.array(data["pressure_drop"]))
-    np.testing.assert_allclose(data["flow_rate"], back.flow_rate, rtol=1e-15)
+    np.testing.assert_allclose(data["flow_rate"], back.flow_rate, rtol=1e-13)
     assert plot.stat().st_size > 10_000
 
 

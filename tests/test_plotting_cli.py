@@ -365,4 +365,6 @@ def test_console_script():
     assert bad.stderr.startswith("tubefsi: error: no steady state")
     good = subprocess.run([exe, "solve", *SCENE_ARGS, "--flow-rate", "1e-9", "--json"], capture_output=True,
                           text=True, check=True)
-    assert json.loads(good.stdout)["pressure_drop"] == tubefsi.solve(FLUID, SOFT, TUBE, flow_rate=1e-9).pressure_drop
+    # a fresh process solves directly, this one may be served by a cached table (they agree to 1e-13)
+    assert json.loads(good.stdout)["pressure_drop"] == pytest.approx(
+        tubefsi.solve(FLUID, SOFT, TUBE, flow_rate=1e-9).pressure_drop, rel=1e-13)
