@@ -385,13 +385,15 @@ class SeparatedVariables(Coupler):
         if live.size == 0:
             return guess
         pts = scene.at(index[live], column=True)
+        ends = scene.at(index[live])                 # the same points, for the slope at v
         qq = None if q is None else q[live][:, None]
+        q_end = None if q is None else q[live]
         t, v, hi = target[live], guess[live].copy(), top[live] + np.zeros(live.size)
         with np.errstate(all="ignore"):
             for _ in range(4):
                 values = self.integrand(pts, v[:, None] * _START_NODES, qq)
                 estimate = v * (values @ _START_WEIGHTS)
-                slope = self.integrand(scene.at(index[live]), v, None if q is None else q[live])
+                slope = self.integrand(ends, v, q_end)
                 nxt = np.clip(v - np.log(estimate / t) * estimate / slope, 0.5 * v, np.minimum(2.0 * v, hi))
                 v = np.where(np.isfinite(nxt) & (nxt > 0), nxt, v)
         out = guess.copy()
