@@ -13,7 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tubefsi._quadrature import (GAUSS_WEIGHTS, KRONROD_NODES, KRONROD_WEIGHTS, adaptive, adaptive_to_pole,
-                                 quiet, warn_unconverged)
+                                 quiet, recording, warn_unconverged)
 from tubefsi.errors import AccuracyWarning
 
 
@@ -91,9 +91,36 @@ def test_noise_is_reported_not_hidden():
         with warnings.catch_warnings():
             warnings.simplefilter("error")
             warn_unconverged("the test integral", r)
+    with warnings.catch_warnings():   # recorded, not warned: the iteration decides what to say
+        warnings.simplefilter("error")
+        with recording() as missed:
+            warn_unconverged("the test integral", r)
+    assert missed == [("the test integral", r)]
 
 
 def test_zero_width_and_reversed_intervals():
     r = adaptive(lambda x, i: np.cos(x), np.array([0.0, 1.0, 2.0]), np.array([0.0, 0.0, 2.0]))
     np.testing.assert_allclose(r.value, [0.0, -np.sin(1.0), 0.0], rtol=1e-15, atol=0)
     assert np.all(r.converged)
+
+
+def test_newton_reports_where_its_answer_was_evaluated():
+    """``solve_increasing(evaluated=)`` marks the points whose answer is the last evaluated point
+    (so its quadrature error estimate is known): x^3 = t from a start at the root and far from it."""
+    from tubefsi._numerics import solve_increasing
+
+    target = np.array([8.0, 27.0, 1e-3])
+    seen = []
+
+    def F(x, i):
+        seen.append(x.copy())
+        return x**3
+
+    evaluated = np.zeros(3, dtype=bool)
+    x, ok = solve_increasing(F, lambda x, i: 3 * x**2, target, guess=np.array([2.0, 1.0, 0.1]), evaluated=evaluated)
+    np.testing.assert_allclose(x, np.cbrt(target), rtol=1e-15)
+    assert ok.all()
+    # the first point starts on its root: its answer is that evaluation
+    assert evaluated[0] and x[0] == 2.0
+    for k in np.flatnonzero(evaluated):      # every marked answer was evaluated as it stands
+        assert any(np.any(values == x[k]) for values in seen)

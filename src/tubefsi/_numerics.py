@@ -180,7 +180,7 @@ def integrate_graded(f, upper, pole, *, gap=None, reach=1.0, order=16, panel_wid
 
 
 def solve_increasing(F, dF, target, *, guess, upper=None, xmax=np.inf, maxiter=200,
-                     rtol=4 * EPS, max_step=np.inf, log=False):
+                     rtol=4 * EPS, max_step=np.inf, log=False, evaluated=None):
     r"""Solve ``F(x) = target`` for increasing ``F`` with ``F(0) = 0``, elementwise.
 
     Safeguarded Newton: a bracket ``[lo, hi]`` is kept, Newton steps that leave
@@ -190,7 +190,9 @@ def solve_increasing(F, dF, target, *, guess, upper=None, xmax=np.inf, maxiter=2
     ``max_step``. With ``log=True`` Newton runs on ``ln F(x) = ln target``, which
     is close to linear both where ``F`` is linear and where it grows exponentially.
 
-    Returns ``(x, ok)``; ``ok`` is False where no root exists below ``xmax``.
+    Returns ``(x, ok)``; ``ok`` is False where no root exists below ``xmax``. ``evaluated`` (a
+    boolean array of the target's size, optional) is set True where the returned ``x`` is the
+    last point ``F`` was evaluated at (its residual met the tolerance there).
     """
     target = np.asarray(target, dtype=float)
     shape = target.shape
@@ -231,7 +233,10 @@ def solve_increasing(F, dF, target, *, guess, upper=None, xmax=np.inf, maxiter=2
                 | (hi_a - lo_a <= rtol * np.abs(xn)))
         stuck = runaway & (xa >= xmax)
         ok[active[stuck]] = False
-        x[active] = np.where(np.abs(r) <= 8 * EPS * target[active], xa, xn)
+        met = np.abs(r) <= 8 * EPS * target[active]
+        x[active] = np.where(met, xa, xn)
+        if evaluated is not None:
+            evaluated.ravel()[active] = met
         active = active[~(done | stuck)]
     else:
         if active.size:

@@ -259,9 +259,29 @@ def quiet():
         _QUIET.reset(token)
 
 
+_RECORD = contextvars.ContextVar("tubefsi_record_unconverged", default=None)
+
+
+@contextlib.contextmanager
+def recording():
+    """Collect, instead of warning, the ``(what, result)`` of every quadrature in the block that
+    missed its tolerance: an iteration learns whether the evaluation it ends on was converged,
+    and need not evaluate its answer once more only to find out."""
+    found = []
+    token = _RECORD.set(found)
+    try:
+        yield found
+    finally:
+        _RECORD.reset(token)
+
+
 def warn_unconverged(what: str, result: Integral) -> None:
     """The ``AccuracyWarning`` of a quadrature that could not meet its tolerance somewhere
-    (silent within :func:`quiet`)."""
+    (silent within :func:`quiet`, collected within :func:`recording`)."""
+    found = _RECORD.get()
+    if found is not None:
+        found.append((what, result))
+        return
     if _QUIET.get():
         return
     bad = ~np.asarray(result.converged)

@@ -54,6 +54,8 @@ def _invalid_type(field, value):
 def _convert_real(value, field):
     """A float for a scalar, a read-only float ndarray for an array (any shape); a pint Quantity
     is converted to SI first."""
+    if type(value) is float:                 # the common case (a Monte Carlo loop builds models)
+        return value
     value = to_si(field.name, value, field.metadata.get("unit", ""))
     if isinstance(value, (bool, str, bytes)):
         raise _invalid_type(field, value)

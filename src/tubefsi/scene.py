@@ -123,11 +123,13 @@ class Scene:
         """A scene of scalars with an unloaded outlet, from already validated models (the scalar
         fast path of :func:`tubefsi.solve`)."""
         new = object.__new__(cls)
-        for name, value in (("rheology", rheology), ("wall", wall), ("tube", tube), ("outlet_pressure", 0.0),
-                            ("external_pressure", 0.0), ("gauge_outlet_pressure", 0.0), ("shape", ()),
-                            ("outlet_strain", 0.0), ("outlet_stretch", 1.0),
-                            ("log_stretch_max", log_stretch_max)):
-            object.__setattr__(new, name, value)
+        set_ = object.__setattr__
+        set_(new, "rheology", rheology)
+        set_(new, "wall", wall)
+        set_(new, "tube", tube)
+        set_(new, "log_stretch_max", log_stretch_max)
+        for name, value in _UNLOADED:
+            set_(new, name, value)
         return new
 
     @property
@@ -197,6 +199,11 @@ class Scene:
         """The per-point quantities of a flat scene at ``index``, as columns (shape ``(n, 1)``, to
         broadcast against ``(n, nodes)`` arrays) if ``column``."""
         return Points(self, index, column)
+
+
+#: the fields of a scene with an unloaded outlet that do not depend on its models
+_UNLOADED = (("outlet_pressure", 0.0), ("external_pressure", 0.0), ("gauge_outlet_pressure", 0.0), ("shape", ()),
+             ("outlet_strain", 0.0), ("outlet_stretch", 1.0))
 
 
 def _evolve_arrays(scene, transform):

@@ -206,7 +206,10 @@ class Solution:
                 pts = part.at(np.arange(live.size))
                 r_in = pts.radius * (1.0 + state.inlet_strain)
                 g_in = pts.rheology._pressure_gradient(state.flow_rate, r_in)
-                if owner == "rheology":
+                if owner == "rheology" and field in type(pts.rheology)._gradient_scales:
+                    # G proportional to the field: d ln G / d theta = 1/theta all along the tube
+                    value[live] = g_in * pts.length / np.asarray(getattr(pts.rheology, field), dtype=float)
+                elif owner == "rheology":
                     def weight(rheology, flow_rate, radius):
                         return rheology._log_gradient_derivative(field, flow_rate, radius)
 

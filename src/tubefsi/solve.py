@@ -152,7 +152,7 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
     values = np.broadcast_to(load, shape).ravel()
     method = runner.flow_controlled if controlled == "flow_rate" else runner.pressure_controlled
     n = values.size
-    out = {f.name: np.full(n, np.nan) for f in attrs.fields(State)}
+    out = _Results(n)
     feasible = np.ones(n, dtype=bool)
     optimistic = controlled == "flow_rate" and _is(type(chosen), SeparatedVariables)
     shown = bar(n, progress, "tubefsi.solve")
@@ -171,8 +171,7 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
                     if _feasible(runner, chunk, values[idx], controlled, raise_=on_infeasible == "raise") is None:
                         raise error
                 else:
-                    for name in out:
-                        out[name][idx] = np.broadcast_to(np.asarray(getattr(state, name), dtype=float), idx.shape)
+                    out.store(idx, state)
                     shown.update(idx.size)
                     continue
             ok = _feasible(runner, chunk, values[idx], controlled, raise_=on_infeasible == "raise")
@@ -187,8 +186,7 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
                 state = method(sub, values[idx][go])
             except OverflowError:             # a scene beyond double precision: a typed error
                 raise _beyond_range(controlled, values[idx][go], "an intermediate quantity overflows") from None
-            for name in out:
-                out[name][idx[go]] = np.broadcast_to(np.asarray(getattr(state, name), dtype=float), go.shape)
+            out.store(idx[go], state)
             shown.update(idx.size)
     shown.close()
     finite = np.isfinite(out["pressure_drop"]) & np.isfinite(out["flow_rate"]) & np.isfinite(out["inlet_strain"])
@@ -203,6 +201,33 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
                     coupler_name=registry.couplers.name_of(chosen) or type(chosen).__name__,
                     feasible=None if np.all(feasible) else feasible.reshape(shape), density=density,
                     controlled=controlled)
+
+
+class _Results(dict):
+    """The State fields of every point of a solve, filled chunk by chunk (NaN where no chunk
+    answered); a single chunk that answers every point hands over its arrays without a copy."""
+
+    def __init__(self, n):
+        super().__init__()
+        self.n = n
+
+    def store(self, idx, state):
+        whole = not self and idx.size == self.n
+        for f in _STATE_FIELDS:
+            value = np.asarray(getattr(state, f), dtype=float)
+            if whole and value.shape == (self.n,):
+                self[f] = value
+                continue
+            if f not in self:
+                self[f] = np.full(self.n, np.nan)
+            self[f][idx] = np.broadcast_to(value, idx.shape)
+
+    def __missing__(self, name):          # no chunk answered (every point beyond a limit)
+        value = self[name] = np.full(self.n, np.nan)
+        return value
+
+
+_STATE_FIELDS = tuple(f.name for f in attrs.fields(State))
 
 
 def _beyond_range(controlled, values, why):

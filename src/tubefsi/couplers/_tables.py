@@ -49,6 +49,12 @@ class Chebyshev:
         self._coef = [row.tolist() for row in self.coef]
         self.lo, self.hi = float(self.breaks[0]), float(self.breaks[-1])
         self._width = np.diff(self.breaks)
+        # 2t = 4 (x - a) / width - 2 on the panel [a, a + width], as one multiply and one add
+        self._t2_scale = 4.0 / self._width
+        self._t2_offset = -2.0 - self.breaks[:-1] * self._t2_scale
+        self._t2_scale_list, self._t2_offset_list = self._t2_scale.tolist(), self._t2_offset.tolist()
+        self._coef_reversed = [row[::-1] for row in self._coef]
+        self._last = len(self._breaks) - 2
         self._coefT = np.ascontiguousarray(self.coef.T)
         # panel lookup by equal buckets as narrow as the narrowest panel (the panels come from
         # bisection, so a bucket holds at most two of them): one multiply and a gather instead
@@ -78,33 +84,35 @@ class Chebyshev:
         """Values at ``x`` (an array inside ``[lo, hi]``), one gather and one Clenshaw sweep."""
         x = np.asarray(x, dtype=float)
         j = self._panel(x)
-        a, width = self.breaks[j], self._width[j]
-        t2 = (x - a) * (4.0 / width) - 2.0                    # 2 t, t in [-1, 1] on the panel
-        c = self._coefT[:, j]                                  # (degree + 1, n), rows contiguous
-        b1 = c[_DEGREE].copy()
-        b2 = np.zeros_like(b1)
-        tmp = np.empty_like(b1)
-        for k in range(_DEGREE - 1, 0, -1):
-            np.multiply(t2, b1, out=tmp)
-            tmp -= b2
-            tmp += c[k]
-            b1, b2, tmp = tmp, b1, b2
-        np.multiply(t2, b1, out=tmp)
-        tmp *= 0.5
-        tmp -= b2
-        tmp += c[0]
-        return tmp
+        t2 = x * self._t2_scale[j]                             # 2 t, t in [-1, 1] on the panel
+        t2 += self._t2_offset[j]
+        c = self._coefT[:, j]                                  # (degree + 1, n), rows contiguous: a private
+        b2 = c[_DEGREE]                                        # gather, so its rows serve as the buffers
+        b1 = np.multiply(t2, b2)
+        b1 += c[_DEGREE - 1]
+        for k in range(_DEGREE - 2, 0, -1):
+            # b_k = 2t b_{k+1} - b_{k+2} + c_k; row k+2 is free by now (b_{k+2} was just used), b_k goes there
+            out = c[k]
+            out -= b2
+            b2 = b1
+            b1 = np.multiply(t2, b1, out=c[k + 2])
+            b1 += out
+        value = np.multiply(t2, b1)                            # a fresh array: no view of the gather
+        value *= 0.5
+        value -= b2
+        value += c[0]
+        return value
 
     def scalar(self, x: float) -> float:
         """The value at one float ``x``, in plain Python (the scalar path)."""
-        j = min(max(bisect.bisect_right(self._breaks, x) - 1, 0), len(self._breaks) - 2)
-        a, b = self._breaks[j], self._breaks[j + 1]
-        t = (2.0 * x - a - b) / (b - a)
-        c = self._coef[j]
-        t2, b1, b2 = 2.0 * t, 0.0, 0.0
-        for k in range(_DEGREE, 0, -1):
-            b1, b2 = t2 * b1 - b2 + c[k], b1
-        return t * b1 - b2 + c[0]
+        j = bisect.bisect_right(self._breaks, x) - 1
+        j = 0 if j < 0 else (self._last if j > self._last else j)
+        t2 = x * self._t2_scale_list[j] + self._t2_offset_list[j]
+        c = self._coef_reversed[j]                 # c_D, ..., c_1, c_0
+        b1, b2 = c[0], 0.0
+        for ck in c[1:-1]:
+            b1, b2 = t2 * b1 - b2 + ck, b1
+        return 0.5 * t2 * b1 - b2 + c[-1]
 
     def derivative(self):
         """The interpolant of the derivative (on the same panels)."""
@@ -183,8 +191,11 @@ class _Bound:
         self.norm = float(scene.tube.radius) ** table.k * self.scale
         self.x_lo, self.x_hi, self.inverse = table.x_lo, table.x_hi, table.inverse
 
-    def rise(self, y, v):
-        """The pressure rise (Pa) at ``y = ln v`` (arrays)."""
+    def rise(self, y, v, strain=None):
+        """The pressure rise (Pa) at ``y = ln v`` (arrays; ``strain``: :math:`e^v - 1` if the caller has it)."""
         if self.table.tabulate_pressure:
-            return self.scale * np.exp(self.table.pressure(y))
-        return self.wall._pressure_at_strain(np.expm1(v), self.tb)
+            out = self.table.pressure(y)
+            np.exp(out, out=out)
+            out *= self.scale
+            return out
+        return self.wall._pressure_at_strain(np.expm1(v) if strain is None else strain, self.tb)

@@ -42,7 +42,7 @@ from scipy import interpolate, optimize
 from scipy.optimize import elementwise
 
 from .._numerics import EPS, integrate_graded, solve_increasing
-from .._quadrature import adaptive_to_pole, quiet, warn_unconverged
+from .._quadrature import adaptive_to_pole, quiet, recording, warn_unconverged
 from ..errors import ConvergenceError, InvalidParameterError, NoSteadyStateError, StretchRangeError
 from ..scene import Points, Scene, State
 from ._tables import SeparatedTable, fit_chebyshev
@@ -232,6 +232,11 @@ class SeparatedVariables(Coupler):
             with np.errstate(divide="ignore"):
                 x = np.log(target / table.norm)
             served = direct & (x >= table.x_lo) & (x <= table.x_hi)
+            if served.all():                 # a whole curve inside the table (the common case): no masks
+                y = table.inverse(x)
+                v = np.exp(y)
+                strain = np.expm1(v)         # the outlet is unloaded wherever there is a table
+                return State(q, table.rise(y, v, strain), strain, v)
             if np.any(served):
                 y = table.inverse(x[served])
                 v[served] = np.exp(y)
@@ -326,8 +331,20 @@ class SeparatedVariables(Coupler):
         sep = scene.rheology.separable
         qflat = None if sep else np.broadcast_to(np.asarray(q, dtype=float), target.shape)
 
+        unchecked = np.ones(target.size, dtype=bool)    # the last evaluation missed its tolerance here
+
         def F(v, i):
-            return self._J(scene, v, index[i], None if sep else qflat[i])
+            with recording() as missed:
+                value = self._J(scene, v, index[i], None if sep else qflat[i])
+            good = np.ones(np.size(i), dtype=bool)
+            for _, result in missed:
+                converged = np.asarray(result.converged)
+                if converged.shape == good.shape:
+                    good &= converged
+                else:                                   # not one entry per point: check them all again
+                    good[:] = False
+            unchecked[i] = ~good
+            return value
 
         def dF(v, i):
             return self.integrand(scene.at(index[i]), v, None if sep else qflat[i])
@@ -358,12 +375,15 @@ class SeparatedVariables(Coupler):
             limit = np.where(capped, cap, np.inf)
             upper = limit if upper is None else np.minimum(upper, limit)
             guess = np.where(capped, np.minimum(guess, 0.5 * cap), guess)
+        evaluated = np.zeros(target.size, dtype=bool)
         with quiet():
             v, ok = solve_increasing(F, dF, target, guess=guess, upper=upper, xmax=MAX_LOG_STRETCH, max_step=2.0,
-                                     log=True)
-        answered = np.flatnonzero(ok.ravel() & (target.ravel() > 0))
+                                     log=True, evaluated=evaluated)
+        # the answer's own error estimate: where the iteration ended on an evaluation that met its
+        # tolerance, that evaluation is the estimate; elsewhere the integral is evaluated once more
+        answered = np.flatnonzero(ok.ravel() & (target.ravel() > 0) & ~(evaluated & ~unchecked))
         if check and answered.size:
-            F(v.ravel()[answered], answered)                            # the answer's own error estimate
+            self._J(scene, v.ravel()[answered], index.ravel()[answered], None if sep else qflat.ravel()[answered])
         if np.any(capped):
             # converged onto the maximum stretch without reaching the target: out of reach
             at_cap = np.flatnonzero(capped.ravel() & (v.ravel() >= cap.ravel() * (1 - 1e-12))

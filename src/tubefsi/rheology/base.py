@@ -77,7 +77,9 @@ class Rheology(abc.ABC):
     Class attributes: ``separable``, ``radius_exponent`` (:math:`k` with
     :math:`\psi(R) = R^{-k}`, for power-law-like fluids: enables the ``closed-form``
     coupler; None otherwise), ``yield_stress`` (0 unless the fluid declares a
-    ``yield_stress`` field) and ``_examples`` (parameter sets for the contract suites).
+    ``yield_stress`` field), ``_gradient_scales`` (the fields :math:`\theta` that :math:`G` is
+    proportional to: their sensitivities need no integral along the tube) and ``_examples``
+    (parameter sets for the contract suites).
     """
 
     __slots__ = ()
@@ -88,6 +90,8 @@ class Rheology(abc.ABC):
     radius_exponent = None
     #: The yield stress (Pa); a yield-stress fluid declares it as a field.
     yield_stress = 0.0
+    #: Fields :math:`\theta` with :math:`G \propto \theta` (:math:`\partial\ln G/\partial\theta = 1/\theta`).
+    _gradient_scales: ClassVar[tuple] = ()
     #: Example parameter sets (keyword dicts) run through the contract suites of :mod:`tubefsi.testing`.
     _examples: ClassVar[tuple] = ()
 

@@ -23,14 +23,17 @@ _TINY = float(np.finfo(float).tiny)
 _HUGE = 1.0 / _TINY
 
 
-def _representable(value, load, name, what):
+def _representable(value, load, name, index):
     """Raise unless ``value`` (a factor of G) is a normal double wherever ``load > 0``: a factor that
     underflows or overflows would make the pressure drop 0, NaN or inf (``docs/verification.md``,
     "Fuzzing")."""
+    if type(value) is float and type(load) is float and (_TINY <= value < math.inf or not load > 0.0):
+        return                                   # the scalar path: no NumPy round trip
     with np.errstate(invalid="ignore"):
         bad = (np.asarray(load) > 0) & ~((np.asarray(value) >= _TINY) & (np.asarray(value) < math.inf))
     if np.any(bad):
         q = float(np.ravel(np.broadcast_to(load, np.shape(bad)))[np.argmax(np.ravel(bad))])
+        what = f"2 m [(3n+1) q / (pi n)]^n, n = {index!r}"
         raise InvalidParameterError(name, f"values for which {what} is within double precision "
                                     f"[{_TINY:.3g}, {_HUGE:.3g}]", q, "the pressure gradient would underflow "
                                     "or overflow")
@@ -41,6 +44,7 @@ class _PowerLawForms(Rheology):
 
     __slots__ = ()
     separable = True
+    _gradient_scales = ("consistency", "viscosity")      # G = 2m [...]^n R^-(3n+1): proportional to m
 
     def _stress(self, shear_rate):
         return self.consistency * shear_rate**self.index
@@ -54,7 +58,7 @@ class _PowerLawForms(Rheology):
             out = 2.0 * self.consistency * ((3.0 * n + 1.0) * flow_rate / (math.pi * n)) ** n
         except OverflowError:
             out = math.inf
-        _representable(out, flow_rate, "flow_rate", f"2 m [(3n+1) q / (pi n)]^n, n = {n!r}")
+        _representable(out, flow_rate, "flow_rate", n)
         return out
 
     def _flow_factor_inverse(self, factor):

@@ -136,7 +136,7 @@ class HyperelasticWall(WallModel):
         materials that have it): radius and thickness over :math:`\sqrt{\lambda_z}` (incompressible),
         length times :math:`\lambda_z`; the tube itself at :math:`\lambda_z = 1`."""
         lz = getattr(self, "axial_stretch", 1.0)
-        if np.ndim(lz) == 0 and lz == 1.0:
+        if lz == 1.0 if type(lz) is float else (np.ndim(lz) == 0 and lz == 1.0):
             return tube
         if isinstance(tube, InstalledTube):          # a solution's tube, solved again: already installed
             if np.array_equal(np.broadcast_to(tube.axial_stretch, np.shape(lz)), lz):

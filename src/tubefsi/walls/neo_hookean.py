@@ -55,6 +55,17 @@ class _NeoHookeanLaw:
         return self._installed_modulus() * (s * s + 1.0) / s**3
 
 
+def _beyond(out, strain, stretch, direct):
+    """``out`` with ``direct(stretch)`` where the strain is past 1e70 (its polynomial form would
+    overflow); the rare case only costs its own points."""
+    far = strain > 1e70
+    if out.ndim == 0:
+        return direct(stretch) if far else out
+    if far.any():
+        out[far] = direct(stretch[far])
+    return out
+
+
 def _reference_unit(strain):
     r""":math:`\lambda - \lambda^{-3}` at :math:`\lambda = 1 + \varepsilon`: as
     :math:`(\lambda^4 - 1)/\lambda^3` from the strain (no cancellation at small strain), directly
@@ -62,8 +73,8 @@ def _reference_unit(strain):
     e = np.asarray(strain, dtype=float)
     with np.errstate(over="ignore", invalid="ignore"):
         lam = 1.0 + e
-        small = e * (4.0 + e * (6.0 + e * (4.0 + e))) / lam**3
-        return np.where(e > 1e70, lam - lam**-3, small)
+        out = e * (4.0 + e * (6.0 + e * (4.0 + e))) / (lam * lam * lam)
+        return _beyond(out, e, lam, lambda big: big - big**-3)
 
 
 def _current_unit(strain):
@@ -72,8 +83,9 @@ def _current_unit(strain):
     e = np.asarray(strain, dtype=float)
     with np.errstate(over="ignore", invalid="ignore"):
         lam = 1.0 + e
-        small = e * (4.0 + e * (6.0 + e * (4.0 + e))) / lam**4
-        return np.where(e > 1e70, 1.0 - lam**-4, small)
+        lam2 = lam * lam
+        out = e * (4.0 + e * (6.0 + e * (4.0 + e))) / (lam2 * lam2)
+        return _beyond(out, e, lam, lambda big: 1.0 - big**-4)
 
 
 class _ThinForms(_NeoHookeanLaw):
