@@ -397,25 +397,34 @@ class SeparatedVariables(Coupler):
 
     def _gauss_start(self, scene, index, target, guess, q, top):
         r"""A starting value near the root for the Newton iteration on :math:`\ln J`: Newton on a
-        six-point Gauss–Legendre estimate of :math:`J(v)` over :math:`[0, v]` (six integrand values
-        per point and step, no error estimate; exact for smooth integrands over moderate strains
-        to ~1e-10), its slope the exact :math:`J'(v)`, a few steps from the linear guess. Only a
-        start: the error-controlled iteration that follows decides the answer."""
+        eight-point Gauss–Legendre estimate of :math:`J(v)` over :math:`[0, v]` (eight integrand
+        values per point and step, no error estimate; ~1e-10 for smooth integrands over moderate
+        strains), its slope the exact :math:`J'(v)`, from the linear guess until a step moves less
+        than 1e-10 (at most ``_START_STEPS``; each step only for the points still moving). Eight
+        nodes, not six: at large strain six leave half the points two adaptive passes from the
+        root, eight one. Only a start: the error-controlled iteration that follows decides the answer."""
         live = np.flatnonzero((target > 0) & (guess > 0))
         if live.size == 0:
             return guess
-        pts = scene.at(index[live], column=True)
-        ends = scene.at(index[live])                 # the same points, for the slope at v
-        qq = None if q is None else q[live][:, None]
-        q_end = None if q is None else q[live]
-        t, v, hi = target[live], guess[live].copy(), top[live] + np.zeros(live.size)
+        ids, t, v = index[live], target[live], guess[live].copy()
+        hi = top[live] + np.zeros(live.size)
+        q_live = None if q is None else q[live]
+        act = np.arange(live.size)                    # the points still moving
         with np.errstate(all="ignore"):
-            for _ in range(4):
-                values = self.integrand(pts, v[:, None] * _START_NODES, qq)
-                estimate = v * (values @ _START_WEIGHTS)
-                slope = self.integrand(ends, v, q_end)
-                nxt = np.clip(v - np.log(estimate / t) * estimate / slope, 0.5 * v, np.minimum(2.0 * v, hi))
-                v = np.where(np.isfinite(nxt) & (nxt > 0), nxt, v)
+            for _ in range(_START_STEPS):
+                pts = scene.at(ids[act], column=True)
+                ends = scene.at(ids[act])             # the same points, for the slope at v
+                va = v[act]
+                values = self.integrand(pts, va[:, None] * _START_NODES, None if q is None else q_live[act][:, None])
+                estimate = va * (values @ _START_WEIGHTS)
+                slope = self.integrand(ends, va, None if q is None else q_live[act])
+                nxt = np.clip(va - np.log(estimate / t[act]) * estimate / slope, 0.5 * va, np.minimum(2.0 * va, hi[act]))
+                nxt = np.where(np.isfinite(nxt) & (nxt > 0), nxt, va)
+                v[act] = nxt
+                # the rule's own error is ~1e-10: closer than that, Newton on the exact J takes over
+                act = act[np.abs(nxt - va) > 1e-10 * va]
+                if act.size == 0:
+                    break
         out = guess.copy()
         out[live] = v
         return out
@@ -750,7 +759,9 @@ def _rigid_state(scene: Scene, *, flow_rate=None, pressure_drop=None) -> State:
 _TABLE_MIN_POINTS = 64
 #: Start the direct Newton iteration from a Gauss estimate (SeparatedVariables._gauss_start).
 _GAUSS_START = True
-_START_NODES, _START_WEIGHTS = np.polynomial.legendre.leggauss(6)
+_START_NODES, _START_WEIGHTS = np.polynomial.legendre.leggauss(8)
+#: at most this many Newton steps on the Gauss estimate (a start far out needs 6-8, most 3)
+_START_STEPS = 8
 _START_NODES, _START_WEIGHTS = 0.5 * (_START_NODES + 1.0), 0.5 * _START_WEIGHTS      # on [0, 1]
 #: Tolerance of a curve interpolated between direct solves, in ln v: the direct solves' own
 #: accuracy (the quadrature's 1e-14, a little more near a yield point), not tighter.
