@@ -49,6 +49,16 @@ class State:
     inlet_strain: np.ndarray
     log_stretch: np.ndarray
 
+    def arrays(self, n: int) -> dict:
+        """Every field as a float array of ``n`` entries (broadcast, not copied), by name."""
+        return {f.name: np.broadcast_to(np.asarray(getattr(self, f.name), dtype=float), (n,))
+                for f in attrs.fields(State)}
+
+    def take(self, index) -> State:
+        """The state at the entries ``index`` of its (flat) arrays."""
+        n = np.size(self.flow_rate)
+        return State(**{name: value[index] for name, value in self.arrays(n).items()})
+
 
 def _value_eq(a, b) -> bool:
     a, b = np.asarray(a), np.asarray(b)

@@ -201,8 +201,7 @@ class Solution:
             live = np.flatnonzero(q > 0)
             if live.size:
                 part = chunk if live.size == idx.size else chunk.take(live)
-                state = State(**{k: np.asarray(getattr(sub, k))[live] for k in ("flow_rate", "pressure_drop",
-                                                                                  "inlet_strain", "log_stretch")})
+                state = sub.take(live)
                 pts = part.at(np.arange(live.size))
                 r_in = pts.radius * (1.0 + state.inlet_strain)
                 g_in = pts.rheology._pressure_gradient(state.flow_rate, r_in)

@@ -106,14 +106,12 @@ class Coupler(abc.ABC):
         if uniform:
             r_out = radius * np.broadcast_to(np.asarray(scene.outlet_stretch, dtype=float), (n,))
             return length * weight(scene.rheology, q, r_out)
-        fields = {name: np.broadcast_to(np.asarray(getattr(state, name), dtype=float), (n,))
-                  for name in ("flow_rate", "pressure_drop", "inlet_strain", "log_stretch")}
-        kind = type(state)
+        fields = state.arrays(n)
 
         def f(z, idx):
             rows = np.repeat(idx, z.shape[1])
             part = scene.take(rows) if scene.size != 1 else scene
-            strain, _ = self.profile(part, kind(**{k: v[rows] for k, v in fields.items()}), z.ravel())
+            strain, _ = self.profile(part, state.take(rows), z.ravel())
             r = radius[rows] * (1.0 + np.asarray(strain))
             return np.asarray(weight(part.rheology, fields["flow_rate"][rows], r)).reshape(z.shape)
 
@@ -144,8 +142,7 @@ class Coupler(abc.ABC):
         if np.any(flowing):
             live = np.flatnonzero(flowing)
             part = scene if live.size == n else scene.take(live)
-            sub = type(state)(**{name: np.broadcast_to(np.asarray(getattr(state, name), dtype=float), (n,))[live]
-                                 for name in ("flow_rate", "pressure_drop", "inlet_strain", "log_stretch")})
+            sub = state.take(live)
             k_int[live] = self.length_integral(part, sub, _flow_index, uniform=rheo.separable)
         # q = 0: the tube is uniform at the outlet radius; the limit at an apparent shear rate 1e-30/s
         q_use = np.where(flowing, q, 0.25e-30 * math.pi * r_out**3)
