@@ -148,9 +148,20 @@ class _ThickForms(_NeoHookeanLaw):
         return 0.5 * self._installed_modulus() * (np.log1p(ratio * d) + last)
 
     def _stiffness(self, stretch, tb):
-        lam2 = stretch * stretch
+        # mu d lam (lam^2 (d + 2) + d) / (lam^4 (lam^2 + d)^2), d = tb (2 + tb); the per-point factors
+        # (mu d, d + 2) first, then in place: the integrand's hot spot, on (points x nodes) arrays
+        lam2 = np.multiply(stretch, stretch)
         d = tb * (2.0 + tb)
-        return self._installed_modulus() * stretch * d * (lam2 * (d + 2.0) + d) / (lam2 * lam2 * (lam2 + d) ** 2)
+        den = lam2 + d
+        den *= den
+        den *= lam2
+        den *= lam2
+        num = lam2 * (d + 2.0)
+        num += d
+        num *= stretch
+        num *= self._installed_modulus() * d
+        num /= den
+        return num
 
     def _strain(self, pressure, tb):
         # the law per unit modulus: no parameter but t/a, which is gathered for the active points
