@@ -223,20 +223,23 @@ class SeparatedVariables(Coupler):
             return _rigid_state(scene, flow_rate=q)
         index = np.arange(q.size)
         pts = scene.at(index)
-        target = np.where(q == 0, 0.0, self.target(pts, q) if target is None else target)
-        v = np.zeros(q.shape)
-        dp = np.full(q.shape, np.nan)
-        direct = target > 0
         table = self._table(scene, build=q.size >= _TABLE_MIN_POINTS or _worth_building(scene))
-        if table is not None:                # the points whose target the table serves
-            with np.errstate(divide="ignore"):
-                x = np.log(target / table.norm)
-            served = direct & (x >= table.x_lo) & (x <= table.x_hi)
-            if served.all():                 # a whole curve inside the table (the common case): no masks
+        if table is not None and target is None:
+            # x = ln(L phi(q) / norm) straight from ln phi (no power, no division)
+            x = pts.rheology._log_flow_factor(q) + math.log(float(pts.length) / table.norm)
+            if np.all((x >= table.x_lo) & (x <= table.x_hi)):   # a whole curve inside the table: no masks
                 y = table.inverse(x)
                 v = np.exp(y)
                 strain = np.expm1(v)         # the outlet is unloaded wherever there is a table
                 return State(q, table.rise(y, v, strain), strain, v)
+        target = np.where(q == 0, 0.0, self.target(pts, q) if target is None else target)
+        v = np.zeros(q.shape)
+        dp = np.full(q.shape, np.nan)
+        direct = target > 0
+        if table is not None:                # the points whose target the table serves
+            with np.errstate(divide="ignore"):
+                x = np.log(target / table.norm)
+            served = direct & (x >= table.x_lo) & (x <= table.x_hi)
             if np.any(served):
                 y = table.inverse(x[served])
                 v[served] = np.exp(y)

@@ -72,6 +72,7 @@ class Rheology(abc.ABC):
     ``_flow_factor``                 separable rheologies only: :math:`\phi(q)` in :math:`G = \phi(q)\psi(R)`,
     ``_flow_factor_inverse``         its inverse,
     ``_radius_factor``               and :math:`\psi(R)`
+    ``_log_flow_factor``             :math:`\ln\phi(q)` (default: the log of ``_flow_factor``)
     ===============================  ======================================================================
 
     Class attributes: ``separable``, ``radius_exponent`` (:math:`k` with
@@ -319,6 +320,11 @@ class Rheology(abc.ABC):
 
     def _flow_factor_inverse(self, factor):
         raise NotImplementedError
+
+    def _log_flow_factor(self, flow_rate):
+        r""":math:`\ln\phi(q)` (optional, for speed and range: the tables work in logs)."""
+        with np.errstate(divide="ignore"):
+            return np.log(self._flow_factor(flow_rate))
 
     def _radius_factor(self, radius):
         raise NotImplementedError

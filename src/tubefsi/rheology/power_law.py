@@ -61,6 +61,13 @@ class _PowerLawForms(Rheology):
         _representable(out, flow_rate, "flow_rate", n)
         return out
 
+    def _log_flow_factor(self, flow_rate):
+        # ln 2m + n ln((3n+1)/(pi n)) + n ln q: a log and a multiply-add, no power; finite wherever
+        # q > 0, even where phi itself would leave double range
+        n = self.index
+        with np.errstate(divide="ignore"):
+            return np.log(flow_rate) * n + (np.log(2.0 * self.consistency) + n * np.log((3.0 * n + 1.0) / (math.pi * n)))
+
     def _flow_factor_inverse(self, factor):
         n = self.index
         return math.pi * n / (3.0 * n + 1.0) * (factor / (2.0 * self.consistency)) ** (1.0 / n)
