@@ -91,6 +91,17 @@ def check(scene, flow_rate, inlet_strain, *, density=None) -> Validity:
     arrays ``flow_rate``, ``inlet_strain`` of its points (NaN where infeasible)."""
     q = np.ravel(np.asarray(flow_rate, dtype=float))
     strain = np.broadcast_to(np.asarray(inlet_strain, dtype=float), q.shape)
+    a, length = scene.tube.radius, scene.tube.length
+    limit = getattr(scene.wall, "calibrated_strain", math.inf)
+    if density is None and q.size and np.ndim(a) == 0 and np.ndim(length) == 0 and np.ndim(limit) == 0:
+        # one tube (a curve): R_in/L grows with the strain, so the largest strain decides both
+        # checks: one reduction, and the per-point pass only when there is something to report
+        top = float(np.fmax.reduce(strain, initial=-math.inf))    # NaN (infeasible points) ignored
+        worst = float(a) * (1.0 + top) / float(length)
+        if not (worst > SLENDERNESS or top > limit):
+            return Validity(deformed_slenderness=max(worst, 0.0) if math.isfinite(top) else math.nan,
+                            max_strain=top if math.isfinite(top) else math.nan,
+                            reduced_reynolds_number=None, reynolds_number=None, messages=())
     ok = np.isfinite(q) & np.isfinite(strain)
     a = np.broadcast_to(np.asarray(scene.tube.radius, dtype=float), q.shape)
     length = np.broadcast_to(np.asarray(scene.tube.length, dtype=float), q.shape)
