@@ -179,3 +179,30 @@ def test_curve_interpolation_reproduces_the_direct_path(case, monkeypatch):
     direct = tubefsi.solve(fluid, wall, TUBE, flow_rate=sample, outlet_pressure=p_out)
     np.testing.assert_allclose(curve.pressure_drop[::23], direct.pressure_drop, rtol=1e-13, atol=0)
     np.testing.assert_allclose(curve.inlet_displacement[::23], direct.inlet_displacement, rtol=1e-13, atol=0)
+
+
+def test_a_chunked_curve_builds_one_interpolant(monkeypatch):
+    """A curve of several chunks through one scene (10^6 points at the real chunk size; 300 points
+    in chunks of 64 here) fits ln v(ln q) once over the whole call, and each chunk's points agree
+    with the direct path (1e-13), the chunk edges included."""
+    import sys
+
+    solve_module = sys.modules["tubefsi.solve"]
+    fluid, wall, _ = CURVE_CASES[0]
+    q = np.geomspace(3e-13, 3e-9, 300)
+    fits = []
+    real = engine.SeparatedVariables._fit_log_stretch
+
+    def spy(self, scene, lo, hi):
+        fits.append((lo, hi))
+        return real(self, scene, lo, hi)
+
+    monkeypatch.setattr(engine.SeparatedVariables, "_fit_log_stretch", spy)
+    monkeypatch.setattr(solve_module, "CHUNK", 64)
+    curve = tubefsi.solve(fluid, wall, TUBE, flow_rate=q)
+    assert fits == [(pytest.approx(np.log(q[0]), rel=1e-15), pytest.approx(np.log(q[-1]), rel=1e-15))]
+    sample = np.r_[0, 63, 64, 127, 128, 150, 299]
+    monkeypatch.setattr(engine, "_TABLE_MIN_POINTS", 10**9)
+    direct = tubefsi.solve(fluid, wall, TUBE, flow_rate=q[sample])
+    np.testing.assert_allclose(curve.pressure_drop[sample], direct.pressure_drop, rtol=1e-13, atol=0)
+    np.testing.assert_allclose(curve.inlet_displacement[sample], direct.inlet_displacement, rtol=1e-13, atol=0)

@@ -8,6 +8,7 @@ loads and returns a :class:`~tubefsi.Solution`.
 
 from __future__ import annotations
 
+import contextlib
 import math
 
 import attrs
@@ -19,7 +20,7 @@ from ._validation import as_load
 from .couplers.base import Coupler
 from .couplers.checked import checked
 from .errors import InvalidParameterError, NoSteadyStateError, StretchRangeError
-from .couplers.separated import _TABLES, SeparatedVariables
+from .couplers.separated import _TABLES, SeparatedVariables, curve_span
 from .geometry import Tube
 from .rheology.base import Rheology
 from .scene import Scene, State, _resolve, make_scene
@@ -156,38 +157,8 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
     feasible = np.ones(n, dtype=bool)
     optimistic = controlled == "flow_rate" and _is(type(chosen), SeparatedVariables)
     shown = bar(n, progress, "tubefsi.solve")
-    for index, part in flat.split(np.arange(n)):
-        for start in range(0, index.size, CHUNK):
-            idx = index[start:start + CHUNK]
-            chunk = part if part.size == 1 or idx.size == index.size else part.take(np.arange(start, start + idx.size))
-            if optimistic:
-                # the engine detects a point beyond the limit itself (its inlet stretch runs away):
-                # solve first, and look for the limit (a quadrature to infinity) only if one did
-                try:
-                    state = method(chunk, values[idx])
-                except OverflowError:         # a scene beyond double precision: a typed error
-                    raise _beyond_range(controlled, values[idx], "an intermediate quantity overflows") from None
-                except (NoSteadyStateError, StretchRangeError) as error:   # the limit decides which
-                    if _feasible(runner, chunk, values[idx], controlled, raise_=on_infeasible == "raise") is None:
-                        raise error
-                else:
-                    out.store(idx, state)
-                    shown.update(idx.size)
-                    continue
-            ok = _feasible(runner, chunk, values[idx], controlled, raise_=on_infeasible == "raise")
-            go = np.arange(idx.size) if ok is None else np.flatnonzero(ok)
-            if ok is not None:
-                feasible[idx] = ok
-            if go.size == 0:
-                shown.update(idx.size)
-                continue
-            sub = chunk if go.size == idx.size else (chunk.take(go) if chunk.size > 1 else chunk)
-            try:
-                state = method(sub, values[idx][go])
-            except OverflowError:             # a scene beyond double precision: a typed error
-                raise _beyond_range(controlled, values[idx][go], "an intermediate quantity overflows") from None
-            out.store(idx[go], state)
-            shown.update(idx.size)
+    with curve_span(flat, values) if optimistic and flat.size == 1 and n > CHUNK else contextlib.nullcontext():
+        _solve_chunks(flat, values, method, runner, controlled, optimistic, on_infeasible, out, feasible, shown)
     shown.close()
     with np.errstate(over="ignore", invalid="ignore"):     # three sums: NaN and inf survive them
         quick = math.isfinite(float(out["pressure_drop"].sum() + out["flow_rate"].sum() + out["inlet_strain"].sum()))
@@ -231,6 +202,44 @@ class _Results(dict):
 
 
 _STATE_FIELDS = tuple(f.name for f in attrs.fields(State))
+
+
+def _solve_chunks(flat, values, method, runner, controlled, optimistic, on_infeasible, out, feasible, shown):
+    """Solve every point of ``flat`` in chunks of at most ``CHUNK`` points (one parameter set per
+    chunk where a model needs it), storing into ``out`` and ``feasible``."""
+    n = values.size
+    for index, part in flat.split(np.arange(n)):
+        for start in range(0, index.size, CHUNK):
+            idx = index[start:start + CHUNK]
+            chunk = part if part.size == 1 or idx.size == index.size else part.take(np.arange(start, start + idx.size))
+            if optimistic:
+                # the engine detects a point beyond the limit itself (its inlet stretch runs away):
+                # solve first, and look for the limit (a quadrature to infinity) only if one did
+                try:
+                    state = method(chunk, values[idx])
+                except OverflowError:         # a scene beyond double precision: a typed error
+                    raise _beyond_range(controlled, values[idx], "an intermediate quantity overflows") from None
+                except (NoSteadyStateError, StretchRangeError) as error:   # the limit decides which
+                    if _feasible(runner, chunk, values[idx], controlled, raise_=on_infeasible == "raise") is None:
+                        raise error
+                else:
+                    out.store(idx, state)
+                    shown.update(idx.size)
+                    continue
+            ok = _feasible(runner, chunk, values[idx], controlled, raise_=on_infeasible == "raise")
+            go = np.arange(idx.size) if ok is None else np.flatnonzero(ok)
+            if ok is not None:
+                feasible[idx] = ok
+            if go.size == 0:
+                shown.update(idx.size)
+                continue
+            sub = chunk if go.size == idx.size else (chunk.take(go) if chunk.size > 1 else chunk)
+            try:
+                state = method(sub, values[idx][go])
+            except OverflowError:             # a scene beyond double precision: a typed error
+                raise _beyond_range(controlled, values[idx][go], "an intermediate quantity overflows") from None
+            out.store(idx[go], state)
+            shown.update(idx.size)
 
 
 def _beyond_range(controlled, values, why):

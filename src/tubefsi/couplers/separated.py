@@ -33,6 +33,8 @@ Hagen–Poiseuille, :math:`\Delta p = L\,G(q, a)`, handled here once (``_rigid_s
 from __future__ import annotations
 
 import abc
+import contextlib
+import contextvars
 import functools
 import math
 import time
@@ -277,6 +279,19 @@ class SeparatedVariables(Coupler):
         lo, hi = float(log_q.min()), float(log_q.max())
         if not hi > lo:
             return None
+        span = _CURVE_SPAN.get()
+        if span is not None and span.scene is scene and span.lo <= lo and hi <= span.hi:
+            # one call solved in chunks: the interpolant of the call's whole range, built once
+            if span.interpolant is None:
+                span.interpolant = self._fit_log_stretch(scene, span.lo, span.hi) or False
+            if span.interpolant is False:
+                return None
+            return np.exp(span.interpolant(np.clip(log_q, span.lo, span.hi)))
+        interpolant = self._fit_log_stretch(scene, lo, hi)
+        return None if interpolant is None else np.exp(interpolant(np.clip(log_q, lo, hi)))
+
+    def _fit_log_stretch(self, scene: Scene, lo, hi):
+        r"""The accepted interpolant of :math:`\ln v` on ``[lo, hi]`` in :math:`\ln q`, or None."""
         length = float(scene.tube.length)
         separable = scene.rheology.separable
         pts = scene.at(np.zeros(1, dtype=int))
@@ -293,7 +308,7 @@ class SeparatedVariables(Coupler):
         interpolant, error = fit_chebyshev(log_v, lo, hi, panels=2, max_panels=64, tol=_CURVE_TOL)
         if interpolant is None or not math.isfinite(error):
             return None
-        return np.exp(interpolant(np.clip(log_q, lo, hi)))
+        return interpolant
 
     # --------------------------------------------------------------- tables
     def _table(self, scene: Scene, build=True):
@@ -754,6 +769,36 @@ def _rigid_state(scene: Scene, *, flow_rate=None, pressure_drop=None) -> State:
         q = np.where(dp == 0, 0.0, rheo._flow_rate(a + 0.0 * dp, np.where(dp == 0, 1.0, dp) / L))
     zero = np.zeros_like(q)
     return State(q, dp, zero + scene.outlet_strain, zero)
+
+
+class _Span:
+    """The range of ln q of one call that a caller solves in chunks through one scene."""
+
+    __slots__ = ("scene", "lo", "hi", "interpolant")
+
+    def __init__(self, scene, lo, hi):
+        self.scene, self.lo, self.hi, self.interpolant = scene, lo, hi, None
+
+
+_CURVE_SPAN = contextvars.ContextVar("tubefsi_curve_span", default=None)
+
+
+@contextlib.contextmanager
+def curve_span(scene: Scene, flow_rate):
+    """Within the block, the chunks of a long curve through ``scene`` (the same object each
+    chunk) share one interpolant of the inlet log-stretch over all of ``flow_rate`` (the
+    positive, finite ones) instead of each building its own."""
+    q = np.asarray(flow_rate, dtype=float)
+    q = q[(q > 0) & np.isfinite(q)]
+    if q.size < 2:
+        yield
+        return
+    with np.errstate(divide="ignore"):
+        token = _CURVE_SPAN.set(_Span(scene, float(np.log(q.min())), float(np.log(q.max()))))
+    try:
+        yield
+    finally:
+        _CURVE_SPAN.reset(token)
 
 
 #: Curves at least this long build a table at once; shorter calls build one once the time spent
