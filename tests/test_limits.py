@@ -185,3 +185,18 @@ def test_loose_ode_near_the_maximum_flow_rate_warns_instead_of_silently_erring()
     assert abs(loose.inlet_displacement / exact.inlet_displacement - 1) > 1e-2   # the warning was deserved
     with pytest.raises(tubefsi.NoSteadyStateError):
         tubefsi.solve(fluid, wall, TUBE, flow_rate=1.01 * q / 0.99, coupler=ODE())
+
+
+def test_stiffening_wall_max_flow_rate_is_inf_without_a_spurious_warning():
+    """Exponential fibres (thin HGO, reference thickness) have no limit pressure: the law's
+    representable end (pressure 1.3e266 Pa at stretch 6) is not one, and the flow rate that would
+    reach it is beyond double range. ``inf`` comes back, and no AccuracyWarning about the
+    integral up to that end (its estimate cannot matter for a q_max that overflows)."""
+    import warnings
+
+    wall = walls["thin-hgo"](shear_modulus=3000.0, fibre_stiffness=2363.2, fibre_exponent=0.8393,
+                             fibre_angle=math.radians(29.0), thickness_convention="reference")
+    assert wall.limit_pressure(TUBE.reduced_thickness) > 1e250
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", tubefsi.AccuracyWarning)
+        assert tubefsi.max_flow_rate(rheologies["power-law"](consistency=0.017, index=0.7), wall, TUBE) == math.inf

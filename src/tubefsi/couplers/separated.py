@@ -658,7 +658,8 @@ class SeparatedVariables(Coupler):
         if np.any(limited):
             ids = index[limited]
             if scene.rheology.separable:
-                j_inf = self._J_infinity(scene, ids)
+                with recording() as missed:     # an estimate matters only for a representable q_max
+                    j_inf = self._J_infinity(scene, ids)
                 finite = np.isfinite(j_inf)
                 if np.any(finite):
                     sp = scene.at(ids[finite])
@@ -667,6 +668,11 @@ class SeparatedVariables(Coupler):
                     sub = out[ids]
                     sub[finite] = np.where(np.isfinite(q), q, np.inf)
                     out[ids] = sub
+                    # a stiffening law whose "limit" is where its pressure leaves double range
+                    # (exponential fibres) has a maximum flow rate beyond it too: inf, exactly
+                    if np.any(np.isfinite(q)):
+                        for what, result in missed:
+                            warn_unconverged(what, result)
             else:
                 out[ids] = self._max_flow_rate_search(scene, ids)
         return float(out[0]) if n == 1 else out
