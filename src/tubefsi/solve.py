@@ -189,7 +189,7 @@ class _Results(dict):
         whole = not self and idx.size == self.n
         for f in _STATE_FIELDS:
             value = np.asarray(getattr(state, f), dtype=float)
-            if whole and value.shape == (self.n,):
+            if whole and value.shape == (self.n,) and value.flags.writeable:   # not a broadcast view
                 self[f] = value
                 continue
             if f not in self:
