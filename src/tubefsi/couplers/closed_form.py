@@ -54,10 +54,10 @@ class ClosedForm(SeparatedVariables):
         index = np.arange(q.size)
         pts = scene.at(index)
         k = pts.rheology.radius_exponent
+        if not pts.wall._has_power_law_integral_inverse():
+            return super().flow_controlled(scene, q)    # no explicit inverse: the tables or Newton (in logs)
         target = self.target(pts, q)
         v = pts.wall._power_law_integral_inverse(target / pts.radius**k, pts.outlet_stretch, k, pts.tb)
-        if v is None:
-            return super().flow_controlled(scene, q, target=target)
         v = np.where(q == 0, 0.0, v)
         if not np.all(v <= MAX_LOG_STRETCH):
             self._raise_runaway(scene, q, v <= MAX_LOG_STRETCH)

@@ -74,6 +74,7 @@ class WallModel(abc.ABC):
                                                             of a power-law fluid (with
                                                             ``closed_form_integral = True``)
     ``_power_law_integral_inverse(integral, ...)``          None; its explicit inverse, where there is one
+    ``_has_power_law_integral_inverse()``                   whether that inverse is given (overridden)
     ``_pressure_scale()``, ``_shape_key()``                 1 and every parameter: ``P = scale * P_hat(key)``
                                                             lets a curve table serve every modulus
     ``_pressure_needs_quadrature()``                        False (True for a generic thick wall)
@@ -246,6 +247,10 @@ class WallModel(abc.ABC):
     def _power_law_integral_inverse(self, integral, outlet_stretch, exponent, tb):
         """Inverse of ``_power_law_integral`` in ``log_ratio`` where it is explicit, else None."""
         return None
+
+    def _has_power_law_integral_inverse(self) -> bool:
+        """Whether ``_power_law_integral_inverse`` gives an answer (asked before computing its argument)."""
+        return type(self)._power_law_integral_inverse is not WallModel._power_law_integral_inverse
 
     def _max_stretch(self, tb):
         return math.inf

@@ -126,6 +126,9 @@ class _ThinForms(_NeoHookeanLaw):
                          + 3.0 * s0 ** (k - 3) * expm1_ratio(k - 3, log_ratio))
         return 4.0 * mt * s0 ** (k - 4) * expm1_ratio(k - 4, log_ratio)
 
+    def _has_power_law_integral_inverse(self) -> bool:
+        return self.thickness_convention != "reference"
+
     def _power_law_integral_inverse(self, integral, outlet_stretch, exponent, tb):
         if self.thickness_convention == "reference":
             return None
