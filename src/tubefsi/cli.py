@@ -514,7 +514,7 @@ def _cmd_network(args, out) -> int:
         except ImportError:
             raise UsageError("--plot needs the nodes' positions (a 'positions' object in FILE) or networkx "
                              "for a layout: pip install 'tubefsi[network]'") from None
-    result = net.solve()
+    result = net.solve(progress="auto")      # a bar on a terminal, when tqdm is installed
     if args.format == "csv":
         for written in result.to_csv(args.output):
             print(f"wrote {written}", file=out)
