@@ -328,7 +328,7 @@ def plot_tube_law(wall, reduced_thickness, *, ax=None, max_stretch=3.0, normaliz
 
     if math.isfinite(lim):
         ax.axhline(lim / scale, color=color, lw=1.0, ls="--", label="_nolegend_")
-        text = f"limit {lim / scale:.3g}" if unit is None else f"limit {_fmt(lim / scale, unit)}"
+        text = f"limit {lim / scale:.3g}" if unit is None else f"limit {_fmt_p(lim)}"
         ax.annotate(text, xy=(hi, lim / scale), xytext=(-4, 3),
                     textcoords="offset points", ha="right", va="bottom", color=color, fontsize=8)
     ax.grid(True, alpha=0.25)
@@ -478,7 +478,7 @@ def plot_flow_curve(rheology, wall, tube, *, flow_rates=None, ax=None, n=200, la
     if math.isfinite(lim):
         x_lim = (lim - outlet_pressure) / p_unit
         ax.axvline(x_lim, color=color, lw=1.0, ls=":", label="_nolegend_")
-        ax.annotate(f"limit {_fmt(x_lim, p_sym)}", xy=(x_lim, 0.4),
+        ax.annotate(f"limit {_fmt_p(lim - outlet_pressure)}", xy=(x_lim, 0.4),
                     xycoords=("data", "axes fraction"), xytext=(3, 0), textcoords="offset points",
                     rotation=90, ha="left", va="bottom", color=color, fontsize=8)
     ax.set_xlabel(rf"pressure drop $\Delta p$ ({p_sym})")
