@@ -139,21 +139,22 @@ def draw(ax, x, results, label, color, marker, ls="-"):
         ax.text(xi, RAISED_Y * 1.8, "!", color="red", fontsize=14, fontweight="bold", ha="center", va="center")
 
 
-def finish(ax, xlabel, ylabel, title, xlog=True):
+def finish(ax, xlabel, ylabel, title, xlog=True, legend_loc="best", bottom=1e-17, ncol=1):
     if xlog:
         ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_ylim(1e-17, TOP)
+    ax.set_ylim(bottom, TOP)
     ax.axhline(1e-12, color="k", lw=0.8, ls=":")
     ax.axhline(1.0, color="0.6", lw=0.6)
-    ax.text(1.0, RAISED_Y, " raised ", transform=ax.get_yaxis_transform(), ha="right", va="center", fontsize=8,
+    ax.text(1.0, RAISED_Y, " raised ", transform=ax.get_yaxis_transform(), ha="right", va="center", fontsize=10,
             color="0.3")
-    ax.text(0.0, 1e-12, " 1e-12", transform=ax.get_yaxis_transform(), ha="left", va="bottom", fontsize=8)
+    ax.text(0.0, 1e-12, " 1e-12", transform=ax.get_yaxis_transform(), ha="left", va="bottom", fontsize=10)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
-    ax.set_title(title, fontsize=10)
+    ax.set_title(title, fontsize=12.5)
     ax.grid(True, which="major", alpha=0.3)
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, fontsize=8, frameon=False)
+    # the legend inside its own panel, so that it cannot be read as the next panel's
+    ax.legend(loc=legend_loc, fontsize=10.5, framealpha=0.9, edgecolor="0.8", ncol=ncol)
 
 
 def status_marks():
@@ -224,10 +225,11 @@ def panel_singular(ax, log, points=31):
                    f"|n - n*| = 1e-16..0.1: {max(e for e, _ in ours if e is not None):.1e}; naive formula at n*: "
                    f"{'NaN (0/0)' if naive0[0] is None else f'{naive0[0]:.1e}'}, worst naive error "
                    f"{max(e for e, _ in naive if e is not None):.1e}")
-    ax.annotate("naive formula at the double\nnearest n*: 0/0 = NaN", (5e-17, RAISED_Y * 1.5), xytext=(1e-12, 2e-2),
-                fontsize=8, arrowprops=dict(arrowstyle="->", lw=0.6))
-    finish(ax, "|n − n*|  (leftmost: the double nearest n*; n = 1 is exact, drawn at the edge)",
-           "relative error of q(Δp)", "(a) closed forms at their removable singularities (λ_in = 1.5)")
+    ax.annotate("naive formula at the double\nnearest n*: 0/0 = NaN", (5e-17, RAISED_Y * 1.5), xytext=(3e-17, 1e-8),
+                fontsize=10, arrowprops=dict(arrowstyle="->", lw=0.6))
+    finish(ax, "|n − n*|  (leftmost: the double nearest n*)",
+           "relative error of q(Δp)", "(a) closed forms at their removable singularities (λ_in = 1.5)",
+           legend_loc="lower center", bottom=1e-23)
     ax.set_xlim(1e-17, 0.3)
 
 
@@ -356,7 +358,7 @@ def panel_strain(ax, log, points=18):
             log.append(f"(d) ODE(odeint) pressure-controlled at Δp = {float(dp)!r}: UNTYPED {msg}")
     draw(ax, strains, res, "ODE(odeint), pressure-controlled (error of q)", "tab:brown", "P", ":")
     finish(ax, "inlet strain (R − a)/a", "relative error of the inlet displacement",
-           "(d) tiny to large strain (thick neo-Hookean, n = 0.7)")
+           "(d) tiny to large strain (thick neo-Hookean, n = 0.7)", legend_loc="lower left", bottom=1e-23)
 
 
 # ------------------------------------------------------------------------- (e, f) heat maps
@@ -394,16 +396,16 @@ def panel_heat(ax, fig, kind, log, n_points=12, tb_points=11):
                           norm=LogNorm(vmin=1e-16, vmax=1e-11), cmap="viridis", shading="flat")
     for j, i, mark in marks:
         ax.text(j + 0.5, i + 0.5, {"x": "×", "!": "!", "w": "w"}[mark], ha="center", va="center",
-                color="red", fontsize=12, fontweight="bold")
+                color="red", fontsize=14, fontweight="bold")
     for i in range(tbs.size):
         for j in range(ns.size):
             if np.isfinite(err[i, j]) and err[i, j] > 1e-12:
-                ax.text(j + 0.5, i + 0.5, f"{err[i, j]:.0e}", ha="center", va="center", fontsize=6, color="w")
-    ax.set_xticks(np.arange(ns.size) + 0.5, [f"{n:.2g}" for n in ns], fontsize=7, rotation=45)
-    ax.set_yticks(np.arange(tbs.size) + 0.5, [f"{t:.1g}" for t in tbs], fontsize=7)
+                ax.text(j + 0.5, i + 0.5, f"{err[i, j]:.0e}", ha="center", va="center", fontsize=8, color="w")
+    ax.set_xticks(np.arange(ns.size) + 0.5, [f"{n:.2g}" for n in ns], fontsize=11, rotation=45)
+    ax.set_yticks(np.arange(tbs.size) + 0.5, [f"{t:.1g}" for t in tbs], fontsize=11)
     ax.set_xlabel("power-law index n")
     ax.set_ylabel("t/a")
-    ax.set_title(title, fontsize=10)
+    ax.set_title(title, fontsize=12.5)
     bar = fig.colorbar(image, ax=ax, label="max rel. error (Δp, u, q)", extend="both")
     bar.ax.axhline(1e-12, color="w", lw=2)
     worst = np.nanmax(err)
@@ -426,7 +428,10 @@ def main(argv=None) -> int:
     heat = dict(n_points=3, tb_points=3) if args.quick else {}       # the heat maps (e, f)
     mp.dps = 30
     t0 = time.perf_counter()
-    fig, axes = plt.subplots(2, 3, figsize=(19, 12.5), constrained_layout=True)
+    # two columns, readable where the docs show it (about 900 px wide): 13-point text
+    plt.rcParams.update({"font.size": 13, "axes.labelsize": 13, "xtick.labelsize": 12, "ytick.labelsize": 12})
+    fig, axes = plt.subplots(3, 2, figsize=(14, 18), constrained_layout=True)
+    axes = axes.reshape(2, 3)     # the panels keep their letters (a)-(f), read row by row
     log: list[str] = []
     panels = [(panel_singular, axes[0, 0]), (panel_max_flow, axes[0, 1]), (panel_limit_pressure, axes[0, 2]),
               (panel_strain, axes[1, 0])]
@@ -438,8 +443,8 @@ def main(argv=None) -> int:
         t = time.perf_counter()
         panel_heat(ax, fig, kind, log, **heat)
         log.append(f"   [heat map {kind}: {time.perf_counter() - t:.1f} s]")
-    fig.legend(handles=status_marks(), loc="outside lower center", ncol=6, fontsize=10, frameon=False)
-    fig.suptitle("tubefsi stability map: errors against an independent mpmath reference", fontsize=12)
+    fig.legend(handles=status_marks(), loc="outside lower center", ncol=3, fontsize=12, frameon=False)
+    fig.suptitle("tubefsi stability map: errors against an independent mpmath reference", fontsize=15)
     path = outdir / "stability_map.png"
     fig.savefig(path, dpi=100)
     plt.close(fig)

@@ -449,3 +449,29 @@ def test_chapter_linear_closed_forms_agree_with_tubefsi(n, tb):
     for beta in BETAS:
         np.testing.assert_allclose(chapter.linear_pressure_drop(n, beta, QBAR, reduced_thickness=tb),
                                    linear(n, QBAR, beta, tb=tb), rtol=1e-12)
+
+
+def test_reproduced_figures_put_the_flow_rate_up_and_define_their_symbols():
+    """As the demo's flow curves: pressure drop across, flow rate up; the figure itself says what
+    the bars, beta and gamma are (under the legend, which the layout keeps inside the figure)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    curves = chapter.chapter_curves("thick", "consistent", points=11)
+    par = dict(chapter.CHAPTER_PARAMETERS)
+    fig = chapter._figure("thick", "consistent", curves, par, plt.get_cmap("viridis")([0.0, 0.4, 0.8]))
+    try:
+        for ax in fig.axes:
+            assert "pressure drop" in ax.get_xlabel() and "flow rate" in ax.get_ylabel()
+        first = fig.axes[0].get_lines()[0]
+        np.testing.assert_array_equal(first.get_ydata(), curves[0]["qbar"])
+        np.testing.assert_array_equal(first.get_xdata(), curves[0]["dpbar"])
+        (legend,) = fig.legends
+        title = legend.get_title().get_text()
+        for symbol in (r"\Delta\bar p =", r"\bar q =", r"\beta =", r"\gamma =", r"\mathcal{P}_c", r"\bar t = t/a"):
+            assert symbol in title, symbol
+        assert len(legend.get_texts()) == 2 * len(par["betas"])
+    finally:
+        plt.close(fig)

@@ -127,6 +127,35 @@ def test_help_and_version_start_without_scipy():
     assert out.splitlines()[-1] == "False False"
 
 
+def test_list_starts_without_scipy():
+    """``python -m tubefsi list`` imports every registered model (plugins too) and lists it, and
+    none of them loads SciPy before a computation needs it (tubefsi._lazy)."""
+    code = ("import runpy, sys\n"
+            "sys.argv = ['tubefsi', 'list']\n"
+            "try:\n"
+            "    runpy.run_module('tubefsi', run_name='__main__')\n"
+            "except SystemExit as exc:\n"
+            "    assert not exc.code, exc.code\n"
+            "loaded = sorted(m for m in sys.modules if m == 'scipy' or m.startswith('scipy.'))\n"
+            "print('SCIPY', loaded, 'matplotlib' in sys.modules, file=sys.stderr)\n")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    for name in ("thick-neo-hookean", "thin-fung", "ode", "quadrature", "newtonian", "bingham"):
+        assert f"  {name} " in run.stdout, name
+    assert run.stderr.strip().splitlines()[-1] == "SCIPY [] False"
+
+
+def test_lazy_scipy_modules_bind_themselves_on_first_use():
+    from tubefsi._lazy import lazy_module
+
+    namespace = {}
+    namespace["special"] = lazy_module("scipy.special", namespace, "special")
+    assert "lazy" in repr(namespace["special"])
+    assert namespace["special"].gamma(5.0) == 24.0                  # imports, then answers
+    import scipy.special
+
+    assert namespace["special"] is scipy.special                   # rebound: no proxy on later calls
+
+
 def test_progress_bar(capsys, monkeypatch):
     pytest.importorskip("tqdm")
     q = np.linspace(0.0, 1e-9, 7)

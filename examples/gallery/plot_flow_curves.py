@@ -6,7 +6,10 @@ A blood-like power-law fluid (m = 0.017 Pa s^n, n = 0.7) in a soft tube (a = 100
 t = 30 µm, L = 10 mm, shear modulus 2 kPa). The rigid tube is Hagen–Poiseuille; the linear
 walls are the small-strain limit of the neo-Hookean ones (E = 3µ, ν = 1/2); only the thick
 neo-Hookean wall has a limit pressure, hence a maximum steady flow rate for this
-shear-thinning fluid (dashed line).
+shear-thinning fluid (dashed line). The linear walls warn (``ModelValidityWarning``): over most
+of their curves the inlet strain is past the 5 % of their small-strain theory. Each curve stops
+where the inflated inlet would reach a tenth of the tube's length (the slender-tube limit), and
+the axes are in µL/min and Pa.
 """
 
 import matplotlib.pyplot as plt
@@ -25,6 +28,6 @@ for label, wall in [("thin linear", walls["thin-linear"](youngs_modulus=3 * mu, 
                     ("thin neo-Hookean", walls["thin-neo-hookean"](shear_modulus=mu)),
                     ("thick neo-Hookean", walls["thick-neo-hookean"](shear_modulus=mu))]:
     plot_flow_curve(fluid, wall, tube, ax=ax, label=label, rigid=label == "thin linear")
-ax.legend()
+ax.legend(loc="lower right")
 ax.set_title("power-law fluid, n = 0.7, in a 2 kPa tube")
 plt.show()

@@ -274,6 +274,54 @@ def _title(figure, variant, tb):
     return f"{wall}, consistent: hyperelastic at γ = 3β (the same E = 3μ as the linear wall), tubefsi"
 
 
+#: What the figures' symbols mean, printed on every figure (``docs/verification.md``).
+_DEFINITIONS = (r"$\Delta\bar p = \Delta p/\mathcal{P}_c$ and $\bar q = q/(\mathcal{V}_z\,\pi a^2)$ at a fixed "
+               r"pressure scale $\mathcal{P}_c$, with $\mathcal{V}_z = [a^{n+1}\mathcal{P}_c/(mL)]^{1/n}$; "
+               r"$\beta = \mathcal{P}_c/(E\,\bar t)$, $\gamma = \mathcal{P}_c/(\mu\,\bar t)$, $\bar t = t/a$"
+               "\n(power-law fluid $\\tau = m\\dot\\gamma^n$ in a tube of radius $a$, thickness $t$, length $L$; "
+               "wall of Young's modulus $E$, shear modulus $\\mu$)")
+
+
+def _figure(figure, variant, curves, par, colors):
+    """One reproduced figure: a panel per flow index, :math:`\\bar q` against :math:`\\Delta\\bar p`
+    (flow rate up, pressure drop across, as the flow curves of :mod:`tubefsi.plotting`), the
+    symbols defined under the legend."""
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, len(par["indices"]), figsize=(11.5, 5.9), layout="constrained")
+    axes = np.atleast_1d(axes)
+    for ax, n in zip(axes, par["indices"]):
+        for color, b in zip(colors, par["betas"]):
+            for c in curves:
+                if c["n"] != n or c["beta"] != b:
+                    continue
+                hyper = c["wall"] == "hyperelastic"
+                label = (f"β = {b:g}, hyperelastic (γ = {c['gamma']:.3g})" if hyper
+                         else f"β = {b:g}, linear")
+                ax.plot(c["dpbar"], c["qbar"], "-" if hyper else "--", color=color, lw=2.0 if hyper else 1.6,
+                        label=label)
+                if hyper and math.isfinite(c["qbar_max"]) and c["qbar_max"] <= c["qbar"][-1]:
+                    ok = np.isfinite(c["dpbar"])
+                    ax.plot(c["dpbar"][ok][-1], c["qbar"][ok][-1], "x", color=color, ms=9, mew=2)
+        kind = "Newtonian" if n == 1 else ("shear-thinning" if n < 1 else "shear-thickening")
+        ax.set_title(f"n = {n:g} ({kind})", fontsize=12)
+        ax.set_xlabel(r"dimensionless pressure drop $\Delta\bar p$", fontsize=12)
+        ax.set_ylabel(r"dimensionless flow rate $\bar q$", fontsize=12)
+        ax.set_ylim(par["qbar"])
+        ax.set_xlim(left=0.0)
+        ax.tick_params(labelsize=10)
+        ax.grid(alpha=0.3)
+    handles, labels = axes[0].get_legend_handles_labels()   # one column per beta
+    legend = fig.legend(handles, labels, loc="outside lower center", ncol=len(par["betas"]), fontsize=10,
+                        frameon=False, title=_DEFINITIONS, title_fontsize=9.5)
+    legend.get_title().set_multialignment("center")
+    note = ("solid: hyperelastic Mooney–Rivlin, dashed: linear (ν = 1/2)"
+            + ("; ×: last steady state (maximum flow rate)" if any(
+                math.isfinite(c["qbar_max"]) and c["qbar_max"] <= c["qbar"][-1] for c in curves) else ""))
+    fig.suptitle(_title(figure, variant, par["thick_reduced_thickness"]) + "\n" + note, fontsize=11.5)
+    return fig
+
+
 def _write_csv(path, figure, variant, curves):
     with open(path, "w", newline="") as fh:
         w = csv.writer(fh, lineterminator="\n")
@@ -314,36 +362,7 @@ def reproduce_chapter(output_dir="chapter-figures", *, points=None, parameters=N
                 written.append(_write_csv(out / f"{stem}.csv", figure, variant, curves))
             if "png" not in formats:
                 continue
-            fig, axes = plt.subplots(1, len(par["indices"]), figsize=(11.5, 5.4), layout="constrained")
-            axes = np.atleast_1d(axes)
-            for ax, n in zip(axes, par["indices"]):
-                for color, b in zip(colors, par["betas"]):
-                    for c in curves:
-                        if c["n"] != n or c["beta"] != b:
-                            continue
-                        hyper = c["wall"] == "hyperelastic"
-                        label = (f"β = {b:g}, hyperelastic (γ = {c['gamma']:.3g})" if hyper
-                                 else f"β = {b:g}, linear")
-                        ax.plot(c["qbar"], c["dpbar"], "-" if hyper else "--", color=color, lw=2.0 if hyper else 1.6,
-                                label=label)
-                        if hyper and math.isfinite(c["qbar_max"]) and c["qbar_max"] <= c["qbar"][-1]:
-                            ok = np.isfinite(c["dpbar"])
-                            ax.plot(c["qbar"][ok][-1], c["dpbar"][ok][-1], "x", color=color, ms=9, mew=2)
-                kind = "Newtonian" if n == 1 else ("shear-thinning" if n < 1 else "shear-thickening")
-                ax.set_title(f"n = {n:g} ({kind})", fontsize=12)
-                ax.set_xlabel(r"dimensionless flow rate $\bar q$", fontsize=12)
-                ax.set_ylabel(r"dimensionless pressure drop $\Delta\bar p$", fontsize=12)
-                ax.set_xlim(par["qbar"])
-                ax.set_ylim(bottom=0.0)
-                ax.tick_params(labelsize=10)
-                ax.grid(alpha=0.3)
-            handles, labels = axes[0].get_legend_handles_labels()   # one column per beta
-            fig.legend(handles, labels, loc="outside lower center", ncol=len(par["betas"]), fontsize=10,
-                       frameon=False)
-            note = ("solid: hyperelastic Mooney–Rivlin, dashed: linear (ν = 1/2)"
-                    + ("; ×: last steady state (maximum flow rate)" if any(
-                        math.isfinite(c["qbar_max"]) and c["qbar_max"] <= c["qbar"][-1] for c in curves) else ""))
-            fig.suptitle(_title(figure, variant, par["thick_reduced_thickness"]) + "\n" + note, fontsize=11.5)
+            fig = _figure(figure, variant, curves, par, colors)
             fig.savefig(out / f"{stem}.png", dpi=110)
             plt.close(fig)
             written.append(out / f"{stem}.png")

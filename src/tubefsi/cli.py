@@ -24,7 +24,8 @@ exit status 2; a result outside the model's assumptions prints ``tubefsi: warnin
 lines on stderr (:mod:`tubefsi.validity`).
 
 The command starts fast: ``--help``, ``--version`` import only the standard library and
-the registry; the models and SciPy load when a command needs them.
+the registry; ``list`` imports every registered model but not SciPy, which the models load on
+first use (:mod:`tubefsi._lazy`); ``python -m tubefsi`` runs the same command.
 """
 
 from __future__ import annotations
@@ -513,7 +514,7 @@ def _cmd_network(args, out) -> int:
         except ImportError:
             raise UsageError("--plot needs the nodes' positions (a 'positions' object in FILE) or networkx "
                              "for a layout: pip install 'tubefsi[network]'") from None
-    result = net.solve()
+    result = net.solve(progress="auto")      # a bar on a terminal, when tqdm is installed
     if args.format == "csv":
         for written in result.to_csv(args.output):
             print(f"wrote {written}", file=out)

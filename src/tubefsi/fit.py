@@ -20,6 +20,7 @@ import attrs
 import numpy as np
 from scipy import optimize
 
+from ._progress import bar
 from .errors import InvalidParameterError, ModelValidityWarning, TubefsiError
 from .scene import make_scene
 from .solve import solve
@@ -56,7 +57,7 @@ def _split(name):
 
 
 def fit(flow_rate, pressure_drop, rheology, wall, tube, *, parameters, outlet_pressure=0.0,
-        coupler="auto") -> FitResult:
+        coupler="auto", progress=False) -> FitResult:
     """Least-squares calibration of ``parameters`` from data.
 
     Parameters
@@ -69,6 +70,10 @@ def fit(flow_rate, pressure_drop, rheology, wall, tube, *, parameters, outlet_pr
     parameters : sequence of str
         Fields to fit, as ``"wall.<field>"`` or ``"rheology.<field>"``,
         e.g. ``["wall.shear_modulus", "rheology.consistency", "rheology.index"]``.
+    progress : bool or "auto"
+        Show a progress bar counting the model evaluations (one solve over every data point
+        each; tqdm, ``pip install 'tubefsi[progress]'``); ``"auto"``: only if tqdm is installed
+        and standard error is a terminal.
 
     Returns
     -------
@@ -114,6 +119,7 @@ def fit(flow_rate, pressure_drop, rheology, wall, tube, *, parameters, outlet_pr
         """Models, model drops and the solution at ``theta`` (cached: the Jacobian reuses them)."""
         key = theta.tobytes()
         if key not in cache:
+            shown.update()
             m = build(theta)
             # beyond the maximum flow rate the drop is continued by its supremum, the limit
             # pressure rise, so trial parameters with no steady state still steer the fit
@@ -171,8 +177,12 @@ def fit(flow_rate, pressure_drop, rheology, wall, tube, *, parameters, outlet_pr
     # log parameters may move by a factor of up to 1e4 from their starting values
     start = np.array(start)
     span = np.where(logs, math.log(1e4), np.inf)
-    res = optimize.least_squares(residuals, start, jac=jacobian, bounds=(start - span, start + span), x_scale="jac",
-                                 xtol=1e-12, ftol=1e-12, gtol=1e-12)
+    shown = bar(None, progress, "tubefsi.fit", unit="evaluation")   # the count of evaluations is not known
+    try:
+        res = optimize.least_squares(residuals, start, jac=jacobian, bounds=(start - span, start + span),
+                                     x_scale="jac", xtol=1e-12, ftol=1e-12, gtol=1e-12)
+    finally:
+        shown.close()
     dof = max(q.size - len(names), 1)
     s2 = 2.0 * res.cost / dof
     try:

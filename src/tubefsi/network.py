@@ -53,6 +53,7 @@ import scipy.sparse as sp
 from scipy.sparse import csgraph
 from scipy.sparse import linalg as spla
 
+from ._progress import bar
 from ._validation import as_array
 from . import validity
 from .errors import (AccuracyWarning, ConvergenceError, InvalidParameterError, ModelValidityWarning,
@@ -222,8 +223,12 @@ class Network:
         return graph
 
     # ------------------------------------------------------------------ solving
-    def solve(self, *, rtol=1e-13, max_iterations=100) -> NetworkSolution:
+    def solve(self, *, rtol=1e-13, max_iterations=100, progress=False) -> NetworkSolution:
         """The steady state: node pressures and tube flow rates (a :class:`NetworkSolution`).
+
+        ``progress`` (bool or ``"auto"``) shows a progress bar over the Newton iterations (tqdm,
+        ``pip install 'tubefsi[progress]'``; ``"auto"``: only if tqdm is installed and standard
+        error is a terminal); it ends at convergence, usually well before ``max_iterations``.
 
         Raises
         ------
@@ -244,7 +249,12 @@ class Network:
         rtol = float(as_array("rtol", rtol, "[1e-15, 1)", lambda a: (a >= 1e-15) & (a < 1)))
         if isinstance(max_iterations, bool) or not isinstance(max_iterations, int) or max_iterations < 1:
             raise InvalidParameterError("max_iterations", "the integers >= 1", max_iterations)
-        return _Solver(self._snapshot()).run(rtol, max_iterations)
+        solver = _Solver(self._snapshot())
+        shown = bar(max_iterations, progress, "tubefsi.Network.solve", unit="Newton step")
+        try:
+            return solver.run(rtol, max_iterations, shown)
+        finally:
+            shown.close()
 
     def _snapshot(self):
         """A copy that later changes to this network do not reach (the solution keeps it)."""
@@ -550,7 +560,7 @@ class _Solver:
                                    f"rate at pressure drop {drop[i]:.6g} Pa, outlet pressure {outlet[i]:.6g} Pa")
         return q, d_in, d_out
 
-    def run(self, rtol, max_iterations):
+    def run(self, rtol, max_iterations, shown=None):
         p, c = self._rigid_start()
         self.c = c
         free = self.free
@@ -600,6 +610,8 @@ class _Solver:
                                            f"largest mass imbalance {worst:.3e} m^3/s = {worst / through:.3e} of the "
                                            f"throughput (rtol {rtol:g})")
             p, q, gu, gv, r_u, r_v, balance = trial, t_q, t_gu, t_gv, t_ru, t_rv, t_balance
+            if shown is not None:
+                shown.update()
         raise ConvergenceError(f"network: no convergence in {max_iterations} Newton iterations; largest mass "
                                f"imbalance {worst:.3e} m^3/s = {worst / through:.3e} of the throughput (rtol {rtol:g})")
 

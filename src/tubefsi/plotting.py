@@ -18,9 +18,10 @@ is called.
   wide as their deformed radius (Axes).
 
 ``WallModel.plot`` and ``Solution.plot`` are shortcuts for :func:`plot_tube_law`
-and :func:`plot_profiles`. Quantities are SI except lengths on the axes of
-solution plots, which are in millimetres (and velocities in mm/s), the natural
-scale of the microfluidic tubes tubefsi is made for.
+and :func:`plot_profiles`. Arguments are SI; each axis shows its quantity in the unit that
+suits its data (flow rates in nL/min, µL/min or mL/min, pressures in Pa or kPa, lengths in µm
+or mm, velocities in mm/s, ...), so that no tick label needs an offset such as "1e-8"; the
+axis label names the unit, and curves drawn later onto the same Axes keep it.
 
 Example::
 
@@ -37,13 +38,15 @@ Example::
 from __future__ import annotations
 
 import math
+import warnings
 
 import attrs
 import numpy as np
 
 from . import registry
-from .errors import InvalidParameterError, NoSteadyStateError, StretchRangeError
+from .errors import InvalidParameterError, ModelValidityWarning, NoSteadyStateError, StretchRangeError
 from .solve import max_flow_rate, solve
+from .validity import SLENDERNESS
 from .walls.hyperelastic import HyperelasticWall
 
 __all__ = [
@@ -55,8 +58,65 @@ __all__ = [
     "plot_network",
 ]
 
-_MM = 1e3            # metres -> millimetres
 _TANGENT_GID = "tubefsi-small-strain-tangent"
+
+# Display units: (symbol, size in SI), smallest first. An axis shows its quantity in the largest
+# unit not larger than the data's magnitude, so that tick labels need no offset ("1e-8") and read
+# as numbers of the scale the field uses (µL/min, kPa, µm).
+_UNITS = {
+    "flow_rate": (("pL/min", 1e-15 / 60), ("nL/min", 1e-12 / 60), ("µL/min", 1e-9 / 60),
+                  ("mL/min", 1e-6 / 60), ("L/min", 1e-3 / 60)),
+    "pressure": (("mPa", 1e-3), ("Pa", 1.0), ("kPa", 1e3), ("MPa", 1e6), ("GPa", 1e9)),
+    "length": (("nm", 1e-9), ("µm", 1e-6), ("mm", 1e-3), ("m", 1.0)),
+    "velocity": (("µm/s", 1e-6), ("mm/s", 1e-3), ("m/s", 1.0)),
+}
+
+
+def _unit(kind, magnitude):
+    """``(symbol, size)`` of the display unit of ``kind`` for data of largest size ``magnitude`` (SI)."""
+    units = _UNITS[kind]
+    m = abs(float(magnitude)) if np.isfinite(magnitude) else 0.0
+    if m == 0.0:
+        return units[1] if kind != "length" else units[2]
+    best = units[0]
+    for unit in units:
+        if unit[1] <= m * (1 + 1e-12):
+            best = unit
+    return best
+
+
+def _axes_unit(ax, axis, kind, magnitude):
+    """The unit of an Axes' ``axis`` ("x"/"y"): chosen by the first call, kept by later ones, so
+    that curves drawn onto one Axes share its scale."""
+    store = ax.__dict__.setdefault("_tubefsi_units", {})
+    if axis not in store:
+        store[axis] = _unit(kind, magnitude)
+    return store[axis]
+
+
+def _scaled_formatter(size):
+    """A tick formatter showing ``value / size`` (a colour bar kept in SI, read in a display unit)."""
+    from matplotlib.ticker import FuncFormatter
+
+    return FuncFormatter(lambda v, _pos: f"{v / size:g}")
+
+
+def _fmt_q(q) -> str:
+    """A flow rate (m^3/s) in its display unit, for titles and legends."""
+    sym, size = _unit("flow_rate", q)
+    return _fmt(q / size, sym)
+
+
+def _fmt_len(x) -> str:
+    """A length (m) in its display unit."""
+    sym, size = _unit("length", x)
+    return _fmt(x / size, sym)
+
+
+def _fmt_p(p) -> str:
+    """A pressure (Pa) in its display unit."""
+    sym, size = _unit("pressure", p)
+    return _fmt(p / size, sym)
 
 
 # ---------------------------------------------------------------------------- helpers
@@ -151,8 +211,39 @@ def _subset(solution, max_loads):
 
 
 # ---------------------------------------------------------------------------- tube law
-def plot_tube_law(wall, reduced_thickness, *, ax=None, max_stretch=3.0, normalize=True, label=None,
-                  color=None):
+def _pressure_scale(ax, wall, tb, normalize, scale_name, magnitude):
+    """``(scale in Pa, ylabel, unit symbol or None if dimensionless)`` of a tube-law Axes: one scale
+    per Axes, fixed by its first wall."""
+    store = ax.__dict__.setdefault("_tubefsi_units", {})
+    if "tube_law" in store:
+        return store["tube_law"]
+    if wall.is_rigid and normalize is True:
+        raise InvalidParameterError("normalize", "False or a pressure scale, for a rigid wall first on an Axes",
+                                    True, "a rigid wall has no small-strain modulus to normalize by")
+    if normalize is False:
+        sym, size = _unit("pressure", magnitude)
+        scale = (size, f"transmural pressure $p$ ({sym})", sym)
+    elif normalize is True:
+        k0 = wall.small_strain_modulus(tb)
+        name = scale_name or "k_0"
+        scale = (k0, rf"$p\,/\,{name}$,  ${name}$ = {_fmt_p(k0)} ($dp/d\lambda$ at $\lambda = 1$ of "
+                     f"{_model_name(wall, 'wall')})", None)
+    else:
+        try:
+            value = float(normalize)
+        except (TypeError, ValueError):
+            raise InvalidParameterError("normalize", "True, False or a pressure scale in (0, inf) Pa",
+                                        normalize) from None
+        if not (math.isfinite(value) and value > 0):
+            raise InvalidParameterError("normalize", "True, False or a pressure scale in (0, inf) Pa", normalize)
+        name = scale_name or "p_0"
+        scale = (value, rf"$p\,/\,{name}$,  ${name}$ = {_fmt_p(value)}", None)
+    store["tube_law"] = scale
+    return scale
+
+
+def plot_tube_law(wall, reduced_thickness, *, ax=None, max_stretch=3.0, normalize=False, scale_name=None,
+                  label=None, color=None):
     r"""Plot a wall's tube law: transmural pressure :math:`p` against hoop stretch :math:`\lambda = R/a`.
 
     Parameters
@@ -165,18 +256,27 @@ def plot_tube_law(wall, reduced_thickness, *, ax=None, max_stretch=3.0, normaliz
     max_stretch : float
         Right end of the stretch axis (> 1); clipped just below the wall's own
         maximum stretch, if it has one.
-    normalize : bool
-        Divide pressures by the small-strain modulus :math:`k_0 = dp/d\lambda|_{\lambda=1}`
-        (then every law starts with slope 1); otherwise plot pressures in Pa.
+    normalize : bool or float
+        The pressure scale, **one per Axes** (the first wall drawn on an Axes fixes it, and
+        the walls drawn after it share it, so their curves compare): ``False`` (default)
+        pressures in Pa or kPa, whichever reads best; ``True`` divided by the small-strain
+        modulus :math:`k_0 = dp/d\lambda|_{\lambda=1}` *of the first wall* (which then starts
+        with slope 1); a number divides by that pressure (Pa), e.g. the material's shear
+        modulus. The y label states the scale and its value.
+    scale_name : str, optional
+        TeX symbol of the scale in the y label (``"k_0"`` for ``True``, ``"p_0"`` for a number;
+        e.g. ``r"\mu"``).
     label : str, optional
         Legend entry; defaults to the wall's registered name.
     color : matplotlib color, optional
         Colour of the curve (and its limit line); the Axes' colour cycle otherwise.
 
     Draws the tube law (solid), its linear small-strain tangent :math:`k_0(\lambda-1)`
-    (faint; with ``normalize`` drawn once per Axes, since it is then the same line for
-    every wall) and, when finite, the limit pressure as a dashed horizontal line in the
-    curve's colour. A rigid wall is the vertical line :math:`\lambda = 1` only.
+    (faint, in the curve's colour; one legend entry per Axes) and, when finite, the limit
+    pressure as a dashed horizontal line in the curve's colour, labelled in the axis' own
+    scale. A rigid wall is the vertical line :math:`\lambda = 1` on a pressure axis in
+    pascals, and is not drawn on a dimensionless one (it has no small-strain modulus; its
+    law is :math:`\lambda = 1` at every pressure).
 
     Returns
     -------
@@ -191,21 +291,20 @@ def plot_tube_law(wall, reduced_thickness, *, ax=None, max_stretch=3.0, normaliz
         raise InvalidParameterError("max_stretch", "(1, inf)", max_stretch)
     label = _model_name(wall, "wall") if label is None else label
     ax = _new_axes(ax, (6.0, 4.2))
-    ax.set_xlabel(r"hoop stretch $\lambda = R/a$")
-    if normalize:
-        ax.set_ylabel(r"$p\,/\,k_0$   ($k_0 = dp/d\lambda$ at $\lambda = 1$)")
-    else:
-        ax.set_ylabel("transmural pressure $p$ (Pa)")
     if not ax.get_title():
         ax.set_title(f"Tube law, $t/a$ = {tb:.3g}")
-
+    ax.set_xlabel(r"hoop stretch $\lambda = R/a$")
     if wall.is_rigid:
-        ax.axvline(1.0, color="0.15" if color is None else color, lw=2.0, label=label)
+        scale, ylabel, unit = _pressure_scale(ax, wall, tb, normalize, scale_name, 1e3)
+        ax.set_ylabel(ylabel)
+        if unit is not None:
+            ax.axvline(1.0, color="0.15" if color is None else color, lw=2.0, label=label)
         # keep the stretch axis as wide as for the other walls, without freezing autoscaling
         ax.update_datalim([(1.0, 0.0), (max_stretch, 0.0)], updatey=False)
         ax.autoscale_view()
         ax.grid(True, alpha=0.25)
-        ax.legend(frameon=False)
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(frameon=False)
         return ax
 
     lam_cap = wall.max_stretch(tb)
@@ -213,34 +312,24 @@ def plot_tube_law(wall, reduced_thickness, *, ax=None, max_stretch=3.0, normaliz
     lam = np.linspace(1.0, hi, 400)
     p = np.asarray(wall.pressure(lam, tb), dtype=float)
     k0 = wall.small_strain_modulus(tb)
-    scale = k0 if normalize else 1.0
+    scale, ylabel, unit = _pressure_scale(ax, wall, tb, normalize, scale_name, float(np.max(p)))
+    ax.set_ylabel(ylabel)
     (line,) = ax.plot(lam, p / scale, lw=2.0, label=label, color=color)
     line.sticky_edges.y.append(0.0)   # pressures start at 0, even on a shared Axes
     color = line.get_color()
 
-    # the small-strain tangent, drawn only as high as the curves go (so it does not set the scale)
+    # the small-strain tangent, drawn only as high as the curve goes (so it does not set the scale)
     lim = wall.limit_pressure(tb)
     top = max(float(p[-1]), lim if math.isfinite(lim) else 0.0) * 1.08
     lam_t = np.linspace(1.0, min(hi, 1.0 + top / k0), 50)
-    if not normalize:
-        ax.plot(lam_t, k0 * (lam_t - 1.0), color=color, lw=1.0, alpha=0.35, ls="-",
-                label="_nolegend_", gid=_TANGENT_GID)
-    else:
-        existing = [ln for ln in ax.get_lines() if ln.get_gid() == _TANGENT_GID]
-        if existing:
-            old = existing[0]
-            x0 = np.asarray(old.get_xdata(), dtype=float)
-            if lam_t[-1] > x0[-1]:
-                old.set_data(lam_t, lam_t - 1.0)
-                ax.relim()
-                ax.autoscale_view()
-        else:
-            ax.plot(lam_t, lam_t - 1.0, color="0.5", lw=1.0, alpha=0.6,
-                    label="small-strain tangent", gid=_TANGENT_GID)
+    first = not any(ln.get_gid() == _TANGENT_GID for ln in ax.get_lines())
+    ax.plot(lam_t, k0 * (lam_t - 1.0) / scale, color=color, lw=1.0, alpha=0.4, ls="-",
+            label="small-strain tangents" if first else "_nolegend_", gid=_TANGENT_GID)
 
     if math.isfinite(lim):
         ax.axhline(lim / scale, color=color, lw=1.0, ls="--", label="_nolegend_")
-        ax.annotate(f"limit {_fmt(lim, 'Pa')}", xy=(hi, lim / scale), xytext=(-4, 3),
+        text = f"limit {lim / scale:.3g}" if unit is None else f"limit {_fmt_p(lim)}"
+        ax.annotate(text, xy=(hi, lim / scale), xytext=(-4, 3),
                     textcoords="offset points", ha="right", va="bottom", color=color, fontsize=8)
     ax.grid(True, alpha=0.25)
     ax.legend(frameon=False)
@@ -248,8 +337,36 @@ def plot_tube_law(wall, reduced_thickness, *, ax=None, max_stretch=3.0, normaliz
 
 
 # ---------------------------------------------------------------------------- flow curve
-def _default_flow_rates(scene_sol, tube, n, outlet_pressure):
-    """``0..0.9 q_max`` if the maximum flow rate is finite, else a rigid-tube estimate.
+def _valid_flow_rate(fluid, wall, tube, outlet_pressure, coupler):
+    """The flow rate at which the deformed tube stops being slender (``docs/scope.md``): the inlet
+    radius reaches :data:`tubefsi.validity.SLENDERNESS` times the length; ``inf`` if that is beyond
+    the wall's range or limit pressure."""
+    tb = tube.reduced_thickness
+    # a hair inside the limit, so that this probe's own solve does not warn
+    lam = 1.0 + (1.0 - 1e-6) * (SLENDERNESS * tube.length / tube.radius - 1.0)
+    if wall.is_rigid or not lam < wall.max_stretch(tb):
+        return math.inf
+    try:
+        dp = float(wall.pressure(lam, tb)) - outlet_pressure
+    except (TypeError, ValueError):      # array-valued wall parameters: no single limit
+        return math.inf
+    if not (math.isfinite(dp) and dp > 0):
+        return math.inf
+    lim = wall.limit_pressure(tb)
+    if math.isfinite(lim) and dp >= lim - outlet_pressure:
+        return math.inf
+    try:
+        with warnings.catch_warnings():     # a probe: the curve drawn is checked, not this point
+            warnings.simplefilter("ignore", ModelValidityWarning)
+            return float(solve(fluid, wall, tube, pressure_drop=dp, outlet_pressure=outlet_pressure,
+                               coupler=coupler).flow_rate)
+    except (NoSteadyStateError, StretchRangeError):
+        return math.inf
+
+
+def _default_flow_rates(scene_sol, tube, n, outlet_pressure, coupler="auto"):
+    """``0..0.9 q_max`` if the maximum flow rate is finite, else a rigid-tube estimate; either
+    stopped at 99 % of the flow rate where the tube stops being slender (:func:`_valid_flow_rate`).
 
     The estimate is the rigid-tube flow rate at a pressure drop of the wall's
     small-strain modulus (the pressure that would double the radius by the linear
@@ -258,16 +375,18 @@ def _default_flow_rates(scene_sol, tube, n, outlet_pressure):
     fluid, wall = scene_sol.rheology, scene_sol.wall
     q_max = max_flow_rate(fluid, wall, tube, outlet_pressure=outlet_pressure)
     if math.isfinite(q_max):
-        return np.linspace(0.0, 0.9 * q_max, n), q_max
-    tb = tube.reduced_thickness
-    if wall.is_rigid:
-        dp = 1e3
+        q_hi = 0.9 * q_max
     else:
-        dp = wall.small_strain_modulus(tb)
-        lim = wall.limit_pressure(tb)
-        if math.isfinite(lim):
-            dp = min(dp, 0.9 * (lim - outlet_pressure))
-    q_hi = float(fluid.flow_rate(tube.radius, dp / tube.length))
+        tb = tube.reduced_thickness
+        if wall.is_rigid:
+            dp = 1e3
+        else:
+            dp = wall.small_strain_modulus(tb)
+            lim = wall.limit_pressure(tb)
+            if math.isfinite(lim):
+                dp = min(dp, 0.9 * (lim - outlet_pressure))
+        q_hi = float(fluid.flow_rate(tube.radius, dp / tube.length))
+    q_hi = min(q_hi, 0.99 * _valid_flow_rate(fluid, wall, tube, outlet_pressure, coupler))
     return np.linspace(0.0, q_hi, n), q_max
 
 
@@ -285,7 +404,11 @@ def plot_flow_curve(rheology, wall, tube, *, flow_rates=None, ax=None, n=200, la
         less: for a power law with n close to 1 the inlet radius diverges long before
         :math:`q_{max}`), else from 0 to the rigid-tube flow rate at a
         pressure drop of the wall's small-strain modulus (capped at 90 % of its limit
-        pressure; 1 kPa for a rigid wall).
+        pressure; 1 kPa for a rigid wall); in either case stopped at 99 % of the flow rate
+        where the deformed tube stops being slender (inlet radius :math:`R_{in} = 0.1 L`,
+        ``docs/scope.md``), so that the default curve of a hyperelastic wall draws without a
+        :class:`~tubefsi.ModelValidityWarning` (a linear wall still warns once its inlet strain
+        passes its calibrated 5 %).
     ax : matplotlib Axes, optional
         Draw here (several walls can share one Axes); a new figure otherwise.
     n : int
@@ -304,7 +427,9 @@ def plot_flow_curve(rheology, wall, tube, *, flow_rates=None, ax=None, n=200, la
     Draws the curve (one solve over the whole array of flow rates), the rigid
     reference, and, when finite, the maximum flow rate (dashed horizontal) and the
     largest possible pressure drop, limit pressure minus outlet pressure (dotted
-    vertical), in the curve's colour.
+    vertical), in the curve's colour. The axes are in the units that suit the first curve
+    drawn on them (flow rates in nL/min, µL/min or mL/min, pressures in Pa or kPa; the labels
+    say which), kept for the curves drawn after it.
 
     Returns
     -------
@@ -313,7 +438,7 @@ def plot_flow_curve(rheology, wall, tube, *, flow_rates=None, ax=None, n=200, la
     probe = solve(rheology, wall, tube, flow_rate=0.0, outlet_pressure=outlet_pressure, coupler=coupler)
     fluid, wall = probe.rheology, probe.wall
     if flow_rates is None:
-        q, q_max = _default_flow_rates(probe, tube, _check_count("n", n), outlet_pressure)
+        q, q_max = _default_flow_rates(probe, tube, _check_count("n", n), outlet_pressure, coupler)
     else:
         q = np.ravel(np.asarray(flow_rates, dtype=float))
         q_max = max_flow_rate(fluid, wall, tube, outlet_pressure=outlet_pressure)
@@ -327,43 +452,53 @@ def plot_flow_curve(rheology, wall, tube, *, flow_rates=None, ax=None, n=200, la
         q = np.linspace(0.0, 0.9 * exc.limit, q.size)
         sol = solve(fluid, wall, tube, flow_rate=q, outlet_pressure=outlet_pressure, coupler=coupler)
     label = _model_name(wall, "wall") if label is None else label
+    dp = np.asarray(sol.pressure_drop, dtype=float)
 
     ax = _new_axes(ax, (6.0, 4.2))
-    (line,) = ax.plot(sol.pressure_drop, q, lw=2.0, label=label, color=color)
+    p_sym, p_unit = _axes_unit(ax, "x", "pressure", np.max(dp, initial=0.0))
+    q_sym, q_unit = _axes_unit(ax, "y", "flow_rate", np.max(q, initial=0.0))
+    (line,) = ax.plot(dp / p_unit, q / q_unit, lw=2.0, label=label, color=color)
     line.sticky_edges.x.append(0.0)
     line.sticky_edges.y.append(0.0)
     color = line.get_color()
     if rigid and not wall.is_rigid:
         # a soft tube conducts far more than a rigid one: draw the reference over the soft
         # curve's pressure range (plus 30 %), so that it does not squeeze the curve it explains
-        dp_top = 1.3 * float(np.max(sol.pressure_drop, initial=0.0))
+        dp_top = 1.3 * float(np.max(dp, initial=0.0))
         if dp_top > 0:
             dp_ref = np.linspace(0.0, dp_top, max(q.size, 50))
             q_ref = fluid.flow_rate(tube.radius, dp_ref / tube.length)
-            ax.plot(dp_ref, q_ref, color="0.45", lw=1.2, ls="--", label="rigid tube")
+            ax.plot(dp_ref / p_unit, q_ref / q_unit, color="0.45", lw=1.2, ls="--", label="rigid tube")
     if math.isfinite(q_max):
-        ax.axhline(q_max, color=color, lw=1.0, ls="--", label="_nolegend_")
-        ax.annotate(f"$q_{{max}}$ = {_fmt(q_max, 'm³/s')}", xy=(0.0, q_max), xycoords=("axes fraction", "data"),
-                    xytext=(4, -3), textcoords="offset points", ha="left", va="top", color=color, fontsize=8)
+        ax.axhline(q_max / q_unit, color=color, lw=1.0, ls="--", label="_nolegend_")
+        ax.annotate(f"$q_{{max}}$ = {_fmt(q_max / q_unit, q_sym)}", xy=(0.0, q_max / q_unit),
+                    xycoords=("axes fraction", "data"), xytext=(4, -3), textcoords="offset points",
+                    ha="left", va="top", color=color, fontsize=8)
     lim = wall.limit_pressure(tube.reduced_thickness)
     if math.isfinite(lim):
-        ax.axvline(lim - outlet_pressure, color=color, lw=1.0, ls=":", label="_nolegend_")
-        ax.annotate(f"limit {_fmt(lim - outlet_pressure, 'Pa')}", xy=(lim - outlet_pressure, 0.4),
+        x_lim = (lim - outlet_pressure) / p_unit
+        ax.axvline(x_lim, color=color, lw=1.0, ls=":", label="_nolegend_")
+        ax.annotate(f"limit {_fmt_p(lim - outlet_pressure)}", xy=(x_lim, 0.4),
                     xycoords=("data", "axes fraction"), xytext=(3, 0), textcoords="offset points",
                     rotation=90, ha="left", va="bottom", color=color, fontsize=8)
-    ax.set_xlabel(r"pressure drop $\Delta p$ (Pa)")
-    ax.set_ylabel("flow rate $q$ (m³/s)")
+    ax.set_xlabel(rf"pressure drop $\Delta p$ ({p_sym})")
+    ax.set_ylabel(f"flow rate $q$ ({q_sym})")
     if not ax.get_title():
         ax.set_title(f"Flow curve: {_model_name(fluid, 'rheology')} fluid")
     ax.update_datalim([(0.0, 0.0)])       # from the origin, without freezing autoscaling
     ax.autoscale_view()
-    ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 3))
     ax.grid(True, alpha=0.25)
     ax.legend(frameon=False)
     return ax
 
 
 # ---------------------------------------------------------------------------- profiles
+#: The limit pressure is drawn on a profile's pressure axis only if it lies below this multiple
+#: of the largest pressure drawn; higher, it is stated at the top of the axis instead (drawn,
+#: it would squeeze the profiles into the bottom of the panel).
+_LIMIT_SHOWN_BELOW = 1.25
+
+
 def plot_profiles(solution, *, axes=None, n=200, max_loads=8):
     r"""Plot the pressure :math:`p(z)` and the radius :math:`R(z)/a` along the tube.
 
@@ -371,8 +506,8 @@ def plot_profiles(solution, *, axes=None, n=200, max_loads=8):
     ----------
     solution : Solution
         A single load gives one line per panel; a curve of loads gives one line per
-        load for at most ``max_loads`` loads evenly spread over the flow rates,
-        coloured by flow rate (with a colorbar).
+        load for at most ``max_loads`` loads evenly spread over the flow rates, each in its
+        own colour, with a legend of their flow rates.
     axes : pair of matplotlib Axes, optional
         Pressure and radius panels; a new two-panel figure otherwise.
     n : int
@@ -380,15 +515,17 @@ def plot_profiles(solution, *, axes=None, n=200, max_loads=8):
     max_loads : int
         Most lines per panel for a curve of loads.
 
-    The pressure panel shows the wall's limit pressure (dashed) when it is finite,
-    the radius panel the undeformed radius (dotted).
+    The radius panel shows the undeformed radius :math:`R/a = 1` (black dashed, drawn over the
+    profiles: a load of zero flow rate lies on it). The pressure panel shows the wall's limit
+    pressure (dashed) when it is finite and within 1.25 times the largest pressure drawn;
+    a higher one is stated in a note at the top of the panel, so that the profiles keep the
+    whole axis. Pressures are in Pa or kPa and positions in mm or µm, whichever reads best
+    (the labels say which).
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    import matplotlib as mpl
-
     n = _check_count("n", n)
     max_loads = _check_count("max_loads", max_loads, low=1)
     tube = solution.tube
@@ -406,46 +543,63 @@ def plot_profiles(solution, *, axes=None, n=200, max_loads=8):
 
     single = np.size(solution.flow_rate) == 1
     if single:
-        q = float(np.ravel(solution.flow_rate)[0])
+        qs = np.ravel(np.asarray(solution.flow_rate, dtype=float))[:1]
         p = _along(solution.pressure, z, solution)[:, None]
         r = _along(solution.radius, z, solution)[:, None]
         colors = ["C0"]
     else:
+        import matplotlib as mpl
+
         sub, qs = _subset(solution, max_loads)   # profiles cost one root solve per load and position
         p = np.asarray(sub.pressure(z[:, None]))
         r = np.asarray(sub.radius(z[:, None]))
         cmap = mpl.colormaps["viridis"]
-        lo, hi = float(qs.min()), float(qs.max())
-        norm = mpl.colors.Normalize(lo, hi if hi > lo else lo + 1.0)
-        colors = [cmap(0.9 * norm(v)) for v in qs]
-    zz = z * _MM
-    for j, c in enumerate(colors):
-        ax_p.plot(zz, p[:, j], color=c, lw=1.8)
-        ax_r.plot(zz, r[:, j] / a, color=c, lw=1.8)
-    ax_r.axhline(1.0, color="0.5", lw=0.9, ls=":", label="undeformed")
+        colors = [cmap(0.9 * k / max(len(qs) - 1, 1)) for k in range(len(qs))]   # one colour per load
     lim = solution.wall.limit_pressure(tube.reduced_thickness)
-    if math.isfinite(lim):
-        ax_p.axhline(lim, color="0.35", lw=1.0, ls="--", label="limit pressure")
-        ax_p.legend(frameon=False, loc="lower left")
+    p_top = float(np.max(p, initial=0.0))
+    show_limit = math.isfinite(lim) and lim <= _LIMIT_SHOWN_BELOW * max(p_top, 0.0) and p_top > 0
+    z_sym, z_unit = _axes_unit(ax_r, "x", "length", tube.length)
+    p_sym, p_unit = _axes_unit(ax_p, "y", "pressure", max(p_top, lim if show_limit else 0.0))
+    q_sym, q_unit = _unit("flow_rate", float(np.max(qs, initial=0.0)))
+    zz = z / z_unit
+    for j, c in enumerate(colors):
+        entry = f"{qs[j] / q_unit:.3g}"
+        ax_p.plot(zz, p[:, j] / p_unit, color=c, lw=1.8, label=entry)
+        ax_r.plot(zz, r[:, j] / a, color=c, lw=1.8, label="_nolegend_")
+    ax_r.axhline(1.0, color="k", lw=1.2, ls=(0, (4, 3)), zorder=3, label="undeformed")
+    if show_limit:
+        ax_p.axhline(lim / p_unit, color="0.35", lw=1.0, ls="--", label="limit pressure")
+    elif math.isfinite(lim):
+        ax_p.annotate(f"limit pressure {_fmt_p(lim)} (above the axis)", xy=(0.99, 0.98),
+                      xycoords="axes fraction", ha="right", va="top", fontsize=8, color="0.35")
 
-    ax_p.set_ylabel("pressure $p$ (Pa)")
+    ax_p.set_ylabel(f"pressure $p$ ({p_sym})")
     ax_r.set_ylabel("radius $R/a$")
-    ax_r.set_xlabel("axial position $z$ (mm)")
-    ax_p.set_xlim(0.0, tube.length * _MM)
-    ax_p.set_ylim(bottom=min(0.0, float(np.min(p))))
+    ax_r.set_xlabel(f"axial position $z$ ({z_sym})")
+    ax_p.set_xlim(0.0, tube.length / z_unit)
+    ax_p.set_ylim(bottom=min(0.0, float(np.min(p)) / p_unit))
+    ax_r.set_ylim(bottom=min(0.95, float(np.min(r)) / a - 0.02))
     for axx in (ax_p, ax_r):
         axx.grid(True, alpha=0.25)
     wall_name = _model_name(solution.wall, "wall")
     fluid_name = _model_name(solution.rheology, "rheology")
+    lines = ax_p.get_lines()
     if single:
-        ax_p.set_title(f"Pressure and radius along the tube, $q$ = {_fmt(q, 'm³/s')}, "
-                       f"$\\Delta p$ = {_fmt(float(np.ravel(solution.pressure_drop)[0]), 'Pa')}", fontsize=10)
-        ax_r.legend(frameon=False, loc="upper right")
+        ax_p.set_title(f"Pressure and radius along the tube, $q$ = {_fmt_q(float(qs[0]))}, "
+                       f"$\\Delta p$ = {_fmt_p(float(np.ravel(solution.pressure_drop)[0]))}", fontsize=10)
+        if show_limit:
+            ax_p.legend([lines[-1]], ["limit pressure"], frameon=False, loc="lower left")
     else:
         ax_p.set_title(f"Pressure and radius along the tube ({len(colors)} flow rates)", fontsize=10)
-        sm = mpl.cm.ScalarMappable(norm=norm, cmap=mpl.colors.ListedColormap(cmap(np.linspace(0, 0.9, 256))))
-        fig.colorbar(sm, ax=list(axes), label="flow rate $q$ (m³/s)", shrink=0.9)
-        ax_r.legend(frameon=False, loc="upper right")
+        # a discrete legend, one entry per drawn flow rate (and the limit pressure)
+        handles = lines[:len(colors)] + (lines[-1:] if show_limit else [])
+        labels = [h.get_label() for h in handles]
+        options = dict(title=f"flow rate $q$\n({q_sym})", frameon=False, fontsize=8, title_fontsize=9)
+        if own:
+            fig.legend(handles, labels, loc="outside right upper", **options)
+        else:
+            ax_p.legend(handles, labels, loc="lower left", **options)
+    ax_r.legend(frameon=False, loc="upper right")
     if own:
         fig.suptitle(f"{fluid_name} fluid, {wall_name} wall", fontsize=11)
     return fig
@@ -484,32 +638,39 @@ def plot_deformed_tube(solution, *, ax=None, n=200, cmap="plasma"):
     p = _along(solution.pressure, z, solution)
 
     ax = _new_axes(ax, (8.0, 3.6))
-    zz, RR = z * _MM, R * _MM
+    z_sym, z_unit = _axes_unit(ax, "x", "length", L)
+    r_sym, r_unit = _axes_unit(ax, "y", "length", float(np.max(R)) + t)
+    zz, RR = z / z_unit, R / r_unit
     Z = np.repeat(zz[:, None], 2, axis=1)
     Y = RR[:, None] * np.array([-1.0, 1.0])
     P = np.repeat(p[:, None], 2, axis=1)
     mesh = ax.pcolormesh(Z, Y, P, shading="gouraud", cmap=cmap, rasterized=True)
     top = RR.max()
     if _incompressible(solution.wall):
-        Ro = np.sqrt(R**2 + (a + t) ** 2 - a**2) * _MM
+        Ro = np.sqrt(R**2 + (a + t) ** 2 - a**2) / r_unit
         ax.fill_between(zz, RR, Ro, color="0.78", lw=0, label="wall")
         ax.fill_between(zz, -Ro, -RR, color="0.78", lw=0)
         top = Ro.max()
     ax.plot(zz, RR, color="k", lw=1.4)
     ax.plot(zz, -RR, color="k", lw=1.4)
-    ax.plot(zz, np.full_like(zz, a * _MM), color="0.3", lw=0.9, ls=":", label="undeformed lumen")
-    ax.plot(zz, np.full_like(zz, -a * _MM), color="0.3", lw=0.9, ls=":", label="_nolegend_")
-    ax.set_xlim(0.0, L * _MM)
+    ax.plot(zz, np.full_like(zz, a / r_unit), color="0.3", lw=0.9, ls=":", label="undeformed lumen")
+    ax.plot(zz, np.full_like(zz, -a / r_unit), color="0.3", lw=0.9, ls=":", label="_nolegend_")
+    ax.set_xlim(0.0, L / z_unit)
     ax.set_ylim(-1.12 * top, 1.12 * top)
-    ax.set_xlabel("axial position $z$ (mm)")
-    ax.set_ylabel("radial position $r$ (mm)")
+    ax.set_xlabel(f"axial position $z$ ({z_sym})")
+    ax.set_ylabel(f"radial position $r$ ({r_sym})")
     ax.annotate("flow", xy=(0.16, 0.5), xytext=(0.03, 0.5), xycoords="axes fraction",
                 ha="left", va="center", fontsize=9, color="w",
                 arrowprops=dict(arrowstyle="-|>", color="w", lw=1.5))
     if not ax.get_title():
-        ax.set_title(f"{_model_name(solution.wall, 'wall')} tube: $q$ = {_fmt(q, 'm³/s')}, "
-                     f"$\\Delta p$ = {_fmt(dp, 'Pa')}, $R(0)/a$ = {R[0] / a:.3g}", fontsize=10)
-    ax.figure.colorbar(mesh, ax=ax, label="pressure $p$ (Pa)", pad=0.02)
+        ax.set_title(f"{_model_name(solution.wall, 'wall')} tube: $q$ = {_fmt_q(q)}, "
+                     f"$\\Delta p$ = {_fmt_p(dp)}, $R(0)/a$ = {R[0] / a:.3g}", fontsize=10)
+    bar = ax.figure.colorbar(mesh, ax=ax, label="pressure $p$ (Pa)", pad=0.02)
+    p_sym, p_unit = _unit("pressure", float(np.max(p)))
+    if p_unit != 1.0:   # the mesh stays in Pa (its clim is the pressure range); the ticks read in kPa
+        bar.formatter = _scaled_formatter(p_unit)
+        bar.set_label(f"pressure $p$ ({p_sym})")
+        bar.update_ticks()
     ax.legend(frameon=False, loc="upper right", fontsize=8)
     return ax
 
@@ -545,18 +706,22 @@ def plot_velocity_profiles(solution, z_sections=None, *, ax=None, n=101):
         raise InvalidParameterError("z_sections", f"non-empty positions in [0, {L:g}] (m)", z_sections)
     R = _along(solution.radius, zs, solution)
     ax = _new_axes(ax, (6.0, 4.2))
+    z_sym, z_unit = _unit("length", L)
+    r_sym, r_unit = _axes_unit(ax, "y", "length", float(np.max(R)))
+    v_sym, v_unit = _axes_unit(ax, "x", "velocity", 2.0 * q / (np.pi * float(np.min(R)) ** 2))
     cmap = mpl.colormaps["viridis"]
     s = np.linspace(-1.0, 1.0, n)
     for k, (zk, Rk) in enumerate(zip(zs, R)):
         r = np.abs(s) * Rk
         v = _along(lambda rr: solution.velocity(np.minimum(rr, Rk), zk), r, solution)
         frac = 0.0 if zs.size == 1 else k / (zs.size - 1)
-        ax.plot(v * _MM, s * Rk * _MM, color=cmap(0.9 * frac), lw=1.8, label=f"z = {zk * _MM:.3g} mm")
-    ax.set_xlabel("axial velocity $v$ (mm/s)")
-    ax.set_ylabel("radial position $r$ (mm)")
+        ax.plot(v / v_unit, s * Rk / r_unit, color=cmap(0.9 * frac), lw=1.8,
+                label=f"z = {zk / z_unit:.3g} {z_sym}")
+    ax.set_xlabel(f"axial velocity $v$ ({v_sym})")
+    ax.set_ylabel(f"radial position $r$ ({r_sym})")
     ax.set_xlim(left=0.0)
     if not ax.get_title():
-        ax.set_title(f"Velocity profiles, $q$ = {_fmt(q, 'm³/s')}", fontsize=10)
+        ax.set_title(f"Velocity profiles, $q$ = {_fmt_q(q)}", fontsize=10)
     ax.grid(True, alpha=0.25)
     ax.legend(frameon=False, fontsize=8, loc="upper right")
     return ax
@@ -617,5 +782,5 @@ def plot_network(result, *, positions=None, ax=None, cmap="viridis", max_width=8
     ax.figure.colorbar(lines, ax=ax, label="pressure $p$ (Pa)", shrink=0.8)
     if not ax.get_title():
         ax.set_title(f"{len(nodes)} nodes, {len(table['name'])} tubes; width ~ deformed radius "
-                     f"(widest {_fmt(float(radius.max()) * _MM, 'mm')})", fontsize=10)
+                     f"(widest {_fmt_len(float(radius.max()))})", fontsize=10)
     return ax

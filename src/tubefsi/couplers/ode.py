@@ -29,13 +29,17 @@ from typing import ClassVar, final
 
 import attrs
 import numpy as np
-from scipy import integrate, optimize
 
+from .._lazy import lazy_module
 from ..errors import ConvergenceError, InvalidParameterError, NoSteadyStateError
 from ..scene import State
 from ._options import flag, tolerance
 from .base import Coupler
 from .quadrature import Quadrature
+
+# SciPy on first use (tubefsi._lazy): listing the models must not import it
+integrate = lazy_module("scipy.integrate", globals(), "integrate")
+optimize = lazy_module("scipy.optimize", globals(), "optimize")
 
 __all__ = ["ODE"]
 

@@ -40,15 +40,19 @@ import math
 import time
 
 import numpy as np
-from scipy import interpolate, optimize
-from scipy.optimize import elementwise
 
+from .._lazy import lazy_module
 from .._numerics import EPS, integrate_graded, solve_increasing
 from .._quadrature import adaptive_to_pole, quiet, recording, warn_unconverged
 from ..errors import ConvergenceError, InvalidParameterError, NoSteadyStateError, StretchRangeError
 from ..scene import Points, Scene, State
 from ._tables import SeparatedTable, fit_chebyshev
 from .base import Coupler
+
+# SciPy on first use (tubefsi._lazy): listing the models must not import it
+interpolate = lazy_module("scipy.interpolate", globals(), "interpolate")
+optimize = lazy_module("scipy.optimize", globals(), "optimize")
+elementwise = lazy_module("scipy.optimize.elementwise", globals(), "elementwise")
 
 __all__ = ["SeparatedVariables", "MAX_LOG_STRETCH"]
 

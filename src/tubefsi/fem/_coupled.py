@@ -28,6 +28,7 @@ import time
 import attrs
 import numpy as np
 
+from .._progress import bar
 from ..errors import ConvergenceError, InvalidParameterError
 from ..walls.rigid import Rigid
 from ._fluid import StokesLumen
@@ -104,7 +105,7 @@ def axial_grid(radius, length, resolution, *, growth=1.25):
 
 
 def solve_axisymmetric(rheology, wall, tube, *, flow_rate, resolution=4, outlet_pressure=0.0,
-                       tol=1e-8, maxiter=60, relaxation=0.5, ends="clamped"):
+                       tol=1e-8, maxiter=60, relaxation=0.5, ends="clamped", progress=False):
     r"""Steady two-way coupled axisymmetric finite-element solution of one tube.
 
     Parameters
@@ -126,6 +127,10 @@ def solve_axisymmetric(rheology, wall, tube, *, flow_rate, resolution=4, outlet_
         and the initial Aitken factor.
     ends : {"clamped", "sliding"}
         Wall ends clamped (the reference scene), or free to slide radially.
+    progress : bool or "auto"
+        Show a progress bar over the coupling iterations (tqdm, ``pip install
+        'tubefsi[progress]'``; ``"auto"``: only if tqdm is installed and standard error is a
+        terminal); it ends at convergence, usually well before ``maxiter``.
 
     Returns
     -------
@@ -156,26 +161,31 @@ def solve_axisymmetric(rheology, wall, tube, *, flow_rate, resolution=4, outlet_
     x = np.zeros((n, 2))
     omega, r_prev, dp_prev, history = float(relaxation), None, None, []
     picard_tol = fluid.tol
-    for k in range(maxiter):
-        # inexact inner solves: the viscosity iteration to a tenth of the last coupling update
-        fluid.tol = picard_tol if r_prev is None else min(1e-4, max(picard_tol, 0.1 * history[-1]["residual"]))
-        force = fluid.solve(a + x[:, 0], x[:, 1])
-        dp = fluid.dissipation() / q
-        x_wall = x if rigid else solid.solve(2.0 * math.pi * force)
-        r = x_wall - x
-        if r_prev is not None:
-            dr = (r - r_prev).ravel()
-            omega = -omega * float(r_prev.ravel() @ dr) / max(float(dr @ dr), 1e-300)
-        res = float(np.max(np.abs(r))) / a
-        history.append({"residual": res, "relaxation": omega, "pressure_drop": dp,
-                        "picard": fluid.history[-1]})
-        if rigid or (res <= tol and dp_prev is not None and abs(dp - dp_prev) <= tol * abs(dp)
-                     and fluid.tol <= picard_tol * (1 + 1e-12)):
-            break
-        x, r_prev, dp_prev = x + omega * r, r, dp
-    else:
-        raise ConvergenceError(f"tubefsi.fem: the coupling did not converge in {maxiter} iterations "
-                               f"(interface update {res:.3g} a, tolerance {tol:g})")
+    shown = bar(maxiter, progress, "tubefsi.fem", unit="coupling iteration")
+    try:
+        for k in range(maxiter):
+            # inexact inner solves: the viscosity iteration to a tenth of the last coupling update
+            fluid.tol = picard_tol if r_prev is None else min(1e-4, max(picard_tol, 0.1 * history[-1]["residual"]))
+            force = fluid.solve(a + x[:, 0], x[:, 1])
+            dp = fluid.dissipation() / q
+            x_wall = x if rigid else solid.solve(2.0 * math.pi * force)
+            r = x_wall - x
+            if r_prev is not None:
+                dr = (r - r_prev).ravel()
+                omega = -omega * float(r_prev.ravel() @ dr) / max(float(dr @ dr), 1e-300)
+            res = float(np.max(np.abs(r))) / a
+            history.append({"residual": res, "relaxation": omega, "pressure_drop": dp,
+                            "picard": fluid.history[-1]})
+            shown.update()
+            if rigid or (res <= tol and dp_prev is not None and abs(dp - dp_prev) <= tol * abs(dp)
+                         and fluid.tol <= picard_tol * (1 + 1e-12)):
+                break
+            x, r_prev, dp_prev = x + omega * r, r, dp
+        else:
+            raise ConvergenceError(f"tubefsi.fem: the coupling did not converge in {maxiter} iterations "
+                                   f"(interface update {res:.3g} a, tolerance {tol:g})")
+    finally:
+        shown.close()
     zp, p = fluid.axis_pressure()
     traction = fluid.wall_traction(force)
     wall_z, radius = fluid.lines + x[:, 1], a + x[:, 0]

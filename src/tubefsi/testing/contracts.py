@@ -209,7 +209,10 @@ class HyperelasticWallContract(WallContract):
             np.testing.assert_allclose(wall.stiffness(lam, tb), theory._stiffness(wall, lam, tb), rtol=1e-7)
 
     def test_thick_tends_to_thin_current(self, wall):
-        """As t/a -> 0 the thick law tends to tb * dW(lam) / lam, with an O(t/a) error."""
+        """As t/a -> 0 the thick law tends to tb * dW(lam) / lam, with an O(t/a) error: the
+        difference falls at least fivefold per decade of t/a. Its coefficient is the law's own
+        (about 0.77 t/a for neo-Hookean, 43–61 t/a for a stiff fibre law, at stretch 1.5), so at
+        t/a = 0.01 only a difference below 1 (the thin law is the leading term) is asked."""
         if not isinstance(wall, ThickWall):
             pytest.skip("thin wall")
         tbs = (1e-2, 1e-3, 1e-4)
@@ -218,7 +221,7 @@ class HyperelasticWallContract(WallContract):
         for tb in tbs:
             thin = tb * float(wall.dW(lam)) / lam
             errors.append(_rel(wall.pressure(lam, tb), thin))
-        assert errors[0] < 0.05
+        assert errors[0] < 1.0
         assert errors[2] < errors[1] / 5 < errors[0] / 25
 
 

@@ -24,14 +24,17 @@ from typing import ClassVar
 
 import attrs
 import numpy as np
-from scipy import differentiate
-from scipy.optimize import elementwise
 
+from .._lazy import lazy_module
 from .._numerics import solve_signed
 from .._quadrature import quiet
 from .._validation import as_array, real_array
 from ..fields import evaluate, flat_points, model_at, take
 from ..errors import BucklingError, ConvergenceError, InvalidParameterError, NoSteadyStateError
+
+# SciPy on first use (tubefsi._lazy): listing the models must not import it
+differentiate = lazy_module("scipy.differentiate", globals(), "differentiate")
+elementwise = lazy_module("scipy.optimize.elementwise", globals(), "elementwise")
 
 #: scipy.differentiate tolerances: as tight as the error estimate allows
 _DIFF_TOL = dict(rtol=1e-12, atol=0.0)

@@ -44,13 +44,16 @@ import math
 
 import attrs
 import numpy as np
-from scipy import differentiate
 
+from .._lazy import lazy_module
 from .._quadrature import adaptive, adaptive_to_pole, warn_unconverged
 from ..errors import InvalidParameterError
 from ..geometry import Tube
 from ..fields import choice, evaluate, flat_points, model_at, positive, take
 from .base import WallModel
+
+# SciPy on first use (tubefsi._lazy): listing the models must not import it
+differentiate = lazy_module("scipy.differentiate", globals(), "differentiate")
 
 #: scipy.differentiate tolerances: as tight as the error estimate allows
 _DIFF_TOL = dict(rtol=1e-12, atol=0.0)

@@ -15,7 +15,6 @@ import functools
 import math
 
 import numpy as np
-from scipy import optimize
 
 __all__ = ["LimitPoint"]
 
@@ -32,6 +31,8 @@ def first_peak(wall, tb: float) -> tuple[float, float]:
     bad = np.flatnonzero(~(slope > 0))
     if bad.size == 0:
         return math.inf, math.nan
+    from scipy import optimize   # here, not at import: listing the models must not load SciPy
+
     i = bad[0]
     lo = 1.0 if i == 0 else lam[i - 1]
     peak = optimize.brentq(lambda s: float(wall._stiffness(np.asarray(s), tb)), lo, lam[i],
