@@ -419,3 +419,25 @@ class TestStiffHGO(tubefsi.testing.AccuracyContract):
         [POWER_LAW]))
     def case(self, request):
         return request.param
+
+
+# ------------------------------------------------------------------ the command line
+@pytest.mark.parametrize("p_e", [-5.0, 20.0])
+def test_cli_external_pressure_and_axial_stretch(capsys, p_e):
+    """``tubefsi solve --external-pressure`` (with an axial stretch in the wall spec) gives the
+    in-process solve's numbers; ``advise`` refuses an external pressure it would ignore."""
+    import json
+
+    from tubefsi import cli
+
+    scene = ["--rheology", "newtonian:viscosity=1e-3", "--wall", "thick-neo-hookean:shear_modulus=1e4,axial_stretch=1.2",
+             "--tube", "radius=1e-3,thickness=2e-4,length=0.05"]
+    assert cli.main(["solve", *scene, "--flow-rate", "1e-7", "--external-pressure", str(p_e), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    ref = tubefsi.solve(tubefsi.registry.rheologies["newtonian"](viscosity=1e-3),
+                        walls["thick-neo-hookean"](shear_modulus=1e4, axial_stretch=1.2),
+                        tubefsi.Tube(radius=1e-3, thickness=2e-4, length=0.05), flow_rate=1e-7, external_pressure=p_e)
+    assert out["pressure_drop"] == pytest.approx(ref.pressure_drop, rel=1e-13)
+    assert out["inlet_radius"] == pytest.approx(ref.inlet_radius, rel=1e-13)
+    assert cli.main(["advise", *scene, "--flow-rate", "1e-7", "--external-pressure", str(p_e)]) == 2
+    assert "--external-pressure" in capsys.readouterr().err
