@@ -488,14 +488,14 @@ def _network_from_file(path):
     for i, item in enumerate(spec["tubes"]):
         where = f"{path!r}, tube {i}"
         if not isinstance(item, dict) or not {"u", "v", "wall", "tube"} <= set(item):
-            raise UsageError(f"{where}: expected u, v, wall, tube (and optionally name, rheology)")
+            raise UsageError(f"{where}: expected u, v, wall, tube (and optionally name, rheology, external_pressure)")
         geometry = item["tube"]
         if isinstance(geometry, dict):
             geometry = ",".join(f"{k}={v}" for k, v in geometry.items())
         wall = _build("wall", registry.walls, item["wall"])
         rheology = _build("rheology", registry.rheologies, item["rheology"]) if "rheology" in item else None
         net.add_tube(item["u"], item["v"], wall, _tube(geometry, f"{where}: tube"), name=item.get("name"),
-                     rheology=rheology)
+                     rheology=rheology, external_pressure=item.get("external_pressure", 0.0))
     for node, p in dict(spec.get("pressures", {})).items():
         net.set_pressure(node, p)
     for node, q in dict(spec.get("inflows", {})).items():
