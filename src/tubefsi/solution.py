@@ -189,6 +189,9 @@ class Solution:
         :math:`(\Delta p - L G_{in})/\mu`. Other wall parameters raise
         ``InvalidParameterError`` (difference two solves). 0 where ``q = 0``.
         """
+        if self.scene.graded:
+            raise InvalidParameterError("parameter", "a parameter of a uniform tube's solve (a graded tube: "
+                                        "difference two solves)", parameter)
         owner, _, field = parameter.partition(".")
         model = {"rheology": self.rheology, "wall": self.wall}.get(owner)
         if model is None or not attrs.has(type(model)) or field not in attrs.fields_dict(type(model)):
@@ -312,6 +315,10 @@ class Solution:
         is the relative error of the pressure drop that the clamped ends cause, as the
         finite-element validity map measured it (``docs/validity.md``).
         """
+        if self.scene.graded:
+            raise InvalidParameterError("solution", "the solution of a uniform tube (the diagnostics do not cover "
+                                        "tapered and graded tubes yet; solve checks each graded result at its inlet "
+                                        "section)", self)
         from .advise import diagnostics
 
         return diagnostics(self, density=density, warn=warn)

@@ -103,9 +103,6 @@ def _points(scene, n):
     return np.zeros(n, dtype=int) if scene.size == 1 else np.arange(n)
 
 
-def _pick(value, index):
-    return value if np.ndim(value) == 0 else np.asarray(value)[index]
-
 
 @final
 @attrs.frozen(kw_only=True)
@@ -243,6 +240,22 @@ class Graded(Coupler):
                                     "max_flow_rate", scene.tube,
                                     "the maximum flow rate of a graded tube whose wall has a limit pressure is not "
                                     "implemented (solve raises NoSteadyStateError beyond it)")
+
+    def sensitivities(self, scene, state):
+        """The derivatives of a solve: those of the equivalent uniform tube where the scene
+        separates (its pressure drop is the same function of the flow rate and the end pressures);
+        otherwise not implemented (``InvalidParameterError``: difference two solves)."""
+        found = self._uniform(scene)
+        if found is None:
+            raise InvalidParameterError("tube", "a uniform tube or a separable taper for the derivatives of a solve",
+                                        scene.tube, "a graded tube that does not separate: difference two solves")
+        return found[1].sensitivities(found[0], state)
+
+    def length_integral(self, scene, state, weight, *, uniform=False):
+        """Not implemented along a graded tube (the separated identity behind the weighted length
+        integrals does not hold): ``InvalidParameterError``."""
+        raise InvalidParameterError("tube", "a uniform tube for the parameter derivatives of a solve", scene.tube,
+                                    "a graded tube: difference two solves")
 
     def limit_pressure(self, scene):
         """The limit pressure of the inlet section (a necessary bound on the inlet pressure)."""
