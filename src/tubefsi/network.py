@@ -58,7 +58,7 @@ from ._validation import as_array
 from . import validity
 from .errors import (AccuracyWarning, ConvergenceError, InvalidParameterError, ModelValidityWarning,
                      NoSteadyStateError, warn_user)
-from .fields import _array_fields, parameter_shape
+from .fields import varies, _array_fields, parameter_shape
 from .geometry import Tube
 from .scene import make_scene, resolve
 from .solution import Solution
@@ -146,6 +146,9 @@ class Network:
         for label, model in (("wall", wall), ("rheology", fluid), ("tube", tube)):
             if parameter_shape(model) != ():
                 raise InvalidParameterError(label, "scalar parameters (one tube per add_tube)", model)
+            if varies(model):
+                raise InvalidParameterError(label, "a uniform tube and wall (a network takes no tube that varies along z)",
+                                            model)
         p_e = as_array("external_pressure", external_pressure, "the real numbers", np.isfinite)
         if p_e.ndim:
             raise InvalidParameterError("external_pressure", "a number (one tube per add_tube)", external_pressure)
