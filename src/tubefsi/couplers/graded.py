@@ -37,9 +37,8 @@ from typing import ClassVar, final
 
 import attrs
 import numpy as np
-from scipy.integrate._ivp import dop853_coefficients as _dop
-from scipy.optimize import elementwise
 
+from .._lazy import lazy_module
 from .._quadrature import adaptive
 from ..errors import (AccuracyWarning, ConvergenceError, InvalidParameterError, NoSteadyStateError,
                       StretchRangeError, warn_user)
@@ -55,8 +54,9 @@ from .quadrature import Quadrature
 
 __all__ = ["Graded"]
 
-_A = _dop.A[:_dop.N_STAGES, :_dop.N_STAGES]
-_B, _C, _E3, _E5 = _dop.B, _dop.C[:_dop.N_STAGES], _dop.E3, _dop.E5
+# SciPy on first use (tubefsi._lazy): listing the models must not import it
+elementwise = lazy_module("scipy.optimize.elementwise", globals(), "elementwise")
+_dop = lazy_module("scipy.integrate._ivp.dop853_coefficients", globals(), "_dop")   # the DOP853 tableau
 #: Relative deviation of t/a or a wall parameter from its outlet value still taken as constant.
 _CONSTANT = 1e-14
 #: The largest hoop stretch the integration along a graded tube follows (R/L is far beyond the
@@ -341,6 +341,8 @@ class Graded(Coupler):
                 g = model_at(rheo, pts)._pressure_gradient(q[live][sel], a * (1.0 + e))
             return np.where(bad | ~np.isfinite(g) | (e > STRETCH_CAP - 1.0), np.nan, -g / scale[sel])
 
+        stages = _dop.N_STAGES
+        A, B, C, E3, E5 = _dop.A[:stages, :stages], _dop.B, _dop.C[:stages], _dop.E3, _dop.E5
         z = L[live].copy()
         y = np.zeros(live.size)
         span = z - z_end[live]
@@ -359,19 +361,19 @@ class Graded(Coupler):
                 nxt = np.where(j >= 0, breaks[np.maximum(j, 0)], -np.inf)
                 target = np.maximum(target, nxt)
             hs = np.maximum(hs, target - zs)              # h < 0: not beyond the stop
-            K = np.empty((_dop.N_STAGES + 1, sel.size))
+            K = np.empty((stages + 1, sel.size))
             K[0] = f[sel]
-            for s in range(1, _dop.N_STAGES):
-                dy = (K[:s].T @ _A[s, :s]) * hs
-                K[s] = rhs(zs + _C[s] * hs, ys + dy, sel)
-            y_new = ys + hs * (K[:-1].T @ _B)
+            for s in range(1, stages):
+                dy = (K[:s].T @ A[s, :s]) * hs
+                K[s] = rhs(zs + C[s] * hs, ys + dy, sel)
+            y_new = ys + hs * (K[:-1].T @ B)
             land = np.abs(target - (zs + hs)) <= 1e-15 * np.abs(zs) + 1e-300
             z_new = np.where(land, target, zs + hs)
             K[-1] = rhs(z_new, y_new, sel)
             sc = atol + rtol * np.maximum(np.abs(ys), np.abs(y_new))
             with np.errstate(all="ignore"):
-                e5 = (K.T @ _E5) / sc
-                e3 = (K.T @ _E3) / sc
+                e5 = (K.T @ E5) / sc
+                e3 = (K.T @ E3) / sc
                 denom = np.sqrt(e5**2 + 0.01 * e3**2)
                 err = np.abs(hs) * np.where(denom > 0, e5**2 / denom, 0.0)
             broken = ~(np.isfinite(err) & np.isfinite(y_new) & np.all(np.isfinite(K), axis=0))   # beyond the law
