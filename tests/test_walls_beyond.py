@@ -419,3 +419,61 @@ class TestStiffHGO(tubefsi.testing.AccuracyContract):
         [POWER_LAW]))
     def case(self, request):
         return request.param
+
+
+# ------------------------------------------------------------------ the command line
+@pytest.mark.parametrize("p_e", [-5.0, 20.0])
+def test_cli_external_pressure_and_axial_stretch(capsys, p_e):
+    """``tubefsi solve --external-pressure`` (with an axial stretch in the wall spec) gives the
+    in-process solve's numbers; ``advise`` refuses an external pressure it would ignore."""
+    import json
+
+    from tubefsi import cli
+
+    scene = ["--rheology", "newtonian:viscosity=1e-3", "--wall", "thick-neo-hookean:shear_modulus=1e4,axial_stretch=1.2",
+             "--tube", "radius=1e-3,thickness=2e-4,length=0.05"]
+    assert cli.main(["solve", *scene, "--flow-rate", "1e-7", "--external-pressure", str(p_e), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    ref = tubefsi.solve(tubefsi.registry.rheologies["newtonian"](viscosity=1e-3),
+                        walls["thick-neo-hookean"](shear_modulus=1e4, axial_stretch=1.2),
+                        tubefsi.Tube(radius=1e-3, thickness=2e-4, length=0.05), flow_rate=1e-7, external_pressure=p_e)
+    assert out["pressure_drop"] == pytest.approx(ref.pressure_drop, rel=1e-13)
+    assert out["inlet_radius"] == pytest.approx(ref.inlet_radius, rel=1e-13)
+    assert cli.main(["advise", *scene, "--flow-rate", "1e-7", "--external-pressure", str(p_e)]) == 2
+    assert "--external-pressure" in capsys.readouterr().err
+
+
+# ------------------------------------------------------------------ networks
+def test_network_external_pressure_per_tube():
+    """A Y of thick neo-Hookean tubes, each under its own external pressure (one daughter's outlet
+    slightly collapsed, transmural -10 Pa): the network's junction pressure and flows against
+    Kirchhoff's law solved here by Brent's method on single-tube pressure-controlled solves."""
+    from scipy.optimize import brentq
+
+    fluid = tubefsi.registry.rheologies["power-law"](consistency=0.02, index=0.7)
+    wall = walls["thick-neo-hookean"](shear_modulus=2e3)
+    tube = tubefsi.Tube(radius=2e-4, thickness=6e-5, length=2e-2)
+    p_e = {"parent": -20.0, "a": 10.0, "b": 40.0}
+    ends = {"in": 300.0, "a": 0.0, "b": 60.0}
+    net = tubefsi.Network(rheology=fluid)
+    net.add_tube("in", "j", wall, tube, name="parent", external_pressure=p_e["parent"])
+    net.add_tube("j", "a", wall, tube, name="a", external_pressure=p_e["a"])
+    net.add_tube("j", "b", wall, tube, name="b", external_pressure=p_e["b"])
+    for node, p in ends.items():
+        net.set_pressure(node, p)
+    res = net.solve()
+
+    def flow(p_hi, p_lo, name):
+        return tubefsi.solve(fluid, wall, tube, pressure_drop=p_hi - p_lo, outlet_pressure=p_lo,
+                             external_pressure=p_e[name]).flow_rate
+
+    def balance(pj):
+        return flow(ends["in"], pj, "parent") - flow(pj, ends["a"], "a") - flow(pj, ends["b"], "b")
+
+    pj = brentq(balance, ends["b"] + 1e-9, ends["in"] - 1e-9, xtol=1e-13, rtol=1e-15)
+    assert res.pressure["j"] == pytest.approx(pj, rel=1e-11)
+    assert res.flow_rate["a"] == pytest.approx(flow(pj, ends["a"], "a"), rel=1e-10)
+    sol = res.solution("b")
+    assert sol.external_pressure == p_e["b"]
+    with pytest.raises(tubefsi.InvalidParameterError, match="external_pressure"):
+        tubefsi.Network(rheology=fluid).add_tube("x", "y", wall, tube, external_pressure=float("nan"))

@@ -30,7 +30,7 @@ __all__ = [
     "dimensionless", "fields", "Tube", "solve", "max_flow_rate", "select_coupler", "Solution", "registry",
     "advise", "Advice", "Diagnostics", "ModelValidityWarning", "fit", "FitResult", "Network", "NetworkSolution",
     "TubefsiError", "InvalidParameterError", "NoSteadyStateError", "ConvergenceError", "AccuracyWarning",
-    "StretchRangeError", "BucklingError",
+    "StretchRangeError", "BucklingError", "Profile", "sampled",
 ]
 
 __version__ = "0.1.0"
@@ -38,7 +38,7 @@ __version__ = "0.1.0"
 #: public name -> the module that defines it (``None``: the name is a submodule)
 _LAZY = {
     "dimensionless": None, "fields": None, "registry": None,
-    "Tube": "geometry", "Solution": "solution",
+    "Tube": "geometry", "Solution": "solution", "Profile": "profiles", "sampled": "profiles",
     "solve": "solve", "max_flow_rate": "solve", "select_coupler": "solve",
     "advise": "advise", "Advice": "advise", "Diagnostics": "advise",
     "fit": "fit", "FitResult": "fit",

@@ -41,7 +41,7 @@ import warnings
 import numpy as np
 
 from . import __version__, registry
-from .errors import ModelValidityWarning, TubefsiError
+from .errors import InvalidParameterError, ModelValidityWarning, TubefsiError
 
 __all__ = ["main", "parse_model_spec"]
 
@@ -255,7 +255,7 @@ def _cmd_solve(args, out) -> int:
     from .solve import solve
 
     sol = solve(fluid, wall, tube, coupler=coupler, outlet_pressure=args.outlet_pressure, density=args.density,
-                **load)
+                external_pressure=args.external_pressure, **load)
 
     result = {}
     for key in _OUTPUT_UNITS:
@@ -354,7 +354,9 @@ def _add_scene_args(p):
     p.add_argument("--tube", required=True, metavar="radius=..,thickness=..,length=..",
                    help="undeformed tube (m)")
     p.add_argument("--outlet-pressure", type=float, default=0.0, metavar="P",
-                   help="transmural outlet pressure (Pa, default 0)")
+                   help="outlet (gauge) pressure of the fluid (Pa, default 0)")
+    p.add_argument("--external-pressure", type=float, default=0.0, metavar="PE",
+                   help="pressure outside the tube (Pa, any sign, default 0): the wall sees p - PE")
     p.add_argument("--coupler", default="auto", metavar="NAME[:k=v,...]",
                    help="auto (default), closed-form, quadrature, ode, or a plugin's")
 
@@ -420,6 +422,9 @@ def _check_outputs(args):
 
 def _cmd_curve(args, out) -> int:
     fmt = _check_outputs(args)
+    if args.plot and args.external_pressure != 0.0:
+        raise InvalidParameterError("--external-pressure", "0 with --plot (the flow-curve plot takes none)",
+                                    args.external_pressure)
     fluid, wall, tube, coupler = _scene_from_args(args)
     from .solve import solve
 
@@ -427,7 +432,7 @@ def _cmd_curve(args, out) -> int:
     option = "--flow-rate" if kind == "flow_rate" else "--pressure-drop"
     values = _range(option, getattr(args, kind), args.log)
     sol = solve(fluid, wall, tube, coupler=coupler, outlet_pressure=args.outlet_pressure, density=args.density,
-                progress=True if args.progress else "auto", **{kind: values})
+                external_pressure=args.external_pressure, progress=True if args.progress else "auto", **{kind: values})
     if fmt == "netcdf":
         ds = sol.to_xarray()
         if "feasible" in ds:                  # NetCDF 3 has no booleans
@@ -483,14 +488,14 @@ def _network_from_file(path):
     for i, item in enumerate(spec["tubes"]):
         where = f"{path!r}, tube {i}"
         if not isinstance(item, dict) or not {"u", "v", "wall", "tube"} <= set(item):
-            raise UsageError(f"{where}: expected u, v, wall, tube (and optionally name, rheology)")
+            raise UsageError(f"{where}: expected u, v, wall, tube (and optionally name, rheology, external_pressure)")
         geometry = item["tube"]
         if isinstance(geometry, dict):
             geometry = ",".join(f"{k}={v}" for k, v in geometry.items())
         wall = _build("wall", registry.walls, item["wall"])
         rheology = _build("rheology", registry.rheologies, item["rheology"]) if "rheology" in item else None
         net.add_tube(item["u"], item["v"], wall, _tube(geometry, f"{where}: tube"), name=item.get("name"),
-                     rheology=rheology)
+                     rheology=rheology, external_pressure=item.get("external_pressure", 0.0))
     for node, p in dict(spec.get("pressures", {})).items():
         net.set_pressure(node, p)
     for node, q in dict(spec.get("inflows", {})).items():
@@ -541,6 +546,9 @@ def _cmd_advise(args, out) -> int:
     from .solve import solve
 
     fluid, wall, tube, _ = _scene_from_args(args)
+    if args.external_pressure != 0.0:
+        raise InvalidParameterError("--external-pressure", "0 for advise (its simpler models take none)",
+                                    args.external_pressure)
     load = {"flow_rate": args.flow_rate} if args.flow_rate is not None else {"pressure_drop": args.pressure_drop}
     advice = advise(fluid, wall, tube, tolerance=args.tolerance, outlet_pressure=args.outlet_pressure,
                             **load)

@@ -39,11 +39,13 @@ import math
 import attrs
 import numpy as np
 
-from ._units import to_si
+from ._units import is_quantity, to_si
 from .errors import InvalidParameterError
+from .profiles import Profile, as_profile
 
 __all__ = ["real", "positive", "nonnegative", "choice", "Parameter", "parameters", "parameter_shape",
-           "broadcast_model", "model_at", "parameter_sets", "evaluate", "flat_points", "take"]
+           "broadcast_model", "model_at", "parameter_sets", "evaluate", "flat_points", "take", "varies",
+           "at_position"]
 
 
 def _invalid_type(field, value):
@@ -51,12 +53,17 @@ def _invalid_type(field, value):
                                  "give a plain number in SI units, or an array of them")
 
 
-def _convert_real(value, field):
+def _convert_real(value, field, instance=None):
     """A float for a scalar, a read-only float ndarray for an array (any shape); a pint Quantity
     is converted to SI first."""
     if type(value) is float:                 # the common case (a Monte Carlo loop builds models)
         return value
     value = to_si(field.name, value, field.metadata.get("unit", ""))
+    if callable(value) and field.metadata.get("along") and not is_quantity(value):   # a function of z
+        if instance is not None and not getattr(type(instance), "varies_along_z", True):
+            raise InvalidParameterError(field.name, f"a number or an array ({type(instance).__name__}'s parameters "
+                                        "do not vary along the tube)", value)
+        return as_profile(value, field)
     if isinstance(value, (bool, str, bytes)):
         raise _invalid_type(field, value)
     if isinstance(value, (int, float)):
@@ -74,7 +81,8 @@ def _convert_real(value, field):
     return a
 
 
-_real_converter = attrs.Converter(_convert_real, takes_field=True)
+_real_converter = attrs.Converter(lambda value, instance, field: _convert_real(value, field, instance),
+                                  takes_self=True, takes_field=True)
 
 
 def _fmt(x) -> str:
@@ -87,6 +95,8 @@ def _fmt(x) -> str:
 
 def _interval_validator(low, high, low_open, high_open, admissible):
     def check(instance, attribute, value):
+        if isinstance(value, Profile):            # checked where it is evaluated
+            return
         if type(value) is float:                  # the common case, without numpy
             if ((value > low if low_open else value >= low) and (value < high if high_open else value <= high)
                     and (value == value) and (value != math.inf or (high == math.inf and not high_open))
@@ -120,7 +130,7 @@ _EQ = attrs.cmp_using(eq=_same)
 
 
 def real(*, low=-math.inf, high=math.inf, low_open=True, high_open=True, unit="", doc="",
-         default=attrs.NOTHING):
+         default=attrs.NOTHING, along=True):
     """A real parameter in the interval from ``low`` to ``high`` (open ends by default).
 
     The value is a float, or an array of any shape (read-only, broadcast against the other
@@ -128,7 +138,9 @@ def real(*, low=-math.inf, high=math.inf, low_open=True, high_open=True, unit=""
     parameters). NaN is always rejected, and an infinite value unless the interval is closed
     at infinity; an offending array entry is named by its index. ``unit`` is the SI unit as
     text (``"Pa"``, ``"Pa s^n"``, ``""`` for a number), ``doc`` a few words for
-    ``tubefsi list``.
+    ``tubefsi list``. With ``along`` (the default) the value may also be a function of the axial
+    position z, a :class:`~tubefsi.Profile` (a graded tube, ``docs/graded.md``); options that are
+    not properties of the tube pass ``along=False``.
     """
     lo = "(" if low_open else "["
     hi = ")" if high_open else "]"
@@ -137,20 +149,20 @@ def real(*, low=-math.inf, high=math.inf, low_open=True, high_open=True, unit=""
         converter=_real_converter,
         validator=_interval_validator(low, high, low_open, high_open, admissible),
         eq=_EQ, hash=False,
-        metadata={"unit": unit, "doc": doc, "admissible": admissible, "array": True,
+        metadata={"unit": unit, "doc": doc, "admissible": admissible, "array": True, "along": along,
                   "low": low, "high": high, "low_open": low_open, "high_open": high_open},
         default=default,
     )
 
 
-def positive(*, unit="", doc="", default=attrs.NOTHING):
+def positive(*, unit="", doc="", default=attrs.NOTHING, along=True):
     """A finite float parameter that must be ``> 0``."""
-    return real(low=0.0, unit=unit, doc=doc, default=default)
+    return real(low=0.0, unit=unit, doc=doc, default=default, along=along)
 
 
-def nonnegative(*, unit="", doc="", default=attrs.NOTHING):
+def nonnegative(*, unit="", doc="", default=attrs.NOTHING, along=True):
     """A finite float parameter that must be ``>= 0``."""
-    return real(low=0.0, low_open=False, unit=unit, doc=doc, default=default)
+    return real(low=0.0, low_open=False, unit=unit, doc=doc, default=default, along=along)
 
 
 def choice(options, *, doc="", default=attrs.NOTHING):
@@ -301,6 +313,25 @@ def flat_points(model, *values):
     n = (int(np.prod(shape, dtype=int)),)
     return shape, broadcast_model(model, shape), [np.broadcast_to(a, shape).reshape(n).copy() if a.ndim else a
                                                   for a in arrays]
+
+
+def varies(model) -> bool:
+    """Whether some parameter of ``model`` is a function of z (a :class:`~tubefsi.Profile`)."""
+    return any(isinstance(getattr(model, name), Profile) for name in _array_fields(type(model)))
+
+
+def at_position(model, z, index=None):
+    """``model`` with each :class:`~tubefsi.Profile` parameter evaluated at the positions ``z`` (and
+    its flat array parameters taken at ``index``, if given, to align with ``z``); bypasses the
+    validators (each profile validates its own values)."""
+    values = {}
+    for name in _array_fields(type(model)):
+        v = getattr(model, name)
+        if isinstance(v, Profile):
+            values[name] = v(z)
+        elif index is not None and isinstance(v, np.ndarray):
+            values[name] = v[index]
+    return _replace(model, values) if values else model
 
 
 def take(value, index):

@@ -7,6 +7,7 @@ import numpy as np
 
 from .errors import InvalidParameterError
 from .fields import positive
+from .profiles import Profile
 
 __all__ = ["Tube"]
 
@@ -17,24 +18,44 @@ class Tube:
 
     Parameters
     ----------
-    radius : float
+    radius : float, array or function of z
         Undeformed inner radius :math:`a` (m).
-    thickness : float
+    thickness : float, array or function of z
         Wall thickness :math:`t` (m).
-    length : float
+    length : float or array
         Length :math:`L` (m). Lubrication theory assumes :math:`a/L \ll 1`.
+
+    ``radius`` and ``thickness`` may be functions of the axial position :math:`z` (m, 0 at the
+    inlet): a callable, a :class:`~tubefsi.Profile` or a :func:`~tubefsi.sampled` table (a
+    tapered or stenosed tube, ``docs/graded.md``); :attr:`graded` is then True and
+    :attr:`reduced_thickness` is the profile :math:`t(z)/a(z)`.
     """
 
     radius: float = positive(unit="m", doc="undeformed inner radius a")
     thickness: float = positive(unit="m", doc="wall thickness t")
-    length: float = positive(unit="m", doc="tube length L")
+    length: float = positive(unit="m", doc="tube length L", along=False)
 
     def __attrs_post_init__(self):
+        if self.graded:                  # checked along z where the scene evaluates it
+            for name in ("radius", "thickness"):
+                if isinstance(getattr(self, name), Profile):
+                    getattr(self, name).check_span(self.length)
+            return
         tb = np.asarray(self.thickness) / np.asarray(self.radius)
         if not np.all((tb > 0) & np.isfinite(tb)):        # t/a beyond double range
             raise InvalidParameterError("thickness", "values with a finite, nonzero t/a", self.thickness,
                                         f"t/a = {np.ravel(tb)[np.argmin(np.isfinite(tb) & (tb > 0))]!r} with radius "
                                         f"{self.radius!r}")
+
+    @property
+    def graded(self) -> bool:
+        """Whether the radius or the thickness is a function of z (a :class:`~tubefsi.Profile`)."""
+        return isinstance(self.radius, Profile) or isinstance(self.thickness, Profile)
+
+    def at(self, z):
+        """The radius and thickness at the positions ``z`` (m): ``(a(z), t(z))``, validated."""
+        a, t = (v(z) if isinstance(v, Profile) else v for v in (self.radius, self.thickness))
+        return a, t
 
     @property
     def reduced_thickness(self) -> float:

@@ -58,7 +58,7 @@ from ._validation import as_array
 from . import validity
 from .errors import (AccuracyWarning, ConvergenceError, InvalidParameterError, ModelValidityWarning,
                      NoSteadyStateError, warn_user)
-from .fields import _array_fields, parameter_shape
+from .fields import varies, _array_fields, parameter_shape
 from .geometry import Tube
 from .scene import make_scene, resolve
 from .solution import Solution
@@ -87,6 +87,7 @@ class _Tube:
     wall: object
     tube: Tube
     rheology: object
+    external_pressure: float = 0.0
 
 
 class Network:
@@ -120,11 +121,15 @@ class Network:
         self.positions: dict = {}
 
     # ------------------------------------------------------------------ building
-    def add_tube(self, u, v, wall, tube, *, name=None, rheology=None):
+    def add_tube(self, u, v, wall, tube, *, name=None, rheology=None, external_pressure=0.0):
         """Add a tube from node ``u`` to node ``v`` (positive flow runs from ``u`` to ``v``).
 
         ``name`` (any hashable) defaults to ``(u, v)``; two tubes between the same nodes need
-        names. ``rheology`` overrides the network's fluid for this tube. Parameters are scalars.
+        names. ``rheology`` overrides the network's fluid for this tube. ``external_pressure``
+        (Pa, any sign) is the pressure outside this tube: its wall sees the node pressures minus
+        it (``docs/walls_beyond.md``, "External pressure and collapse"); a node pressure whose
+        transmural pressure falls below the wall's buckling bound raises ``BucklingError``.
+        Parameters are scalars.
         """
         name = (u, v) if name is None else name
         if u == v:
@@ -141,9 +146,15 @@ class Network:
         for label, model in (("wall", wall), ("rheology", fluid), ("tube", tube)):
             if parameter_shape(model) != ():
                 raise InvalidParameterError(label, "scalar parameters (one tube per add_tube)", model)
+            if varies(model):
+                raise InvalidParameterError(label, "a uniform tube and wall (a network takes no tube that varies along z)",
+                                            model)
+        p_e = as_array("external_pressure", external_pressure, "the real numbers", np.isfinite)
+        if p_e.ndim:
+            raise InvalidParameterError("external_pressure", "a number (one tube per add_tube)", external_pressure)
         for node in (u, v):
             self._nodes.setdefault(node, len(self._nodes))
-        self._tubes[name] = _Tube(name, u, v, wall, tube, fluid)
+        self._tubes[name] = _Tube(name, u, v, wall, tube, fluid, float(p_e))
         return self
 
     def set_pressure(self, node, pressure):
@@ -193,7 +204,7 @@ class Network:
                 if attr not in data:
                     raise InvalidParameterError(f"edge ({u!r}, {v!r})", f"an edge with a {attr!r} attribute", data)
             net.add_tube(u, v, data[wall], data[tube], name=(u, v, key) if multi else None,
-                         rheology=data.get(fluid))
+                         rheology=data.get(fluid), external_pressure=data.get("external_pressure", 0.0))
         for node, data in graph.nodes(data=True):
             if pressure in data:
                 net.set_pressure(node, data[pressure])
@@ -219,7 +230,8 @@ class Network:
                 data["pos"] = self.positions[node]
             graph.add_node(node, **data)
         for t in self._tubes.values():
-            graph.add_edge(t.u, t.v, key=t.name, wall=t.wall, tube=t.tube, rheology=t.rheology)
+            graph.add_edge(t.u, t.v, key=t.name, wall=t.wall, tube=t.tube, rheology=t.rheology,
+                           external_pressure=t.external_pressure)
         return graph
 
     # ------------------------------------------------------------------ solving
@@ -270,6 +282,7 @@ class _Groups:
 
     def __init__(self, tubes, subset):
         groups: dict = {}
+        self.external = []            # per part: the external pressure of its tubes (float or array)
         for i, t in enumerate(tubes):
             if not subset[i]:
                 continue
@@ -282,21 +295,25 @@ class _Groups:
             fluid = _stack([m.rheology for m in members])
             tube = Tube(**{f: _column([getattr(m.tube, f) for m in members]) for f in ("radius", "thickness", "length")})
             self.parts.append((np.asarray(index), fluid, wall, tube))
+            self.external.append(_column([m.external_pressure for m in members]))
         n = len(tubes)
         self.limit = np.zeros(n)
         self.radius = np.zeros(n)
-        for index, fluid, wall, tube in self.parts:
-            self.limit[index] = np.broadcast_to(wall.limit_pressure(tube.reduced_thickness), index.shape)
+        for (index, fluid, wall, tube), p_e in zip(self.parts, self.external):
+            # the node (gauge) pressure at which the transmural one reaches the limit pressure
+            self.limit[index] = np.broadcast_to(wall.limit_pressure(tube.reduced_thickness) + np.asarray(p_e),
+                                                index.shape)
             self.radius[index] = np.broadcast_to(tube.radius, index.shape)
 
     def evaluate(self, drop, outlet):
         """Flow rates and the derivatives by the inlet and outlet pressures of the tubes (pressure-
         controlled; zeros for the tubes of no group)."""
         q, d_in, d_out, radius_in, radius_out = (np.zeros(drop.size) for _ in range(5))
-        for index, fluid, wall, tube in self.parts:
+        for (index, fluid, wall, tube), p_e in zip(self.parts, self.external):
             with warnings.catch_warnings():    # Newton's trial pressures: the result is checked once
                 warnings.simplefilter("ignore", ModelValidityWarning)
-                sol = solve(fluid, wall, tube, pressure_drop=drop[index], outlet_pressure=outlet[index])
+                sol = solve(fluid, wall, tube, pressure_drop=drop[index], outlet_pressure=outlet[index],
+                            external_pressure=p_e)
             q[index] = sol.flow_rate
             _, d_in[index], d_out[index] = sol._sensitivities()
             radius_in[index] = sol.inlet_radius
@@ -321,14 +338,15 @@ class _Groups:
         """Flow-controlled: the inlet pressure and the inlet and outlet radii of the tubes carrying
         ``q > 0`` with ``outlet`` pressure; a flow rate beyond a tube's maximum raises, naming it."""
         p_in, radius_in, radius_out = (np.zeros(q.size) for _ in range(3))
-        for index, fluid, wall, tube in self.parts:
+        for (index, fluid, wall, tube), p_e in zip(self.parts, self.external):
             with warnings.catch_warnings():    # checked with the rest of the result
                 warnings.simplefilter("ignore", ModelValidityWarning)
                 sol = solve(fluid, wall, tube, flow_rate=q[index], outlet_pressure=outlet[index],
-                            on_infeasible="nan")
+                            external_pressure=p_e, on_infeasible="nan")
             if sol.feasible is not None:
                 j = int(np.flatnonzero(~sol.feasible)[0])
-                limit = np.broadcast_to(tubefsi_max_flow(fluid, wall, tube, outlet_pressure=outlet[index]), index.shape)[j]
+                limit = np.broadcast_to(tubefsi_max_flow(fluid, wall, tube, outlet_pressure=outlet[index],
+                                                         external_pressure=p_e), index.shape)[j]
                 raise NoSteadyStateError("flow_rate", float(limit), float(q[index][j]),
                                          f"the inflow into tube {tubes[index[j]].name!r} reaches its maximum flow rate "
                                          f"at the outlet pressure {outlet[index][j]:.10g} Pa")
@@ -725,7 +743,8 @@ class NetworkSolution:
         if t is None:
             raise InvalidParameterError("name", "the name of a tube of the network", name)
         pu, pv = self.pressure[t.u], self.pressure[t.v]
-        return solve(t.rheology, t.wall, t.tube, flow_rate=abs(self.flow_rate[name]), outlet_pressure=min(pu, pv))
+        return solve(t.rheology, t.wall, t.tube, flow_rate=abs(self.flow_rate[name]), outlet_pressure=min(pu, pv),
+                     external_pressure=t.external_pressure)
 
     def node_table(self) -> dict:
         """Columns ``node``, ``pressure`` (Pa), ``inflow`` (m^3/s, net flow injected; at a fixed

@@ -500,7 +500,8 @@ _LIMIT_SHOWN_BELOW = 1.25
 
 
 def plot_profiles(solution, *, axes=None, n=200, max_loads=8):
-    r"""Plot the pressure :math:`p(z)` and the radius :math:`R(z)/a` along the tube.
+    r"""Plot the pressure :math:`p(z)` and the radius :math:`R(z)/a` along the tube (for a tapered
+    or graded tube, ``docs/graded.md``, the radius :math:`R(z)` and :math:`a(z)` in mm).
 
     Parameters
     ----------
@@ -555,18 +556,31 @@ def plot_profiles(solution, *, axes=None, n=200, max_loads=8):
         r = np.asarray(sub.radius(z[:, None]))
         cmap = mpl.colormaps["viridis"]
         colors = [cmap(0.9 * k / max(len(qs) - 1, 1)) for k in range(len(qs))]   # one colour per load
-    lim = solution.wall.limit_pressure(tube.reduced_thickness)
+    graded = solution.scene.graded       # a taper or stenosis: R(z) and a(z) in length units, not R/a
+    if graded:                           # the limit pressure of the inlet section
+        inlet = solution.scene.uniform_at(0.0)
+        lim = inlet.wall.limit_pressure(inlet.tb)
+        lim = float(np.min(lim)) if np.ndim(lim) else lim
+    else:
+        lim = solution.wall.limit_pressure(tube.reduced_thickness)
     p_top = float(np.max(p, initial=0.0))
     show_limit = math.isfinite(lim) and lim <= _LIMIT_SHOWN_BELOW * max(p_top, 0.0) and p_top > 0
     z_sym, z_unit = _axes_unit(ax_r, "x", "length", tube.length)
     p_sym, p_unit = _axes_unit(ax_p, "y", "pressure", max(p_top, lim if show_limit else 0.0))
     q_sym, q_unit = _unit("flow_rate", float(np.max(qs, initial=0.0)))
     zz = z / z_unit
+    if graded:
+        r_sym, r_unit = _axes_unit(ax_r, "y", "length", float(np.max(r, initial=0.0)))
+    scale = 1.0 / r_unit if graded else 1.0 / a
     for j, c in enumerate(colors):
         entry = f"{qs[j] / q_unit:.3g}"
         ax_p.plot(zz, p[:, j] / p_unit, color=c, lw=1.8, label=entry)
-        ax_r.plot(zz, r[:, j] / a, color=c, lw=1.8, label="_nolegend_")
-    ax_r.axhline(1.0, color="k", lw=1.2, ls=(0, (4, 3)), zorder=3, label="undeformed")
+        ax_r.plot(zz, r[:, j] * scale, color=c, lw=1.8, label="_nolegend_")
+    if graded:
+        ax_r.plot(zz, np.broadcast_to(tube.at(z)[0], z.shape) * scale, color="k", lw=1.2, ls=(0, (4, 3)), zorder=3,
+                  label="undeformed")
+    else:
+        ax_r.axhline(1.0, color="k", lw=1.2, ls=(0, (4, 3)), zorder=3, label="undeformed")
     if show_limit:
         ax_p.axhline(lim / p_unit, color="0.35", lw=1.0, ls="--", label="limit pressure")
     elif math.isfinite(lim):
@@ -574,11 +588,12 @@ def plot_profiles(solution, *, axes=None, n=200, max_loads=8):
                       xycoords="axes fraction", ha="right", va="top", fontsize=8, color="0.35")
 
     ax_p.set_ylabel(f"pressure $p$ ({p_sym})")
-    ax_r.set_ylabel("radius $R/a$")
+    ax_r.set_ylabel(f"radius $R$ ({r_sym})" if graded else "radius $R/a$")
     ax_r.set_xlabel(f"axial position $z$ ({z_sym})")
     ax_p.set_xlim(0.0, tube.length / z_unit)
     ax_p.set_ylim(bottom=min(0.0, float(np.min(p)) / p_unit))
-    ax_r.set_ylim(bottom=min(0.95, float(np.min(r)) / a - 0.02))
+    if not graded:
+        ax_r.set_ylim(bottom=min(0.95, float(np.min(r)) / a - 0.02))
     for axx in (ax_p, ax_r):
         axx.grid(True, alpha=0.25)
     wall_name = _model_name(solution.wall, "wall")

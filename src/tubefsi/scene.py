@@ -23,7 +23,9 @@ from .registry import rheologies as _rheologies
 from .registry import walls as _walls
 from .rheology.base import Rheology
 from .walls.base import WallModel
-from .fields import _array_fields, _replace, model_at, parameter_shape
+from .walls.hyperelastic import InstalledTube
+from .fields import _array_fields, _replace, at_position, model_at, parameter_shape, varies
+from .profiles import Profile
 
 __all__ = ["Scene", "State", "Points", "make_scene", "resolve"]
 
@@ -113,6 +115,13 @@ class Scene:
                                     parameter_shape(self.tube), np.shape(self.outlet_pressure),
                                     np.shape(self.external_pressure), np.shape(self.gauge_outlet_pressure))
         object.__setattr__(self, "shape", shape)
+        if self.graded:                     # the outlet state of the tube law at z = L
+            wall, tb = self.at_outlet()
+            strain = wall.strain(self.outlet_pressure, tb) if np.any(np.asarray(self.outlet_pressure) != 0) else 0.0
+            object.__setattr__(self, "outlet_strain", strain)
+            object.__setattr__(self, "outlet_stretch", 1.0 + strain)
+            object.__setattr__(self, "log_stretch_max", math.inf)
+            return
         # the hoop strain at the outlet, once: every J evaluation needs it
         p_out, tb = self.outlet_pressure, self.tb
         if np.ndim(p_out) == 0 and p_out == 0:
@@ -144,8 +153,40 @@ class Scene:
 
     @property
     def tb(self):
-        """The reduced thickness t/a of the tube."""
+        """The reduced thickness t/a of the tube (a :class:`~tubefsi.Profile` for a graded tube)."""
         return self.tube.reduced_thickness
+
+    @property
+    def graded(self) -> bool:
+        """Whether the tube or the wall varies along z (``docs/graded.md``)."""
+        return self.tube.graded or varies(self.wall)
+
+    def at_position(self, z, index=None):
+        """``(wall, radius, tb)`` at the positions ``z`` (aligned with the flat points ``index`` if
+        given): the wall with its profiles evaluated there, a(z) and t(z)/a(z)."""
+        a, t = self.tube.at(z)
+        if index is not None:
+            a = a if isinstance(self.tube.radius, Profile) or np.ndim(a) == 0 else a[index]
+            t = t if isinstance(self.tube.thickness, Profile) or np.ndim(t) == 0 else t[index]
+        return at_position(self.wall, z, index), a, t / a
+
+    def at_outlet(self):
+        """``(wall, tb)`` at z = L: the tube law at the outlet."""
+        L = np.asarray(self.tube.length, dtype=float)
+        wall, _, tb = self.at_position(L)
+        return _scalars(wall), (float(tb) if np.ndim(tb) == 0 else tb)
+
+    def uniform_at(self, z) -> Scene:
+        """The uniform scene of the tube's section at the position ``z`` (a float, m): every profile
+        evaluated there (the validity checks of a graded solve use the inlet's, z = 0)."""
+        wall, a, tb = self.at_position(np.asarray(float(z)))
+        wall = _scalars(wall)
+        a = float(a) if np.ndim(a) == 0 else a
+        t = a * (float(tb) if np.ndim(tb) == 0 else tb)
+        tube = attrs.evolve(self.tube, radius=a, thickness=t) if type(self.tube) is not Tube else \
+            Tube(radius=a, thickness=t, length=self.tube.length)
+        return Scene(rheology=self.rheology, wall=wall, tube=tube, outlet_pressure=self.outlet_pressure,
+                     external_pressure=self.external_pressure, gauge_outlet_pressure=self.gauge_outlet_pressure)
 
     @property
     def size(self) -> int:
@@ -245,6 +286,13 @@ def _refresh(scene):
     return scene
 
 
+def _scalars(model):
+    """``model`` with its 0-d array parameters as floats."""
+    values = {n: float(v) for n in _array_fields(type(model))
+              if isinstance(v := getattr(model, n), np.ndarray) and v.ndim == 0}
+    return _replace(model, values) if values else model
+
+
 def _array_values(model) -> dict:
     return {n: v for n in _array_fields(type(model)) if isinstance(v := getattr(model, n), np.ndarray)}
 
@@ -329,6 +377,12 @@ def make_scene(rheology, wall, tube, *, outlet_pressure=0.0, external_pressure=0
     wall = resolve("wall", wall)
     if not isinstance(tube, Tube):
         raise InvalidParameterError("tube", "a tubefsi.Tube", tube)
+    if varies(rheology):
+        name = next(n for n in _array_fields(type(rheology)) if isinstance(getattr(rheology, n), Profile))
+        raise InvalidParameterError(name, "a number or an array (a fluid's parameters do not vary along the tube)",
+                                    getattr(rheology, name))
+    if tube.graded or varies(wall):
+        return _graded_scene(rheology, wall, tube, outlet_pressure, external_pressure)
     tube = wall._installed_tube(tube)        # an axial pre-stretch installs the tube longer and narrower
     p_out = as_array("outlet_pressure", outlet_pressure, "[0, inf)", lambda a: a >= 0)
     p_out = float(p_out) if p_out.ndim == 0 else p_out
@@ -348,6 +402,63 @@ def make_scene(rheology, wall, tube, *, outlet_pressure=0.0, external_pressure=0
         return Scene(rheology=rheology, wall=wall, tube=tube, outlet_pressure=p_out)
     return Scene(rheology=rheology, wall=wall, tube=tube, outlet_pressure=p_out, external_pressure=p_e,
                  gauge_outlet_pressure=gauge)
+
+
+#: Positions (fractions of L) where a graded scene's profiles are validated when it is made.
+_CHECK_NODES = np.linspace(0.0, 1.0, 65)
+
+
+def _graded_scene(rheology, wall, tube, outlet_pressure, external_pressure):
+    """:func:`make_scene` for a tube or wall that varies along z: installed at the axial stretch
+    (positions and radii rescaled), validated at 65 positions and the breakpoints (every later
+    evaluation validates itself), the outlet checked with the tube law at z = L."""
+    lz = getattr(wall, "axial_stretch", 1.0)
+    if np.ndim(lz) != 0:
+        raise InvalidParameterError("axial_stretch", "a number for a tube or wall that varies along z", lz)
+    if lz != 1.0:
+        shrink = 1.0 / math.sqrt(lz)
+        fields = {n: (v.scaled(shrink, 1.0 / lz) if isinstance(v, Profile) else v * shrink)
+                  for n in ("radius", "thickness") for v in [getattr(tube, n)]}
+        tube = InstalledTube(**fields, length=tube.length * lz, axial_stretch=lz)
+        wall = _replace(wall, {n: v.scaled(1.0, 1.0 / lz) for n in _array_fields(type(wall))
+                               if isinstance(v := getattr(wall, n), Profile)})
+    length = np.asarray(tube.length, dtype=float)
+    top = float(np.max(length))
+    for model in (tube, wall):
+        for name in _array_fields(type(model)):
+            if isinstance(v := getattr(model, name), Profile):
+                v.check_span(top)
+    breaks = [b for m in (tube, wall) for n in _array_fields(type(m)) if isinstance(v := getattr(m, n), Profile)
+              for b in v.breakpoints if 0 < b < top]
+    z = np.concatenate([top * _CHECK_NODES, breaks]).reshape((-1,) + (1,) * max(
+        len(parameter_shape(wall)), np.ndim(length)))
+    a, t = tube.at(z)
+    tb = np.asarray(t / a)
+    if not np.all(np.isfinite(tb) & (tb > 0)):
+        raise InvalidParameterError("thickness", "values with a finite, nonzero t/a along the tube",
+                                    tube.thickness)
+    checked = {n: v(z) for n in _array_fields(type(wall)) if isinstance(v := getattr(wall, n), Profile)}
+    if checked:
+        attrs.evolve(_replace(wall, {n: getattr(wall, n) for n in checked}), **checked)   # validators, cross-checks
+    p_out = as_array("outlet_pressure", outlet_pressure, "[0, inf)", lambda a: a >= 0)
+    p_out = float(p_out) if p_out.ndim == 0 else p_out
+    p_e = as_array("external_pressure", external_pressure, "the real numbers", lambda a: a == a)
+    p_e = float(p_e) if p_e.ndim == 0 else p_e
+    outlet_wall, _, tb_out = (lambda w, a_, tb_: (_scalars(w), a_, tb_))(*_at(tube, wall, length))
+    gauge = p_out
+    if np.any(p_e != 0):
+        p_out = _transmural(outlet_wall, tb_out, p_out, p_e)
+    lim = outlet_wall.limit_pressure(tb_out)
+    if np.any(np.asarray(p_out >= lim)):
+        raise NoSteadyStateError("pressure", float(np.min(lim)), float(np.max(p_out)),
+                                 "the outlet pressure already reaches it", name="the outlet pressure")
+    return Scene(rheology=rheology, wall=wall, tube=tube, outlet_pressure=p_out, external_pressure=p_e,
+                 gauge_outlet_pressure=gauge)
+
+
+def _at(tube, wall, z):
+    a, t = tube.at(z)
+    return at_position(wall, z), a, (float(t / a) if np.ndim(t / a) == 0 else t / a)
 
 
 def _transmural(wall, tb, p_out, p_e):

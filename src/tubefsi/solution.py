@@ -16,6 +16,7 @@ from ._numerics import as_output
 from ._validation import as_array
 from .couplers.base import Coupler
 from .errors import InvalidParameterError
+from .profiles import Profile
 from .scene import Scene, State
 
 __all__ = ["Solution"]
@@ -87,12 +88,17 @@ class Solution:
     @property
     def inlet_displacement(self):
         """Radial displacement of the inner wall at the inlet, R(0) - a (m), without cancellation."""
-        return as_output(self.tube.radius * self.state.inlet_strain, self.scalar)
+        return as_output(self._undeformed(0.0) * self.state.inlet_strain, self.scalar)
 
     @property
     def inlet_radius(self):
         """Deformed inner radius at the inlet R(0) (m)."""
-        return as_output(self.tube.radius * (1.0 + self.state.inlet_strain), self.scalar)
+        return as_output(self._undeformed(0.0) * (1.0 + self.state.inlet_strain), self.scalar)
+
+    def _undeformed(self, z):
+        """The undeformed radius a(z) (m): the tube's radius, evaluated at ``z`` for a graded tube."""
+        a = self.tube.radius
+        return a(np.asarray(z, dtype=float)) if isinstance(a, Profile) else a
 
     @property
     def max_flow_rate(self) -> float:
@@ -183,6 +189,9 @@ class Solution:
         :math:`(\Delta p - L G_{in})/\mu`. Other wall parameters raise
         ``InvalidParameterError`` (difference two solves). 0 where ``q = 0``.
         """
+        if self.scene.graded:
+            raise InvalidParameterError("parameter", "a parameter of a uniform tube's solve (a graded tube: "
+                                        "difference two solves)", parameter)
         owner, _, field = parameter.partition(".")
         model = {"rheology": self.rheology, "wall": self.wall}.get(owner)
         if model is None or not attrs.has(type(model)) or field not in attrs.fields_dict(type(model)):
@@ -243,29 +252,29 @@ class Solution:
     def radius(self, z):
         """Deformed inner radius R(z) (m)."""
         strain, _, _ = self._profile(z)
-        return self._out(self.tube.radius * (1.0 + strain), z)
+        return self._out(self._undeformed(z) * (1.0 + strain), z)
 
     def displacement(self, z):
         """Radial wall displacement R(z) - a (m), without cancellation."""
         strain, _, _ = self._profile(z)
-        return self._out(self.tube.radius * strain, z)
+        return self._out(self._undeformed(z) * strain, z)
 
     def pressure_gradient(self, z):
         """Local pressure gradient G = -dp/dz (Pa/m)."""
         strain, _, q = self._profile(z)
-        return self._out(self.rheology.pressure_gradient(q, self.tube.radius * (1.0 + strain)), z)
+        return self._out(self.rheology.pressure_gradient(q, self._undeformed(z) * (1.0 + strain)), z)
 
     def wall_shear_stress(self, z):
         """Wall shear stress tau_w = G R / 2 (Pa)."""
         strain, _, q = self._profile(z)
-        big_r = self.tube.radius * (1.0 + strain)
+        big_r = self._undeformed(z) * (1.0 + strain)
         return self._out(0.5 * self.rheology.pressure_gradient(q, big_r) * big_r, z)
 
     def velocity(self, r, z):
         """Axial velocity v(r, z) (m/s) at radial position ``r`` in [0, R(z)] (m)."""
         r_arr = as_array("r", r, "[0, R(z)] (m)", lambda a: a >= 0)
         strain, _, q = self._profile(z)
-        big_r = self.tube.radius * (1.0 + strain)
+        big_r = self._undeformed(z) * (1.0 + strain)
         g = self.rheology.pressure_gradient(q, big_r)
         r_arr, big_r, g = np.broadcast_arrays(r_arr, big_r, g)
         if np.any(r_arr > big_r * (1 + 1e-12)) or np.any(r_arr < 0):
@@ -306,6 +315,10 @@ class Solution:
         is the relative error of the pressure drop that the clamped ends cause, as the
         finite-element validity map measured it (``docs/validity.md``).
         """
+        if self.scene.graded:
+            raise InvalidParameterError("solution", "the solution of a uniform tube (the diagnostics do not cover "
+                                        "tapered and graded tubes yet; solve checks each graded result at its inlet "
+                                        "section)", self)
         from .advise import diagnostics
 
         return diagnostics(self, density=density, warn=warn)

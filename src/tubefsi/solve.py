@@ -19,6 +19,7 @@ from ._progress import bar
 from ._validation import as_load
 from .couplers.base import Coupler
 from .couplers.checked import checked
+from .couplers.graded import Graded
 from .errors import InvalidParameterError, NoSteadyStateError, StretchRangeError
 from .couplers.separated import _TABLES, SeparatedVariables, curve_span
 from .geometry import Tube
@@ -138,7 +139,7 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
     if on_infeasible not in ("raise", "nan"):
         raise InvalidParameterError("on_infeasible", "{'raise', 'nan'}", on_infeasible)
     rho = None if density is None else as_load("density", density, allow_zero=False)
-    chosen = select_coupler(scene.rheology, scene.wall, coupler)
+    chosen = _graded(scene, coupler) if scene.graded else select_coupler(scene.rheology, scene.wall, coupler)
     runner = checked(chosen)            # a self-checking coupler is re-solved finer (AccuracyWarning)
     controlled = "flow_rate" if flow_rate is not None else "pressure_drop"
     load = as_load(controlled, flow_rate if flow_rate is not None else pressure_drop)
@@ -169,7 +170,8 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
         raise _beyond_range(controlled, values[i:i + 1], "the result is not a finite double")
     if density is not None:
         density = float(rho) if rho.ndim == 0 else np.broadcast_to(rho, shape).ravel()
-    warn(check(flat, out["flow_rate"], out["inlet_strain"], density=density))
+    warn(check(flat.uniform_at(0.0) if scene.graded else flat, out["flow_rate"], out["inlet_strain"],
+               density=density))
     state = State(*(out[f.name].reshape(shape) for f in attrs.fields(State)))
     return Solution(scene=scene, coupler=chosen, state=state, scalar=shape == (),
                     coupler_name=registry.couplers.name_of(chosen) or type(chosen).__name__,
@@ -242,6 +244,16 @@ def _solve_chunks(flat, values, method, runner, controlled, optimistic, on_infea
             shown.update(idx.size)
 
 
+def _graded(scene, coupler):
+    """The coupler of a tube or wall that varies along z (``docs/graded.md``): :class:`Graded`, with
+    ``coupler`` (unless ``"auto"``) for the equivalent uniform tube of a separable taper."""
+    if isinstance(coupler, Graded):
+        return coupler
+    if isinstance(coupler, str) and coupler == "auto":
+        return Graded()
+    return Graded(uniform=select_coupler(scene.rheology, scene.wall, coupler))
+
+
 def _beyond_range(controlled, values, why):
     """The typed error of a load (with its scene) whose solution leaves double precision."""
     return InvalidParameterError(controlled, "loads whose solution is within double precision",
@@ -309,13 +321,15 @@ CHUNK = 1 << 14
 def _feasible(coupler, scene, load, controlled, *, raise_):
     """The points below every limit (None: all of them); raises for the first one beyond if ``raise_``."""
     if controlled == "flow_rate":
-        limit = np.asarray(coupler.max_flow_rate(scene), dtype=float)
+        limit = np.asarray(coupler.max_flow_rate(scene, strict=False) if scene.graded else
+                           coupler.max_flow_rate(scene), dtype=float)
         if not np.any(np.isfinite(limit)):
             return None
         beyond = (load > 0) & (load >= limit)
         quantity, detail = "flow_rate", "the tube inflates without bound"
     else:
-        limit = np.asarray(scene.wall.limit_pressure(scene.tb), dtype=float) - scene.outlet_pressure
+        limit = np.asarray(coupler.limit_pressure(scene) if scene.graded else scene.wall.limit_pressure(scene.tb),
+                           dtype=float) - scene.outlet_pressure
         if not np.any(np.isfinite(limit)):
             return None
         beyond = load >= limit
@@ -343,7 +357,7 @@ def max_flow_rate(rheology, wall, tube, *, outlet_pressure=0.0, external_pressur
     (an array of the scene's shape comes back).
     """
     scene = make_scene(rheology, wall, tube, outlet_pressure=outlet_pressure, external_pressure=external_pressure)
-    chosen = select_coupler(scene.rheology, scene.wall, coupler)
+    chosen = _graded(scene, coupler) if scene.graded else select_coupler(scene.rheology, scene.wall, coupler)
     if scene.shape == ():
         return float(chosen.max_flow_rate(scene))
     flat = scene.flat(scene.shape)

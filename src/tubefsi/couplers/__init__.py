@@ -10,14 +10,16 @@ module                contents
 ``quadrature``        :class:`Quadrature` (registered ``quadrature``)
 ``ode``               :class:`ODE` (registered ``ode``), the chapter's method
 ``checked``           :class:`Checked`, the a-posteriori check of any self-checking coupler
+``graded``            :class:`Graded`, tubes and walls that vary along z (``docs/graded.md``)
 ====================  ==========================================================================
 """
 
 from .base import Coupler
 from .checked import Checked, checked
 from .closed_form import ClosedForm
+from .graded import Graded
 from .ode import ODE
 from .quadrature import Quadrature
 from .separated import SeparatedVariables
 
-__all__ = ["Coupler", "SeparatedVariables", "ClosedForm", "Quadrature", "ODE", "Checked", "checked"]
+__all__ = ["Coupler", "SeparatedVariables", "ClosedForm", "Quadrature", "ODE", "Checked", "checked", "Graded"]

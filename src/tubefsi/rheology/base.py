@@ -48,7 +48,8 @@ def _overrides(obj, name) -> bool:
 
 
 class Rheology(abc.ABC):
-    r"""Abstract base of every rheology (see the module docstring for the contract).
+    r"""Abstract base of every rheology (see the module docstring for the contract). Its
+    parameters are numbers or arrays, never functions of z (``varies_along_z = False``).
 
     Hooks (arrays of positive arguments; implement one of the first two, override the
     others for speed or accuracy):
@@ -87,6 +88,8 @@ class Rheology(abc.ABC):
 
     #: True when ``pressure_gradient(q, R) = phi(q) * psi(R)``.
     separable: ClassVar[bool] = False
+    #: Parameters may not be functions of z (a fluid does not vary along the tube).
+    varies_along_z: ClassVar[bool] = False
     #: :math:`k` with :math:`G(q, R) = \phi(q) R^{-k}` (power law: :math:`3n+1`); None if not of that form.
     radius_exponent = None
     #: The yield stress (Pa); a yield-stress fluid declares it as a field.

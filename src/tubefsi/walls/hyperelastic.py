@@ -66,7 +66,7 @@ THICKNESS_CONVENTIONS = ("reference", "current")
 def axial_stretch():
     """The ``axial_stretch`` parameter of a material that supports an axial pre-stretch
     (``docs/walls_beyond.md``, section "Axial pre-stretch"): positive, default 1."""
-    return positive(default=1.0, doc="axial pre-stretch lambda_z: installed / stress-free length")
+    return positive(default=1.0, doc="axial pre-stretch lambda_z: installed / stress-free length", along=False)
 
 
 class HyperelasticWall(WallModel):

@@ -15,7 +15,7 @@ from __future__ import annotations
 import attrs
 import numpy as np
 
-from ..fields import real
+from ..fields import real, varies
 from ..errors import InvalidParameterError
 from .hyperelastic import HyperelasticWall, ThickWall, ThinWall, axial_stretch
 from .neo_hookean import _ThickForms, _ThinForms
@@ -32,6 +32,8 @@ class MooneyRivlin(HyperelasticWall):
     axial_stretch: float = axial_stretch()
 
     def __attrs_post_init__(self):
+        if varies(self):           # a graded wall: checked where the scene evaluates it along z
+            return
         total = np.asarray(self.c1 + self.c2)
         if not np.all(total > 0):
             bad = np.argwhere(~(total > 0))[0] if total.ndim else ()

@@ -1,0 +1,474 @@
+r"""``Graded``: tubes whose radius, thickness or wall parameters vary along z (``docs/graded.md``).
+
+The lubrication problem is :math:`dp/dz = -G(q, a(z)\,\lambda(p; \bar t(z), \theta(z)))`,
+:math:`p(L) = p_{out}`, with :math:`\lambda` the local tube law's inverse.
+
+*Separable case.* Where the tube law does not depend on z — :math:`\bar t = t/a` and every wall
+parameter constant, only the radius varies — and the fluid is a power law,
+:math:`G = \phi(q) R^{-k}`, the variables still separate:
+:math:`\lambda^k\,dp = -\phi(q)\,a(z)^{-k}\,dz`, so the tube is the uniform tube of radius
+:math:`a_{ref} = a(L)` and the *equivalent length*
+
+.. math::
+
+    L_{eq} = \int_0^L \Bigl(\frac{a_{ref}}{a(z)}\Bigr)^k dz,
+
+the position z mapping to :math:`z_{eq}` with :math:`L_{eq} - z_{eq} = \int_z^L (a_{ref}/a)^k dz'`.
+That uniform tube is solved by the separated-variables engine (exact, fast, tables), and
+:math:`L_{eq}` by adaptive Gauss–Kronrod quadrature (relative 1e-15, split at the profiles'
+breakpoints). The case is detected at the quadrature's own nodes: :math:`\bar t(z)` and the wall
+parameters must equal their outlet values there to 1e-14.
+
+*General case.* The ODE is integrated from the outlet to each requested position by an
+embedded Dormand–Prince 8(5,3) pair with *per-point* step-size control, vectorized over all
+points (each has its own position, step and error), never stepping across a breakpoint;
+the tube law is inverted at every stage. The answer (local tolerance ``rtol``) is checked a
+posteriori against a second integration at 100 ``rtol``: where the two differ by more than
+``check_threshold`` an :class:`~tubefsi.AccuracyWarning` states the difference. Pressure-
+controlled problems find the flow rate by bracketed root finding (Chandrupatla) on
+:math:`\ln\Delta p(\ln q)`. A trial step beyond the local limit pressure is rejected and
+halved; a point that cannot advance is beyond its steady state (:class:`~tubefsi.NoSteadyStateError`).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import ClassVar, final
+
+import attrs
+import numpy as np
+
+from .._lazy import lazy_module
+from .._quadrature import adaptive
+from ..errors import (AccuracyWarning, ConvergenceError, InvalidParameterError, NoSteadyStateError,
+                      StretchRangeError, warn_user)
+from ..fields import _array_fields, at_position, model_at
+from ..geometry import Tube
+from ..profiles import Profile
+from ..scene import Scene, State
+from ._options import tolerance
+from .base import Coupler
+from .checked import checked
+from .closed_form import ClosedForm
+from .quadrature import Quadrature
+
+__all__ = ["Graded"]
+
+# SciPy on first use (tubefsi._lazy): listing the models must not import it
+elementwise = lazy_module("scipy.optimize.elementwise", globals(), "elementwise")
+_dop = lazy_module("scipy.integrate._ivp.dop853_coefficients", globals(), "_dop")   # the DOP853 tableau
+#: Relative deviation of t/a or a wall parameter from its outlet value still taken as constant.
+_CONSTANT = 1e-14
+#: The largest hoop stretch the integration along a graded tube follows (R/L is far beyond the
+#: model's reach long before); a point that would exceed it is beyond its steady state.
+STRETCH_CAP = 1e3
+#: Steps (rounds over all points) before the integration gives up.
+_MAX_ROUNDS = 20_000
+
+
+def _profiles(model):
+    return {n: v for n in _array_fields(type(model)) if isinstance(v := getattr(model, n), Profile)}
+
+
+def _breakpoints(scene) -> np.ndarray:
+    """All breakpoints of the scene's profiles, sorted (m)."""
+    found = set()
+    for model in (scene.tube, scene.wall):
+        for p in _profiles(model).values():
+            found.update(p.breakpoints)
+    return np.array(sorted(found), dtype=float)
+
+
+def _split(lower, upper, breaks):
+    """``(lo, hi, owner)``: the intervals ``[lower_i, upper_i]`` (lower < upper) split at ``breaks``."""
+    n = lower.size
+    if breaks.size == 0:
+        return lower, upper, np.arange(n)
+    edges = np.sort(np.clip(np.concatenate([lower[:, None], np.broadcast_to(breaks, (n, breaks.size)),
+                                            upper[:, None]], axis=1), lower[:, None], upper[:, None]), axis=1)
+    lo, hi = edges[:, :-1], edges[:, 1:]
+    keep = hi > lo
+    owner = np.broadcast_to(np.arange(n)[:, None], lo.shape)
+    return lo[keep], hi[keep], owner[keep]
+
+
+def _a_ref(scene):
+    """The outlet radius a(L) of each point of a flat scene (the equivalent uniform tube's radius)."""
+    L = np.broadcast_to(np.asarray(scene.tube.length, dtype=float), (scene.size,))
+    return np.broadcast_to(np.asarray(scene.tube.at(L)[0], dtype=float), (scene.size,))
+
+
+def _points(scene, n):
+    """The flat point of each of ``n`` entries: one each, or all the single point of a scalar scene."""
+    return np.zeros(n, dtype=int) if scene.size == 1 else np.arange(n)
+
+
+
+@final
+@attrs.frozen(kw_only=True)
+class Graded(Coupler):
+    """Tubes and walls that vary along z: exact where separable, else an error-controlled ODE."""
+
+    rtol: float = tolerance(1e-15, 1e-6, default=1e-13, doc="local relative tolerance of the integration along z")
+    check_threshold: float = tolerance(1e-15, 1.0, default=1e-10,
+                                       doc="largest difference from the 100 rtol integration without a warning")
+    #: The coupler of the separable case's equivalent uniform tube (``"auto"`` or a coupler).
+    uniform: object = "auto"
+
+    cost_rank: ClassVar[int] = 5000
+    meets_accuracy_contract: ClassVar[bool] = False     # never picked by "auto" for a uniform tube
+
+    def supports(self, rheology, wall) -> bool:
+        return True
+
+    def describe(self) -> str:
+        return f"Graded(rtol={self.rtol:g})"
+
+    # ------------------------------------------------------------------ separable case
+    def equivalent(self, scene: Scene):
+        r"""The uniform scene equivalent to a separable graded scene (radius :math:`a(L)`, length
+        :math:`L_{eq}`, the wall at z = L) and its coupler; None if the scene is not separable."""
+        rheo = scene.rheology
+        k = rheo.radius_exponent
+        if not rheo.separable or k is None:
+            return None
+        n = scene.size
+        index = np.arange(n)
+        L = np.broadcast_to(np.asarray(scene.tube.length, dtype=float), (n,))
+        wall_out, tb_out = scene.at_outlet()
+        a_ref = _a_ref(scene)
+        value, ok = self._length_integral(scene, np.zeros(n), L, index, a_ref, wall_out, tb_out)
+        if not ok:
+            return None
+        shared = scene.size == 1 or scene.shape == ()
+        if shared:
+            a_s, l_s, tb_s = float(a_ref[0]), float(value[0]), float(np.ravel(tb_out)[0])
+        else:
+            a_s, l_s, tb_s = a_ref, value, np.broadcast_to(tb_out, (n,))
+        tube = Tube(radius=a_s, thickness=a_s * tb_s, length=l_s)
+        uniform = Scene(rheology=rheo, wall=wall_out, tube=tube, outlet_pressure=scene.outlet_pressure,
+                        external_pressure=scene.external_pressure, gauge_outlet_pressure=scene.gauge_outlet_pressure)
+        return uniform
+
+    def _length_integral(self, scene, lower, upper, index, a_ref, wall_out, tb_out):
+        r""":math:`\int (a_{ref}/a)^k dz` over ``[lower, upper]`` per entry (points ``index``), and whether
+        t/a and the wall parameters stayed at their outlet values on every node."""
+        k = np.broadcast_to(np.asarray(scene.rheology.radius_exponent, dtype=float), (scene.size,))
+        walls = _profiles(scene.wall)
+        ref = {name: np.broadcast_to(np.asarray(getattr(wall_out, name), dtype=float), (scene.size,))
+               for name in walls}
+        tb_ref = np.broadcast_to(np.asarray(tb_out, dtype=float), (scene.size,))
+        constant = [True]
+        lo, hi, owner = _split(np.asarray(lower, dtype=float), np.asarray(upper, dtype=float), _breakpoints(scene))
+        pts = np.asarray(index)[owner]
+
+        def f(z, i):
+            p = pts[i][:, None]
+            a, t = scene.tube.at(z)
+            if isinstance(scene.tube.thickness, Profile) or isinstance(scene.tube.radius, Profile):
+                dev = np.abs(t / a / tb_ref[p] - 1.0)
+                if np.any(dev > _CONSTANT):
+                    constant[0] = False
+            for name, prof in walls.items():
+                if np.any(np.abs(prof(z) - ref[name][p]) > _CONSTANT * np.abs(ref[name][p])):
+                    constant[0] = False
+            return (a_ref[p] / a) ** k[p] + 0.0 * z
+
+        result = adaptive(f, lo, hi, rtol=1e-15)
+        if not constant[0]:
+            return None, False
+        if not np.all(result.converged) and np.any(result.error > 1e-13 * np.abs(result.value)):
+            warn_user(f"the equivalent length of a tapered tube: estimated relative error "
+                      f"{float(np.max(result.error / np.abs(result.value))):.2g}", AccuracyWarning)
+        out = np.bincount(owner, result.value, minlength=np.size(lower))
+        return out, True
+
+    def _uniform(self, scene):
+        """``(uniform scene, its coupler)`` for a separable scene, else None."""
+        uniform = self.equivalent(scene)
+        if uniform is None:
+            return None
+        return uniform, checked(_uniform_coupler(self.uniform, uniform))
+
+    def _on_uniform(self, scene, method, *args):
+        """``method`` of the equivalent uniform tube's coupler on it, or None if not separable."""
+        found = self._uniform(scene)
+        return None if found is None else getattr(found[1], method)(found[0], *args)
+
+    # ------------------------------------------------------------------ problems
+    def flow_controlled(self, scene, flow_rate):
+        q = np.asarray(flow_rate, dtype=float)
+        state = self._on_uniform(scene, "flow_controlled", q)
+        if state is not None:
+            return state
+        rise = self._checked_rise(scene, q, np.zeros(q.shape))
+        return self._state(scene, q, rise)
+
+    def _state(self, scene, q, rise):
+        index = _points(scene, q.size)
+        wall0, a0, tb0 = scene.at_position(np.zeros(q.size), index)
+        p = np.asarray(scene.outlet_pressure) + rise
+        strain = wall0._strain(p + 0.0 * rise, tb0)
+        out_stretch = np.asarray(scene.outlet_stretch)
+        v = np.log1p((strain - np.asarray(scene.outlet_strain)) / out_stretch)  # relative to the outlet's law
+        return State(q, rise, strain + 0.0 * q, v + 0.0 * q)
+
+    def pressure_controlled(self, scene, pressure_drop):
+        dp = np.asarray(pressure_drop, dtype=float)
+        state = self._on_uniform(scene, "pressure_controlled", dp)
+        if state is not None:
+            return state
+        q, error = self._flow_rate(scene, dp)
+        self._judge_error(error, "flow rate")
+        return self._state(scene, q, dp)
+
+    def max_flow_rate(self, scene, *, strict=True):
+        """The maximum flow rate: the equivalent uniform tube's where separable; ``inf`` where no
+        section has a limit pressure. Otherwise ``strict`` raises ``InvalidParameterError`` (not
+        implemented) and ``strict=False`` gives ``inf`` (what :func:`tubefsi.solve` asks: its
+        integration raises ``NoSteadyStateError`` where the pressure reaches a local limit)."""
+        q_max = self._on_uniform(scene, "max_flow_rate")
+        if q_max is not None:
+            return q_max
+        n = scene.size
+        z = np.linspace(0.0, 1.0, 65)[:, None] * np.broadcast_to(np.asarray(scene.tube.length, dtype=float), (n,))
+        wall, _, tb = scene.at_position(z.ravel(), np.tile(np.arange(n), 65))
+        limited = np.isfinite(np.asarray(wall._limit_pressure(tb), dtype=float) + np.zeros(65 * n))
+        if not np.any(limited) or not strict:
+            return math.inf if n == 1 else np.full(n, np.inf)
+        raise InvalidParameterError("tube", "a tube law without a limit pressure, or a separable taper, for "
+                                    "max_flow_rate", scene.tube,
+                                    "the maximum flow rate of a graded tube whose wall has a limit pressure is not "
+                                    "implemented (solve raises NoSteadyStateError beyond it)")
+
+    def sensitivities(self, scene, state):
+        """The derivatives of a solve: those of the equivalent uniform tube where the scene
+        separates (its pressure drop is the same function of the flow rate and the end pressures);
+        otherwise not implemented (``InvalidParameterError``: difference two solves)."""
+        found = self._uniform(scene)
+        if found is None:
+            raise InvalidParameterError("tube", "a uniform tube or a separable taper for the derivatives of a solve",
+                                        scene.tube, "a graded tube that does not separate: difference two solves")
+        return found[1].sensitivities(found[0], state)
+
+    def length_integral(self, scene, state, weight, *, uniform=False):
+        """Not implemented along a graded tube (the separated identity behind the weighted length
+        integrals does not hold): ``InvalidParameterError``."""
+        raise InvalidParameterError("tube", "a uniform tube for the parameter derivatives of a solve", scene.tube,
+                                    "a graded tube: difference two solves")
+
+    def limit_pressure(self, scene):
+        """The limit pressure of the inlet section (a necessary bound on the inlet pressure)."""
+        wall, _, tb = scene.at_position(np.zeros(scene.size), np.arange(scene.size))
+        return wall._limit_pressure(tb)
+
+    def profile(self, scene, state, z):
+        z = np.asarray(z, dtype=float)
+        q = np.asarray(state.flow_rate, dtype=float)
+        n = q.size
+        index = _points(scene, n)
+        L = np.broadcast_to(np.asarray(scene.tube.length, dtype=float), (scene.size,))[index]
+        zz = np.broadcast_to(z, (n,))
+        found = self._uniform(scene)
+        if found is not None:
+            uniform, inner = found
+            wall_out, tb_out = scene.at_outlet()
+            a_ref = _a_ref(scene)
+            tail, _ = self._length_integral(scene, zz.copy(), L.copy(), index, a_ref, wall_out, tb_out)
+            l_eq = np.broadcast_to(np.asarray(uniform.tube.length, dtype=float), (scene.size,))[index]
+            z_eq = np.clip(l_eq - tail, 0.0, l_eq)
+            return inner.profile(uniform, state, z_eq)
+        rise = self._checked_rise(scene, q, zz)
+        wall, _, tb = scene.at_position(zz, index)
+        strain = wall._strain(np.asarray(scene.outlet_pressure) + rise, tb)
+        return strain, rise
+
+    # ------------------------------------------------------------------ the integration
+    def _judge(self, fine, coarse, what):
+        fine, coarse = np.asarray(fine, dtype=float), np.asarray(coarse, dtype=float)
+        nz = fine != 0
+        self._judge_error(float(np.max(np.abs(coarse[nz] / fine[nz] - 1.0), initial=0.0)), what)
+
+    def _judge_error(self, err, what):
+        if err > self.check_threshold:
+            warn_user(f"{self.describe()}: the {what} at rtol {self.rtol:g} and {100 * self.rtol:g} differ by "
+                      f"{err:.2g} (relative), more than {self.check_threshold:.2g}: the estimate of its error",
+                      AccuracyWarning)
+
+    def _checked_rise(self, scene, q, z_end):
+        fine = self.rise(scene, q, z_end, self.rtol)
+        coarse = self.rise(scene, q, z_end, 100 * self.rtol)
+        self._judge(fine, coarse, "pressure rise")
+        return fine
+
+    def rise(self, scene, q, z_end, rtol, index=None, *, strict=True):
+        r"""The pressure rise :math:`p(z_{end}) - p_{out}` (Pa) for the flow rates ``q`` at the points
+        ``index`` of a flat scene (default: one per point), integrating from the outlet. Where the
+        pressure reaches a local limit pressure on the way: ``NoSteadyStateError`` (``strict``) or
+        ``inf``."""
+        shape = np.shape(q)
+        q = np.asarray(q, dtype=float).ravel()
+        n = q.size
+        index = _points(scene, n) if index is None else np.asarray(index, dtype=int).ravel()
+        L = np.broadcast_to(np.asarray(scene.tube.length, dtype=float), (scene.size,))[index] if np.ndim(
+            scene.tube.length) else np.full(n, float(scene.tube.length))
+        z_end = np.broadcast_to(np.asarray(z_end, dtype=float), shape).ravel().copy()
+        rheo = scene.rheology
+        p_out = np.broadcast_to(np.asarray(scene.outlet_pressure, dtype=float), (scene.size,))[index] if np.ndim(
+            scene.outlet_pressure) else np.full(n, float(scene.outlet_pressure))
+        out = np.zeros(n)
+        live = np.flatnonzero((q > 0) & (z_end < L))
+        if live.size == 0:
+            return out.reshape(shape)
+        idx = index[live]
+        # the scale of the pressure: the rigid-tube drop at the outlet radius
+        wall_l, a_l, tb_l = scene.at_position(L[live], idx)
+        r_out = a_l * (1.0 + wall_l._strain(p_out[live], tb_l))
+        scale = L[live] * model_at(rheo, idx)._pressure_gradient(q[live], r_out)
+        breaks = _breakpoints(scene)
+        stopped = np.zeros(live.size, dtype=bool)
+
+        def rhs(zs, ys, sel):
+            """dy/dz at (zs, ys) for the live entries ``sel`` (NaN beyond the local tube law)."""
+            pts = idx[sel]
+            wall, a, tb = scene.at_position(zs, pts)
+            p = p_out[live][sel] + ys * scale[sel]
+            lim = np.asarray(wall._limit_pressure(tb), dtype=float) + 0.0 * p
+            low = np.asarray(wall._min_pressure(tb), dtype=float) + 0.0 * p
+            bad = ~((p < lim) & (p >= low)) | ~np.isfinite(p)
+            with np.errstate(all="ignore"):
+                e = wall._strain(np.where(bad, p_out[live][sel], p), tb)
+                g = model_at(rheo, pts)._pressure_gradient(q[live][sel], a * (1.0 + e))
+            return np.where(bad | ~np.isfinite(g) | (e > STRETCH_CAP - 1.0), np.nan, -g / scale[sel])
+
+        stages = _dop.N_STAGES
+        A, B, C, E3, E5 = _dop.A[:stages, :stages], _dop.B, _dop.C[:stages], _dop.E3, _dop.E5
+        z = L[live].copy()
+        y = np.zeros(live.size)
+        span = z - z_end[live]
+        h = -np.minimum(span, span * rtol ** 0.125 * 4)
+        f = rhs(z, y, np.arange(live.size))
+        active = np.ones(live.size, dtype=bool)
+        atol = rtol
+        for _ in range(_MAX_ROUNDS):
+            sel = np.flatnonzero(active)
+            if sel.size == 0:
+                break
+            zs, ys, hs = z[sel], y[sel], h[sel]
+            target = z_end[live][sel]
+            if breaks.size:          # the next breakpoint below z (strictly), else the end
+                j = np.searchsorted(breaks, zs, side="left") - 1
+                nxt = np.where(j >= 0, breaks[np.maximum(j, 0)], -np.inf)
+                target = np.maximum(target, nxt)
+            hs = np.maximum(hs, target - zs)              # h < 0: not beyond the stop
+            K = np.empty((stages + 1, sel.size))
+            K[0] = f[sel]
+            for s in range(1, stages):
+                dy = (K[:s].T @ A[s, :s]) * hs
+                K[s] = rhs(zs + C[s] * hs, ys + dy, sel)
+            y_new = ys + hs * (K[:-1].T @ B)
+            land = np.abs(target - (zs + hs)) <= 1e-15 * np.abs(zs) + 1e-300
+            z_new = np.where(land, target, zs + hs)
+            K[-1] = rhs(z_new, y_new, sel)
+            sc = atol + rtol * np.maximum(np.abs(ys), np.abs(y_new))
+            with np.errstate(all="ignore"):
+                e5 = (K.T @ E5) / sc
+                e3 = (K.T @ E3) / sc
+                denom = np.sqrt(e5**2 + 0.01 * e3**2)
+                err = np.abs(hs) * np.where(denom > 0, e5**2 / denom, 0.0)
+            broken = ~(np.isfinite(err) & np.isfinite(y_new) & np.all(np.isfinite(K), axis=0))   # beyond the law
+            good = ~broken & (err <= 1.0)
+            with np.errstate(all="ignore", divide="ignore"):
+                factor = np.where(np.isfinite(err) & (err > 0), 0.9 * err ** -0.125, 10.0)
+            factor = np.where(good, np.clip(factor, 1.0, 10.0), np.where(broken, 0.1, np.clip(factor, 0.2, 0.9)))
+            acc = sel[good]
+            z[acc], y[acc], f[acc] = z_new[good], y_new[good], K[-1][good]
+            h[sel] = hs * factor
+            done = good & (z_new <= z_end[live][sel])
+            active[sel[done]] = False
+            # an overshoot that no longer shrinks: the stretch cap or the local limit is within |h|
+            tiny = ~good & (np.abs(h[sel]) < 1e-6 * L[live][sel]) & (z_new - z_end[live][sel] > 10 * np.abs(h[sel]))
+            if np.any(tiny):
+                stopped[sel[tiny]] = True
+                active[sel[tiny]] = False
+        else:
+            raise ConvergenceError(f"the integration along the graded tube took more than {_MAX_ROUNDS} steps")
+        if np.any(stopped) and strict:
+            i = int(np.flatnonzero(stopped)[0])
+            wall, _, tb = scene.at_position(z[i:i + 1], idx[i:i + 1])
+            limit = float(np.ravel(wall._limit_pressure(tb))[0])
+            where = (f"at z = {z[i]:.6g} m the pressure reaches the local limit of the tube law (a hoop stretch "
+                     f"{STRETCH_CAP:g}): the flow rate {q[live][i]:.6g} m^3/s is beyond the tube's maximum one")
+            if not math.isfinite(limit):
+                raise StretchRangeError(math.nan, float(q[live][i]), where.replace("the pressure reaches the local "
+                                        "limit of the tube law", "the tube inflates beyond").split(":")[0])
+            raise NoSteadyStateError("pressure", limit, float(p_out[live][i] + y[i] * scale[i]), where,
+                                     name="the (transmural) pressure")
+        y = np.where(stopped, np.inf, y)
+        out[live] = y * scale
+        return out.reshape(shape)
+
+    def _flow_rate(self, scene, dp):
+        r"""The flow rates with pressure drop ``dp`` (per point): bracketed root finding on
+        :math:`\ln\Delta p(\ln q)` with a loose integration (1e-9), then Newton steps with the
+        integration at ``rtol`` (the slope differenced from the loose one); the flow rate's error
+        is estimated from the pressure drop at 100 ``rtol`` over that slope."""
+        n = dp.size
+        q = np.zeros(n)
+        live = np.flatnonzero(dp > 0)
+        if live.size == 0:
+            return q
+        ids = _points(scene, n)[live]
+        L = np.broadcast_to(np.asarray(scene.tube.length, dtype=float), (scene.size,))[ids]
+        p_out = np.broadcast_to(np.asarray(scene.outlet_pressure, dtype=float), (scene.size,))[ids]
+        # rigid tubes bracket the flow: the narrowest section under the outlet pressure, and the
+        # widest under the inlet pressure (or near its local limit), at the mean gradient
+        nodes = np.linspace(0.0, 1.0, 33)
+        zz = (nodes[:, None] * L).ravel()
+        rows = np.tile(np.arange(live.size), nodes.size)
+        wall, a, tb = scene.at_position(zz, ids[rows])
+        lim = np.asarray(wall._limit_pressure(tb), dtype=float) + 0.0 * zz
+        low = np.asarray(wall._min_pressure(tb), dtype=float) + 0.0 * zz
+        with np.errstate(invalid="ignore"):
+            near = np.where(np.isfinite(lim), lim - 1e-3 * np.abs(lim), np.inf)
+        p_hi = np.clip(np.minimum((p_out + dp[live])[rows], near), low, None)
+        r_lo = (a * (1.0 + wall._strain(np.maximum(p_out[rows], low), tb))).reshape(nodes.size, -1).min(axis=0)
+        r_hi = (a * (1.0 + wall._strain(p_hi, tb))).reshape(nodes.size, -1).max(axis=0)
+        rheo = model_at(scene.rheology, ids)
+        x_lo = np.log(rheo._flow_rate(0.98 * r_lo, dp[live] / L))
+        x_hi = np.log(rheo._flow_rate(1.02 * r_hi, dp[live] / L))
+        log_dp = np.log(dp[live])
+        loose = max(1e-9, self.rtol)
+
+        def f(log_q, which, target, rtol=loose):
+            rise = self.rise(scene, np.exp(log_q), np.zeros(which.size), rtol, index=which, strict=False)
+            return np.where(np.isfinite(rise), np.log(rise) - target, 50.0)   # beyond the limit: too much
+
+        br = elementwise.bracket_root(f, x_lo, x_hi, xmin=x_lo - 700.0, xmax=x_hi + 60.0, args=(ids, log_dp))
+        if not np.all(br.success):
+            raise ConvergenceError("the flow rate of a graded tube under a pressure drop could not be bracketed")
+        res = elementwise.find_root(f, br.bracket, args=(ids, log_dp), tolerances=dict(xrtol=1e-11, xatol=1e-11))
+        if not np.all(res.success):
+            raise ConvergenceError("the flow rate of a graded tube under a pressure drop did not converge")
+        x = res.x
+        step = 1e-4
+        slope = (f(x + step, ids, log_dp) - f(x - step, ids, log_dp)) / (2 * step)   # d ln dp / d ln q
+        if not np.all(np.isfinite(slope) & (slope > 0)):
+            raise ConvergenceError("the pressure drop of a graded tube does not increase with the flow rate")
+        for _ in range(4):
+            miss = f(x, ids, log_dp, self.rtol)
+            x = x - miss / slope
+            if np.all(np.abs(miss / slope) <= 1e-15 * np.maximum(1.0, np.abs(x))):
+                break
+        miss_coarse = f(x, ids, log_dp, 100 * self.rtol) - f(x, ids, log_dp, self.rtol)
+        q[live] = np.exp(x)
+        return q, np.max(np.abs(miss_coarse / slope), initial=0.0)
+
+
+def _uniform_coupler(choice, scene):
+    """The separated-variables coupler for the equivalent uniform tube (``"auto"``: closed form where
+    the pair has one, else quadrature), or ``choice`` itself."""
+    if isinstance(choice, Coupler):
+        return choice
+    closed = ClosedForm()
+    return closed if closed.supports(scene.rheology, scene.wall) else Quadrature()
