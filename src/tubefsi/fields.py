@@ -95,14 +95,14 @@ def _fmt(x) -> str:
 
 def _interval_validator(low, high, low_open, high_open, admissible):
     def check(instance, attribute, value):
-        if isinstance(value, Profile):            # checked where it is evaluated
-            return
         if type(value) is float:                  # the common case, without numpy
             if ((value > low if low_open else value >= low) and (value < high if high_open else value <= high)
                     and (value == value) and (value != math.inf or (high == math.inf and not high_open))
                     and value != -math.inf):
                 return
             raise InvalidParameterError(attribute.name, admissible, value)
+        if isinstance(value, Profile):            # checked where it is evaluated
+            return
         v = np.asarray(value)
         with np.errstate(invalid="ignore"):
             ok = np.isfinite(v) | ((v == math.inf) & (high == math.inf) & (not high_open))
