@@ -81,8 +81,14 @@ def _convert_real(value, field, instance=None):
     return a
 
 
-_real_converter = attrs.Converter(lambda value, instance, field: _convert_real(value, field, instance),
-                                  takes_self=True, takes_field=True)
+def _convert_real_field(value, instance, field):
+    """:func:`_convert_real` in the argument order of an attrs converter that takes the instance."""
+    if type(value) is float:                 # the common case, without a second call
+        return value
+    return _convert_real(value, field, instance)
+
+
+_real_converter = attrs.Converter(_convert_real_field, takes_self=True, takes_field=True)
 
 
 def _fmt(x) -> str:

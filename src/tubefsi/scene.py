@@ -67,7 +67,7 @@ def _value_eq(a, b) -> bool:
     return a.shape == b.shape and bool(np.all(a == b))
 
 
-@attrs.frozen(kw_only=True)
+@attrs.frozen(kw_only=True, slots=False)      # a __dict__: the scalar path fills one in a single update
 class Scene:
     r"""A rheology, a wall, a tube and an outlet pressure: everything but the load.
 
@@ -142,13 +142,10 @@ class Scene:
         """A scene of scalars with an unloaded outlet, from already validated models (the scalar
         fast path of :func:`tubefsi.solve`)."""
         new = object.__new__(cls)
-        set_ = object.__setattr__
-        set_(new, "rheology", rheology)
-        set_(new, "wall", wall)
-        set_(new, "tube", tube)
-        set_(new, "log_stretch_max", log_stretch_max)
-        for name, value in _UNLOADED:
-            set_(new, name, value)
+        fields = new.__dict__
+        fields.update(_UNLOADED)
+        fields["rheology"], fields["wall"], fields["tube"] = rheology, wall, tube
+        fields["log_stretch_max"] = log_stretch_max
         return new
 
     @property
@@ -253,8 +250,8 @@ class Scene:
 
 
 #: the fields of a scene with an unloaded outlet that do not depend on its models
-_UNLOADED = (("outlet_pressure", 0.0), ("external_pressure", 0.0), ("gauge_outlet_pressure", 0.0), ("shape", ()),
-             ("outlet_strain", 0.0), ("outlet_stretch", 1.0))
+_UNLOADED = {"outlet_pressure": 0.0, "external_pressure": 0.0, "gauge_outlet_pressure": 0.0, "shape": (),
+             "outlet_strain": 0.0, "outlet_stretch": 1.0}
 
 
 def _evolve_arrays(scene, transform):

@@ -25,7 +25,7 @@ __all__ = ["Solution"]
 _CHUNK = 1 << 14
 
 
-@attrs.frozen(kw_only=True)
+@attrs.frozen(kw_only=True, slots=False)      # a __dict__: the scalar path fills one in a single update
 class Solution:
     """Flow rate, pressure drop, inlet state and profiles of a steady FSI problem.
 
@@ -46,6 +46,16 @@ class Solution:
     density: object = None
     #: The load ``solve`` was given: ``"flow_rate"`` or ``"pressure_drop"``.
     controlled: str = "flow_rate"
+
+    @classmethod
+    def _scalar_flow_controlled(cls, scene, coupler, state, coupler_name) -> Solution:
+        """A flow-controlled scalar solution of validated parts, built without ``__init__`` (the
+        scalar fast path of :func:`tubefsi.solve`; the other fields take their defaults)."""
+        new = object.__new__(cls)
+        fields = new.__dict__
+        fields.update(_SCALAR_DEFAULTS)
+        fields["scene"], fields["coupler"], fields["state"], fields["coupler_name"] = scene, coupler, state, coupler_name
+        return new
 
     # ------------------------------------------------------------------ loads
     @property
@@ -332,3 +342,8 @@ class Solution:
     def __repr__(self) -> str:
         return (f"Solution(flow_rate={self.flow_rate!r}, pressure_drop={self.pressure_drop!r}, "
                 f"inlet_displacement={self.inlet_displacement!r}, coupler={self.coupler_name!r})")
+
+
+#: The fields a flow-controlled scalar solution does not set itself, as ``__init__`` would.
+_SCALAR_DEFAULTS = {"scalar": True, "feasible": None, "density": None, "controlled": "flow_rate"}
+assert set(_SCALAR_DEFAULTS) | {"scene", "coupler", "state", "coupler_name"} == {f.name for f in attrs.fields(Solution)}

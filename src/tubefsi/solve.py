@@ -263,6 +263,9 @@ def _beyond_range(controlled, values, why):
 
 
 _SUBCLASS: dict = {}
+#: (rheology class, wall class, coupler registry generation) -> (coupler, name), or False where
+#: the classes are not models (the scalar path's one lookup)
+_SCALAR_PAIRS: dict = {}
 
 
 def _is(cls, base) -> bool:
@@ -278,7 +281,14 @@ def _scalar_flow(rheology, wall, tube, q):
     """The lean scalar path: one flow rate through a scene of scalars whose curve table is cached
     (a Monte Carlo loop over a modulus, a viscosity, the tube's size or the load). None where it
     does not apply; the general path then answers (and builds the table for the next call)."""
-    if not (_is(type(rheology), Rheology) and _is(type(wall), WallModel) and type(tube) is Tube):
+    if type(tube) is not Tube:
+        return None
+    chosen = _SCALAR_PAIRS.get((type(rheology), type(wall), registry.couplers.generation))
+    if chosen is None:                         # first time for this pair of classes: models, and the coupler
+        ok = _is(type(rheology), Rheology) and _is(type(wall), WallModel)
+        chosen = _SCALAR_PAIRS[(type(rheology), type(wall), registry.couplers.generation)] = \
+            _auto(rheology, wall) if ok else False
+    if chosen is False:
         return None
     if not (q > 0.0 and q < math.inf) or wall.is_rigid or wall._installed_tube(tube) is not tube:
         return None
@@ -305,13 +315,13 @@ def _scalar_flow(rheology, wall, tube, q):
     v = math.exp(y)
     strain = math.expm1(v)
     drop = scale * math.exp(table.pressure.scalar(y))
-    chosen, name = _auto(rheology, wall)
+    chosen, name = chosen
     lam_max = wall._max_stretch(t / a)
     scene = Scene._trusted(rheology, wall, tube, math.log(lam_max) if type(lam_max) is float else
                            float(np.log(lam_max)))
     if a * (1.0 + strain) > SLENDERNESS * L or strain > wall.calibrated_strain:
         warn(check(scene, q, strain))
-    return Solution(scene=scene, coupler=chosen, state=State(q, drop, strain, v), scalar=True, coupler_name=name)
+    return Solution._scalar_flow_controlled(scene, chosen, State(q, drop, strain, v), name)
 
 
 #: Points per coupler call: bounds the working memory (a few tens of MB) of any sweep.

@@ -53,7 +53,7 @@ class Chebyshev:
         self._t2_scale = 4.0 / self._width
         self._t2_offset = -2.0 - self.breaks[:-1] * self._t2_scale
         self._t2_scale_list, self._t2_offset_list = self._t2_scale.tolist(), self._t2_offset.tolist()
-        self._coef_reversed = [row[::-1] for row in self._coef]
+        self._coef_parts = [(row[-1], tuple(row[-2:0:-1]), row[0]) for row in self._coef]
         self._last = len(self._breaks) - 2
         self._coefT = np.ascontiguousarray(self.coef.T)
         # panel lookup by equal buckets as narrow as the narrowest panel (the panels come from
@@ -112,11 +112,11 @@ class Chebyshev:
         j = bisect.bisect_right(self._breaks, x) - 1
         j = 0 if j < 0 else (self._last if j > self._last else j)
         t2 = x * self._t2_scale_list[j] + self._t2_offset_list[j]
-        c = self._coef_reversed[j]                 # c_D, ..., c_1, c_0
-        b1, b2 = c[0], 0.0
-        for ck in c[1:-1]:
+        top, inner, c0 = self._coef_parts[j]       # c_D; c_{D-1}, ..., c_1; c_0
+        b1, b2 = top, 0.0
+        for ck in inner:
             b1, b2 = t2 * b1 - b2 + ck, b1
-        return 0.5 * t2 * b1 - b2 + c[-1]
+        return 0.5 * t2 * b1 - b2 + c0
 
     def derivative(self):
         """The interpolant of the derivative (on the same panels)."""
