@@ -124,15 +124,15 @@ def _interval_validator(low, high, low_open, high_open, admissible):
     return check
 
 
-def _same(a, b) -> bool:
-    """Equality of two parameter values (floats or arrays), as one bool."""
-    if isinstance(a, float) and isinstance(b, float):
-        return a == b
-    a, b = np.asarray(a), np.asarray(b)
-    return a.shape == b.shape and bool(np.all(a == b))
-
-
-_EQ = attrs.cmp_using(eq=_same)
+def _eq_key(value):
+    """What a parameter compares and hashes by: a float itself, an array its shape and bytes (so
+    that equal models hash alike and different ones, as a rule, do not: a model is a key of the
+    flow-table cache), anything else (a profile along z) itself."""
+    if type(value) is float:
+        return value
+    if isinstance(value, np.ndarray):
+        return ("array", value.shape, value.tobytes())
+    return value
 
 
 def real(*, low=-math.inf, high=math.inf, low_open=True, high_open=True, unit="", doc="",
@@ -154,7 +154,7 @@ def real(*, low=-math.inf, high=math.inf, low_open=True, high_open=True, unit=""
     return attrs.field(
         converter=_real_converter,
         validator=_interval_validator(low, high, low_open, high_open, admissible),
-        eq=_EQ, hash=False,
+        eq=_eq_key,
         metadata={"unit": unit, "doc": doc, "admissible": admissible, "array": True, "along": along,
                   "low": low, "high": high, "low_open": low_open, "high_open": high_open},
         default=default,
