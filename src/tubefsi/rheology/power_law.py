@@ -70,6 +70,12 @@ class _PowerLawForms(Rheology):
 
     def _flow_factor_inverse(self, factor):
         n = self.index
+        # a factor below the normal doubles (a tiny drop, a J that underflows) has lost its digits
+        if (0.0 < factor < _TINY) if type(factor) is float else np.any((factor > 0) & (factor < _TINY)):
+            low = float(np.min(np.where(np.asarray(factor) > 0, factor, math.inf)))
+            raise InvalidParameterError("pressure_drop", f"drops whose flow factor J/L = 2 m [(3n+1) q / (pi n)]^n "
+                                        f"is a normal double (>= {_TINY:.3g})", None,
+                                        f"J/L = {low:.3g} underflows (n = {n!r}): the flow rate would lose its digits")
         return math.pi * n / (3.0 * n + 1.0) * (factor / (2.0 * self.consistency)) ** (1.0 / n)
 
     def _radius_factor(self, radius):

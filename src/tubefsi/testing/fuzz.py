@@ -310,8 +310,29 @@ def _solve_probes(fluid, wall, tube, tag):
         yield Probe("solve", f"{tag} {load}=[]", call(**{load: []}))
         yield Probe("solve", f"{tag} {load}=0", call(**{load: 0.0}), check=_zero_load)
     yield Probe("solve", f"{tag} outlet_pressure=1e300", call(flow_rate=1e-12, outlet_pressure=1e300))
+    # tiny drops on a loaded outlet: the small-drop limit, the rigid-tube flow at the outlet radius
+    if not wall.is_rigid:
+        tb = tube.thickness / tube.radius
+        p_out = min(87.6, 0.25 * wall.limit_pressure(tb), 0.01 * wall.small_strain_modulus(tb) * tb)
+        for value in (1e-14, 1e-100, 1e-300):
+            yield Probe("solve", f"{tag} pressure_drop={value:g}, outlet_pressure={p_out:.4g}",
+                        call(pressure_drop=value, outlet_pressure=p_out), check=_small_drop(value))
     yield Probe("max_flow_rate", tag, lambda: max_flow_rate(fluid, wall, tube), check=_max_flow_check(fluid, wall, tube),
                 allow_inf=True)
+
+
+def _small_drop(dp):
+    """A drop far below the outlet pressure: the flow of the rigid tube at the outlet radius (the
+    limit Δp → 0; the tube's radius varies by a relative Δp / (λ P'(λ)) along it)."""
+    def check(sol):
+        scene = sol.scene
+        radius, length = scene.tube.radius * scene.outlet_stretch, scene.tube.length
+        q_ref = sol.rheology.flow_rate(radius, dp / length)
+        if q_ref < 1e-250 or not q_ref > 0:                  # below what the doubles resolve
+            return None if sol.flow_rate <= max(q_ref, 1e-250) else f"q={sol.flow_rate!r}, reference {q_ref!r}"
+        return None if abs(sol.flow_rate - q_ref) <= 1e-9 * q_ref else f"q={sol.flow_rate!r}, reference {q_ref!r}"
+
+    return check
 
 
 def _zero_load(sol):
@@ -636,6 +657,13 @@ def _known_probes():
                              lambda f=fluid, w=nh: solve(f, w, tube, pressure_drop=1e-11),
                              check=lambda sol, f=fluid: None if abs(sol.flow_rate / f.flow_rate(
                                  tube.radius, 1e-11 / tube.length) - 1) < 1e-10 else f"q={sol.flow_rate!r}"))
+    if have("carreau-yasuda", "thick-linear"):     # the networks' dead end: NaN once, then ConvergenceError
+        fluid = R["carreau-yasuda"](**R["carreau-yasuda"]._examples[0])
+        lin = W["thick-linear"](youngs_modulus=6e3, poisson_ratio=0.5)
+        for dp in (1e-14, 1e-100):
+            out.append(Probe("solve", f"known: carreau-yasuda thick-linear dp={dp:g}, p_out=87.6",
+                             lambda f=fluid, w=lin, d=dp: solve(f, w, tube, pressure_drop=d, outlet_pressure=87.6),
+                             check=_small_drop(dp)))
     if have("carreau", "thick-gent"):
         fluid = R["carreau"](**R["carreau"]._examples[0])
         out.append(Probe("solve", "known: carreau thick-gent q=1e-300", lambda f=fluid: solve(
