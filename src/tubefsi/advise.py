@@ -25,6 +25,7 @@ import numpy as np
 
 from . import registry, validity
 from ._validation import as_load
+from ._keywords import checked_keywords
 from .errors import InvalidParameterError, ModelValidityWarning, NoSteadyStateError, TubefsiError, warn_user
 from .rheology.power_law import _PowerLawForms
 from .scene import make_scene
@@ -149,6 +150,9 @@ def _equivalent_viscosity(rheology, tube, load):
     return float(tau_w / rheology.shear_rate(tau_w))
 
 
+@checked_keywords
+
+
 def advise(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, tolerance=0.01,
            outlet_pressure=0.0) -> Advice:
     """Compare the requested model with simpler ones on the same scene.
@@ -254,6 +258,9 @@ class Diagnostics:
                 ("Reynolds number", self.reynolds_number), ("reduced Reynolds Re R/L", self.reduced_reynolds_number)]
         text = "\n".join(f"{k:26s} {'n/a' if v is None else f'{v:.4g}'}" for k, v in rows)
         return text + "".join(f"\nwarning: {w}" for w in self.warnings)
+
+
+@checked_keywords
 
 
 def diagnostics(solution, *, density=None, warn=True) -> Diagnostics:

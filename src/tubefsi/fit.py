@@ -22,6 +22,7 @@ from scipy import optimize
 
 from ._progress import bar
 from .errors import InvalidParameterError, ModelValidityWarning, TubefsiError
+from ._keywords import checked_keywords
 from .scene import make_scene
 from .solve import solve
 
@@ -54,6 +55,9 @@ def _split(name):
     if owner not in ("wall", "rheology") or not field:
         raise InvalidParameterError("parameters", "names like 'wall.shear_modulus' or 'rheology.index'", name)
     return owner, field
+
+
+@checked_keywords
 
 
 def fit(flow_rate, pressure_drop, rheology, wall, tube, *, parameters, outlet_pressure=0.0,

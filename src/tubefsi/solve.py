@@ -16,6 +16,7 @@ import numpy as np
 
 from . import registry
 from ._progress import bar
+from ._keywords import checked_keywords
 from ._validation import as_load
 from .couplers.base import Coupler
 from .couplers.checked import checked
@@ -45,6 +46,9 @@ def _auto(rheology, wall):
     return found
 
 
+@checked_keywords
+
+
 def select_coupler(rheology, wall, coupler="auto") -> Coupler:
     """The coupler ``solve`` would use: a name, an instance, or ``"auto"`` (cheapest accurate)."""
     if isinstance(coupler, str) and coupler == "auto":
@@ -65,6 +69,9 @@ def select_coupler(rheology, wall, coupler="auto") -> Coupler:
                                     f"{type(inst).__name__} does not support {type(rheology).__name__} "
                                     f"with {type(wall).__name__}")
     return inst
+
+
+@checked_keywords
 
 
 def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="auto",
@@ -355,6 +362,9 @@ def _feasible(coupler, scene, load, controlled, *, raise_):
         raise NoSteadyStateError(quantity, float(np.broadcast_to(limit, load.shape)[i]), value, detail,
                                  name="" if quantity == "flow_rate" else "the inlet pressure")
     return ~beyond
+
+
+@checked_keywords
 
 
 def max_flow_rate(rheology, wall, tube, *, outlet_pressure=0.0, external_pressure=0.0, coupler="auto"):

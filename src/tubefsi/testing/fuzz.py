@@ -74,8 +74,10 @@ from hypothesis import strategies as st
 
 from .. import registry
 from ..advise import advise
-from ..errors import InvalidParameterError, NoSteadyStateError, TubefsiError
+from ..errors import InvalidParameterError, KeywordError, NoSteadyStateError, TubefsiError
+from ..fit import fit
 from ..geometry import Tube
+from ..network import Network
 from ..solution import Solution
 from ..solve import max_flow_rate, solve
 
@@ -137,6 +139,8 @@ class Probe:
     parameter: str | None = None
     check: Callable | None = None
     allow_inf: bool = False
+    #: for a typed error: a function of it returning ``None`` or what is wrong with its words
+    words: Callable | None = None
 
 
 @dataclasses.dataclass(frozen=True)
@@ -212,6 +216,9 @@ def run_probe(probe: Probe, time_limit: float | None = TIME_LIMIT) -> Outcome:
             return out("accepted", f"{type(error).__name__}: {error}"[:200])
         if probe.bad and probe.parameter and not _names(error.parameter, probe.parameter):
             return out("wrong", f"names {error.parameter!r}, not {probe.parameter!r}")
+        why = probe.words(error) if probe.words is not None else None
+        if why:
+            return out("wrong", why)
         return out("typed", f"{type(error).__name__}")
     if probe.bad:
         return out("accepted", f"returned {_short(result)}")
@@ -276,6 +283,74 @@ def _model_probes(kind, name):
             kwargs = {**example, field.name: value}
             yield Probe(entry, f"{field.name}={_short(value)}", lambda kw=kwargs: cls(**kw), bad=True,
                         parameter=field.name)
+    yield from _keyword_probes(entry, cls, example)
+
+
+def _keyword_probes(entry, target, good, args=(), label=""):
+    """Wrong and missing keywords of a call ``target(*args, **good)``: a misspelt keyword (its last
+    letter dropped, or doubled), a keyword no callable has, and each required keyword left out
+    must each raise :class:`~tubefsi.KeywordError` (a ``TypeError`` too) naming it, with the
+    intended keyword suggested and the valid ones listed."""
+    import inspect
+
+    params = [p for p in inspect.signature(target).parameters.values()
+              if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)][len(args):]
+    names = [p.name for p in params]
+    tag = f"{label} " if label else ""
+
+    def words(intended=None, missing=None):
+        def check(error):
+            if not (isinstance(error, KeywordError) and isinstance(error, TypeError)):
+                return f"{type(error).__name__}, not a KeywordError"
+            if intended and error.suggestion != intended:
+                return f"suggests {error.suggestion!r}, not {intended!r}"
+            if missing and missing not in error.missing:
+                return f"missing {error.missing!r}, not {missing!r}"
+            if not all(n in str(error) for n in names):
+                return "does not list the valid keywords"
+            return None
+        return check
+
+    if names:
+        first = max(names, key=len) if len(names[0]) <= 3 else names[0]
+        for typo in (first[:-1], first + first[-1]):
+            if sum(n.startswith(typo) or typo.startswith(n) for n in names) != 1:     # ambiguous
+                continue
+            kwargs = {**good, typo: good.get(first, 1.0)}
+            kwargs.pop(first, None)
+            yield Probe(entry, f"{tag}keyword {typo}=", lambda kw=kwargs: target(*args, **kw), bad=True,
+                        parameter=typo, words=words(intended=first))
+    yield Probe(entry, f"{tag}keyword no_such_keyword=", lambda: target(*args, **good, no_such_keyword=1.0), bad=True,
+                parameter="no_such_keyword", words=words())
+    for p in params:
+        if p.default is p.empty:
+            kwargs = {k: v for k, v in good.items() if k != p.name}
+            yield Probe(entry, f"{tag}without {p.name}=", lambda kw=kwargs: target(*args, **kw), bad=True,
+                        parameter=p.name, words=words(missing=p.name))
+
+
+def _entry_keyword_probes():
+    """Wrong and missing keywords of every public entry point that takes any (the models' own
+    constructors are probed with their bad values, :func:`_model_probes`)."""
+    R, W = registry.rheologies, registry.walls
+    fluid = R["power-law"](consistency=0.017, index=0.7) if "power-law" in R else None
+    wall = W["thick-neo-hookean"](shear_modulus=2e3) if "thick-neo-hookean" in W else None
+    tube = Tube(**_TUBE)
+    yield from _keyword_probes("Tube", Tube, dict(_TUBE))
+    yield from _keyword_probes("Network", Network, dict(rheology=fluid))
+    net = Network(rheology=fluid)
+    yield from _keyword_probes("Network", net.add_tube, dict(name="t"), args=("a", "b", wall, tube), label="add_tube")
+    yield from _keyword_probes("Network", net.set_pressure, dict(pressure=1.0), args=("a",), label="set_pressure")
+    yield from _keyword_probes("Network", net.set_inflow, dict(flow_rate=1e-12), args=("a",), label="set_inflow")
+    yield from _keyword_probes("Network", net.solve, dict(rtol=1e-13), label="solve")
+    if fluid is None or wall is None:
+        return
+    pair = (fluid, wall, tube)
+    yield from _keyword_probes("solve", solve, dict(flow_rate=1e-12), args=pair)
+    yield from _keyword_probes("solve", solve, dict(flow_rate=1e-12), args=pair[:2], label="two positional")
+    yield from _keyword_probes("max_flow_rate", max_flow_rate, dict(outlet_pressure=0.0), args=pair)
+    yield from _keyword_probes("advise", advise, dict(flow_rate=1e-12), args=pair)
+    yield from _keyword_probes("fit", fit, dict(parameters=["wall.shear_modulus"]), args=([1e-12], [1.0]) + pair)
 
 
 def _solve_probes(fluid, wall, tube, tag):
@@ -698,6 +773,7 @@ def bad_input_probes(rheologies=None, walls=None, couplers=None, *, core=True):
         probes += _model_probes("couplers", name)
     if core:
         probes += _tube_probes()
+        probes += _entry_keyword_probes()
         probes += _known_probes()
     # every named model in pairs: each rheology with a few walls, each wall with a few fluids
     partners_w = [w for w in ("thick-neo-hookean", "thin-linear", "rigid") if w in registry.walls]
