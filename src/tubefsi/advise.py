@@ -151,8 +151,6 @@ def _equivalent_viscosity(rheology, tube, load):
 
 
 @checked_keywords
-
-
 def advise(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, tolerance=0.01,
            outlet_pressure=0.0) -> Advice:
     """Compare the requested model with simpler ones on the same scene.
@@ -261,8 +259,6 @@ class Diagnostics:
 
 
 @checked_keywords
-
-
 def diagnostics(solution, *, density=None, warn=True) -> Diagnostics:
     """Check a :class:`~tubefsi.Solution`'s assumptions on the deformed tube (see
     :meth:`tubefsi.Solution.diagnostics` and :mod:`tubefsi.validity`), and how close it is to

@@ -58,8 +58,6 @@ def _split(name):
 
 
 @checked_keywords
-
-
 def fit(flow_rate, pressure_drop, rheology, wall, tube, *, parameters, outlet_pressure=0.0,
         coupler="auto", progress=False) -> FitResult:
     """Least-squares calibration of ``parameters`` from data.

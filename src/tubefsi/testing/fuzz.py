@@ -661,16 +661,20 @@ def _known_probes():
 
     if have("power-law", "thick-neo-hookean", "rigid", "thin-linear"):
         nh = W["thick-neo-hookean"](shear_modulus=2e3)
-        for n in (26.0, 30.0):
+        # 40-digit references (mpmath: the Lame tube law and the separated integral, tests/test_large_index.py)
+        for n, reference in ((26.0, 1.3803462372831439), (30.0, 1.1497201863833393)):
             fluid = R["power-law"](consistency=0.017, index=n)
-            # reference 1.3675 Pa at n = 26 (mpmath, the campaign)
             out.append(Probe("solve", f"known: power law n={n:g}, thick NH, q=1e-12",
-                             lambda f=fluid: solve(f, nh, tube, flow_rate=1e-12),
-                             check=drop_near(1.3675, 1e-3) if n == 26.0 else None))
+                             lambda f=fluid: solve(f, nh, tube, flow_rate=1e-12), check=drop_near(reference, 1e-12)))
+            out.append(Probe("solve", f"known: power law n={n:g}, thick NH, dp={reference}",
+                             lambda f=fluid, d=reference: solve(f, nh, tube, pressure_drop=d),
+                             check=lambda sol: None if abs(sol.flow_rate - 1e-12) <= 1e-11 * 1e-12
+                             else f"q={sol.flow_rate!r}, reference 1e-12"))
             for w in ("rigid", "thin-linear"):
                 wall = W[w](**W[w]._examples[0])
                 out.append(Probe("solve", f"known: power law n={n:g}, {w}, q=1e-12",
-                                 lambda f=fluid, wl=wall: solve(f, wl, tube, flow_rate=1e-12)))
+                                 lambda f=fluid, wl=wall: solve(f, wl, tube, flow_rate=1e-12),
+                                 check=_round_trip("flow_rate", 1e-12)))
         fluid = R["power-law"](consistency=0.017, index=0.7)
         out.append(Probe("solve", "known: solve(0.999999 max_flow_rate)",
                          lambda f=fluid, w=nh: solve(f, w, tube, flow_rate=0.999999 * max_flow_rate(f, w, tube))))
