@@ -23,9 +23,11 @@ the same code as the built-ins):
   coupler and each argument of each public entry point (``solve``, ``max_flow_rate``,
   ``Tube``, the :class:`~tubefsi.Solution` accessors, the wall and rheology methods,
   ``advise``) given NaN, infinities, values outside the field's admissible range, strings,
-  booleans, complex numbers, ``None`` and arrays with one bad entry; and extreme *valid*
-  inputs (loads of ``1e-300`` and ``1e300``, stretches of ``1e300``), which must give a
-  typed error or a finite value that passes its check.
+  booleans, complex numbers, ``None`` and arrays with one bad entry; misspelt, unknown and
+  missing keywords of every constructor and entry point (a :class:`~tubefsi.KeywordError`
+  naming the keyword and suggesting the intended one); and extreme *valid* inputs (loads of
+  ``1e-300`` and ``1e300``, tiny drops on a loaded outlet, stretches of ``1e300``), which must
+  give a typed error or a finite value that passes its check.
 * :func:`scene_outcomes` — random valid scenes drawn by hypothesis (a registered rheology,
   wall and coupler, their example parameters scaled, a tube, a load below the limits), each
   solved and checked: finite results, the flow-controlled and pressure-controlled solves
