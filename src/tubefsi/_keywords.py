@@ -89,7 +89,7 @@ class KeywordChecked(type):
 
     def __call__(cls, *args, **kwargs):
         try:
-            return super().__call__(*args, **kwargs)
+            return type.__call__(cls, *args, **kwargs)     # (no metaclass in between overrides it)
         except TypeError:
             # the signature of __init__ (the metaclass's own __call__ takes anything)
             error = keyword_error(cls.__init__, (cls,) + args, kwargs, name=f"{cls.__name__}()")

@@ -17,7 +17,7 @@ import numpy as np
 
 from . import registry
 from ._progress import bar
-from ._keywords import checked_keywords
+from ._keywords import checked_keywords, keyword_error
 from ._validation import as_load
 from .couplers.base import Coupler
 from .couplers.checked import checked
@@ -50,20 +50,26 @@ def _auto(rheology, wall):
 
 
 def _in_radius_units(function):
-    """Solve again in units of the tube's radius where a factor of the separated form left the
-    doubles (:class:`~tubefsi.rheology.power_law.FactorRangeError`: a power law of a large index)
-    though the answer may not (:mod:`tubefsi.couplers.rescaled`); the error stands where that
-    cannot help. Nothing runs on the ordinary path but the call."""
+    """:func:`~tubefsi._keywords.checked_keywords` for ``solve``, and: solve again in units of the
+    tube's radius where a factor of the separated form left the doubles
+    (:class:`~tubefsi.rheology.power_law.FactorRangeError`: a power law of a large index) though
+    the answer may not (:mod:`tubefsi.couplers.rescaled`); the error stands where that cannot
+    help. One call frame on the ordinary path, for both."""
 
     @functools.wraps(function)
     def wrapper(*args, **kwargs):
         try:
             return function(*args, **kwargs)
+        except TypeError:
+            error = keyword_error(function, args, kwargs)
+            if error is None:
+                raise
         except FactorRangeError:
             found = _radius_units(function, args, kwargs)
             if found is None:
                 raise
             return found
+        raise error
 
     return wrapper
 
@@ -91,7 +97,6 @@ def select_coupler(rheology, wall, coupler="auto") -> Coupler:
     return inst
 
 
-@checked_keywords
 @_in_radius_units
 def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="auto",
           outlet_pressure=0.0, external_pressure=0.0, on_infeasible="raise", density=None, progress=False) -> Solution:
