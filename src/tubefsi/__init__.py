@@ -23,13 +23,13 @@ import importlib
 import sys
 import types
 
-from .errors import (AccuracyWarning, ConvergenceError, InvalidParameterError, ModelValidityWarning,
+from .errors import (AccuracyWarning, ConvergenceError, InvalidParameterError, KeywordError, ModelValidityWarning,
                      NoSteadyStateError, StretchRangeError, TubefsiError, BucklingError)
 
 __all__ = [
     "dimensionless", "fields", "Tube", "solve", "max_flow_rate", "select_coupler", "Solution", "registry",
     "advise", "Advice", "Diagnostics", "ModelValidityWarning", "fit", "FitResult", "Network", "NetworkSolution",
-    "TubefsiError", "InvalidParameterError", "NoSteadyStateError", "ConvergenceError", "AccuracyWarning",
+    "TubefsiError", "InvalidParameterError", "KeywordError", "NoSteadyStateError", "ConvergenceError", "AccuracyWarning",
     "StretchRangeError", "BucklingError", "Profile", "sampled",
 ]
 

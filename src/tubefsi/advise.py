@@ -25,6 +25,7 @@ import numpy as np
 
 from . import registry, validity
 from ._validation import as_load
+from ._keywords import checked_keywords
 from .errors import InvalidParameterError, ModelValidityWarning, NoSteadyStateError, TubefsiError, warn_user
 from .rheology.power_law import _PowerLawForms
 from .scene import make_scene
@@ -149,6 +150,7 @@ def _equivalent_viscosity(rheology, tube, load):
     return float(tau_w / rheology.shear_rate(tau_w))
 
 
+@checked_keywords
 def advise(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, tolerance=0.01,
            outlet_pressure=0.0) -> Advice:
     """Compare the requested model with simpler ones on the same scene.
@@ -256,6 +258,7 @@ class Diagnostics:
         return text + "".join(f"\nwarning: {w}" for w in self.warnings)
 
 
+@checked_keywords
 def diagnostics(solution, *, density=None, warn=True) -> Diagnostics:
     """Check a :class:`~tubefsi.Solution`'s assumptions on the deformed tube (see
     :meth:`tubefsi.Solution.diagnostics` and :mod:`tubefsi.validity`), and how close it is to

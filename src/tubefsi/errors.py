@@ -15,6 +15,7 @@ import numpy as np
 __all__ = [
     "TubefsiError",
     "InvalidParameterError",
+    "KeywordError",
     "NoSteadyStateError",
     "BucklingError",
     "ConvergenceError",
@@ -27,6 +28,18 @@ __all__ = [
 
 class TubefsiError(Exception):
     """Base class of every tubefsi exception."""
+
+    def __reduce__(self):
+        # rebuilt from its message and attributes, not by calling __init__ again (whose arguments
+        # differ from ``args``): an error raised in a worker process reaches the caller whole
+        return _rebuild, (type(self), self.args, dict(self.__dict__))
+
+
+def _rebuild(cls, args, state):
+    error = cls.__new__(cls)
+    error.args = args
+    error.__dict__.update(state)
+    return error
 
 
 class InvalidParameterError(TubefsiError, ValueError):
@@ -49,6 +62,45 @@ class InvalidParameterError(TubefsiError, ValueError):
         # a range or a set reads "must be in [0, inf)"; a description "must be a coupler that ..."
         joiner = "in " if admissible[:1] in "[({" or admissible.startswith("the ") else ""
         super().__init__(f"{parameter} must be {joiner}{admissible}{got}{extra}")
+
+
+class KeywordError(InvalidParameterError, TypeError):
+    """A call to a public entry point or a model constructor with an unknown keyword, or without
+    a required one.
+
+    Both an :class:`InvalidParameterError` (so ``except tubefsi.InvalidParameterError`` and
+    ``except ValueError`` catch it, as every other bad input) and a :class:`TypeError` (what
+    Python itself raises for a wrong keyword, so ``except TypeError`` code keeps working).
+
+    Attributes
+    ----------
+    parameter : str
+        The unknown keyword, or the first missing one.
+    valid : tuple of str
+        The keywords the callable takes.
+    missing : tuple of str
+        The required keywords not given (empty for an unknown keyword).
+    suggestion : str or None
+        The valid keyword closest to an unknown one (``difflib``), if any is close.
+    """
+
+    def __init__(self, callable_name: str, parameter: str, valid, *, missing=(), suggestion=None, detail: str = ""):
+        self.parameter = parameter
+        self.valid = tuple(valid)
+        self.missing = tuple(missing)
+        self.suggestion = suggestion
+        self.value = None
+        self.admissible = "one of the keywords " + ", ".join(self.valid) if self.valid else "no keyword"
+        listing = ", ".join(self.valid) if self.valid else "none"
+        if self.missing:
+            names = ", ".join(repr(m) for m in self.missing)
+            text = f"{callable_name} missing required keyword{'s' if len(self.missing) > 1 else ''} {names}"
+        elif detail:
+            text = f"{callable_name}: {detail}"
+        else:
+            hint = f"; did you mean {suggestion!r}?" if suggestion else ""
+            text = f"{callable_name} got an unexpected keyword {parameter!r}{hint}"
+        TubefsiError.__init__(self, f"{text} (valid keywords: {listing})")
 
 
 class NoSteadyStateError(TubefsiError, ValueError):

@@ -22,6 +22,7 @@ from scipy import optimize
 
 from ._progress import bar
 from .errors import InvalidParameterError, ModelValidityWarning, TubefsiError
+from ._keywords import checked_keywords
 from .scene import make_scene
 from .solve import solve
 
@@ -56,6 +57,7 @@ def _split(name):
     return owner, field
 
 
+@checked_keywords
 def fit(flow_rate, pressure_drop, rheology, wall, tube, *, parameters, outlet_pressure=0.0,
         coupler="auto", progress=False) -> FitResult:
     """Least-squares calibration of ``parameters`` from data.

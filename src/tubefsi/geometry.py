@@ -5,6 +5,7 @@ from __future__ import annotations
 import attrs
 import numpy as np
 
+from ._keywords import KeywordChecked
 from .errors import InvalidParameterError
 from .fields import positive
 from .profiles import Profile
@@ -13,7 +14,7 @@ __all__ = ["Tube"]
 
 
 @attrs.frozen(kw_only=True)
-class Tube:
+class Tube(metaclass=KeywordChecked):
     r"""An undeformed straight tube, clamped at both ends.
 
     Parameters

@@ -53,6 +53,7 @@ import scipy.sparse as sp
 from scipy.sparse import csgraph
 from scipy.sparse import linalg as spla
 
+from ._keywords import KeywordChecked, checked_keywords
 from ._progress import bar
 from ._validation import as_array
 from . import validity
@@ -90,7 +91,7 @@ class _Tube:
     external_pressure: float = 0.0
 
 
-class Network:
+class Network(metaclass=KeywordChecked):
     """A graph of soft tubes between named nodes.
 
     Parameters
@@ -121,6 +122,7 @@ class Network:
         self.positions: dict = {}
 
     # ------------------------------------------------------------------ building
+    @checked_keywords
     def add_tube(self, u, v, wall, tube, *, name=None, rheology=None, external_pressure=0.0):
         """Add a tube from node ``u`` to node ``v`` (positive flow runs from ``u`` to ``v``).
 
@@ -157,6 +159,7 @@ class Network:
         self._tubes[name] = _Tube(name, u, v, wall, tube, fluid, float(p_e))
         return self
 
+    @checked_keywords
     def set_pressure(self, node, pressure):
         """Fix the (transmural, gauge) pressure of ``node`` (Pa, >= 0)."""
         if node in self._inflow:
@@ -165,6 +168,7 @@ class Network:
         self._pressure[node] = float(as_array("pressure", pressure, "[0, inf)", lambda a: a >= 0))
         return self
 
+    @checked_keywords
     def set_inflow(self, node, flow_rate):
         """Inject ``flow_rate`` (m^3/s; negative: withdraw) at ``node``."""
         if node in self._pressure:
@@ -173,6 +177,7 @@ class Network:
         self._inflow[node] = float(as_array("flow_rate", flow_rate, "(-inf, inf)", np.isfinite))
         return self
 
+    @checked_keywords
     def set_position(self, node, xy):
         """Place ``node`` at ``xy = (x, y)`` for the plot."""
         self.positions[node] = (float(xy[0]), float(xy[1]))
@@ -188,6 +193,7 @@ class Network:
 
     # ------------------------------------------------------------------ networkx
     @classmethod
+    @checked_keywords
     def from_networkx(cls, graph, *, rheology=None, wall="wall", tube="tube", fluid="rheology",
                       pressure="pressure", inflow="inflow", pos="pos"):
         """A network from a networkx graph whose edges hold a ``wall`` and a ``tube`` attribute
@@ -235,6 +241,7 @@ class Network:
         return graph
 
     # ------------------------------------------------------------------ solving
+    @checked_keywords
     def solve(self, *, rtol=1e-13, max_iterations=100, progress=False) -> NetworkSolution:
         """The steady state: node pressures and tube flow rates (a :class:`NetworkSolution`).
 
@@ -735,6 +742,7 @@ class NetworkSolution:
         """Tube flow rates (m^3/s) in the order of :attr:`tube_names`."""
         return self.q.copy()
 
+    @checked_keywords
     def solution(self, name) -> Solution:
         """The full single-tube :class:`~tubefsi.Solution` of tube ``name`` (profiles included): its
         flow rate at its outlet pressure, oriented from its higher-pressure end (``z = 0`` is ``u``
@@ -765,6 +773,7 @@ class NetworkSolution:
                 "pressure_v": [p[t.v] for t in self.tubes], "radius_u": self.radius_u.tolist(),
                 "radius_v": self.radius_v.tolist(), "length": [t.tube.length for t in self.tubes]}
 
+    @checked_keywords
     def to_csv(self, prefix) -> tuple:
         """Write ``<prefix>_nodes.csv`` and ``<prefix>_tubes.csv``; returns the two paths."""
         paths = (f"{prefix}_nodes.csv", f"{prefix}_tubes.csv")
@@ -776,6 +785,7 @@ class NetworkSolution:
                     writer.writerow([_text(x) if not isinstance(x, float) else repr(x) for x in row])
         return paths
 
+    @checked_keywords
     def to_json(self, path=None) -> str:
         """The node and tube tables as JSON (node and tube names as text); written to ``path`` if given."""
         data = {"nodes": _records(self.node_table()), "tubes": _records(self.tube_table()),

@@ -9,6 +9,7 @@ loads and returns a :class:`~tubefsi.Solution`.
 from __future__ import annotations
 
 import contextlib
+import functools
 import math
 
 import attrs
@@ -16,14 +17,17 @@ import numpy as np
 
 from . import registry
 from ._progress import bar
+from ._keywords import checked_keywords, keyword_error
 from ._validation import as_load
 from .couplers.base import Coupler
 from .couplers.checked import checked
 from .couplers.graded import Graded
+from .couplers.rescaled import Rescaled
 from .errors import InvalidParameterError, NoSteadyStateError, StretchRangeError
 from .couplers.separated import _TABLES, SeparatedVariables, curve_span
 from .geometry import Tube
 from .rheology.base import Rheology
+from .rheology.power_law import FactorRangeError
 from .scene import Scene, State, _resolve, make_scene
 from .solution import Solution
 from .validity import SLENDERNESS, check, warn
@@ -45,6 +49,32 @@ def _auto(rheology, wall):
     return found
 
 
+def _in_radius_units(function):
+    """:func:`~tubefsi._keywords.checked_keywords` for ``solve``, and: solve again in units of the
+    tube's radius where a factor of the separated form left the doubles
+    (:class:`~tubefsi.rheology.power_law.FactorRangeError`: a power law of a large index) though
+    the answer may not (:mod:`tubefsi.couplers.rescaled`); the error stands where that cannot
+    help. One call frame on the ordinary path, for both."""
+
+    @functools.wraps(function)
+    def wrapper(*args, **kwargs):
+        try:
+            return function(*args, **kwargs)
+        except TypeError:
+            error = keyword_error(function, args, kwargs)
+            if error is None:
+                raise
+        except FactorRangeError:
+            found = _radius_units(function, args, kwargs)
+            if found is None:
+                raise
+            return found
+        raise error
+
+    return wrapper
+
+
+@checked_keywords
 def select_coupler(rheology, wall, coupler="auto") -> Coupler:
     """The coupler ``solve`` would use: a name, an instance, or ``"auto"`` (cheapest accurate)."""
     if isinstance(coupler, str) and coupler == "auto":
@@ -67,6 +97,7 @@ def select_coupler(rheology, wall, coupler="auto") -> Coupler:
     return inst
 
 
+@_in_radius_units
 def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="auto",
           outlet_pressure=0.0, external_pressure=0.0, on_infeasible="raise", density=None, progress=False) -> Solution:
     r"""Solve steady flow of ``rheology`` through ``tube`` with wall ``wall``.
@@ -133,6 +164,8 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
         if fast is not None:
             return fast
     scene = make_scene(rheology, wall, tube, outlet_pressure=outlet_pressure, external_pressure=external_pressure)
+    if not scene.graded:
+        _radius_power_in_range(scene)
     if (flow_rate is None) == (pressure_drop is None):
         raise InvalidParameterError("flow_rate / pressure_drop", "exactly one of the two",
                                     None, "give flow_rate= or pressure_drop=, not both or neither")
@@ -308,7 +341,10 @@ def _scalar_flow(rheology, wall, tube, q):
     phi = rheology._flow_factor(q)
     if type(phi) is not float or not rheology.separable:
         return None
-    x = math.log(L * phi / (a**k * scale))
+    norm = a**k * scale
+    if not 2.2250738585072014e-308 <= norm < math.inf:     # a power law of a large index: the general path
+        return None
+    x = math.log(L * phi / norm)
     if not table.x_lo <= x <= table.x_hi:
         return None
     y = table.inverse.scalar(x)
@@ -357,6 +393,7 @@ def _feasible(coupler, scene, load, controlled, *, raise_):
     return ~beyond
 
 
+@checked_keywords
 def max_flow_rate(rheology, wall, tube, *, outlet_pressure=0.0, external_pressure=0.0, coupler="auto"):
     r"""The largest flow rate with a steady state (m^3/s); ``inf`` where every flow rate has one.
 
@@ -367,6 +404,16 @@ def max_flow_rate(rheology, wall, tube, *, outlet_pressure=0.0, external_pressur
     (an array of the scene's shape comes back).
     """
     scene = make_scene(rheology, wall, tube, outlet_pressure=outlet_pressure, external_pressure=external_pressure)
+    try:
+        if not scene.graded:
+            _radius_power_in_range(scene)
+    except FactorRangeError:
+        if type(tube.radius) is not float or not (_plain(tube.thickness) and _plain(tube.length)):
+            raise
+        unit = tube.radius       # in units of the radius (the limit is a flow rate: times unit^3)
+        scaled = Tube(radius=1.0, thickness=np.divide(tube.thickness, unit), length=np.divide(tube.length, unit))
+        return max_flow_rate(rheology, wall, scaled, outlet_pressure=outlet_pressure,
+                             external_pressure=external_pressure, coupler=coupler) * unit**3
     chosen = _graded(scene, coupler) if scene.graded else select_coupler(scene.rheology, scene.wall, coupler)
     if scene.shape == ():
         return float(chosen.max_flow_rate(scene))
@@ -375,3 +422,60 @@ def max_flow_rate(rheology, wall, tube, *, outlet_pressure=0.0, external_pressur
     for index, part in flat.split(np.arange(flat.size)):
         out[index] = chosen.max_flow_rate(part)
     return out.reshape(scene.shape)
+
+
+def _radius_units(function, args, kwargs):
+    """The solve of ``function(*args, **kwargs)`` in units of the tube's (scalar, constant)
+    radius, as a Solution of the original scene, or None where it does not apply or fails too."""
+    import inspect
+
+    call = inspect.signature(function).bind(*args, **kwargs)
+    call.apply_defaults()
+    given = dict(call.arguments)
+    tube = given["tube"]
+    if type(tube) is not Tube or given["density"] is not None or type(tube.radius) is not float:
+        return None
+    if not (_plain(tube.thickness) and _plain(tube.length)):     # a tapered or graded tube: the error stands
+        return None
+    scene = make_scene(given["rheology"], given["wall"], tube, outlet_pressure=given["outlet_pressure"],
+                       external_pressure=given["external_pressure"])
+    if scene.graded:             # a model varying along z: z would need the change of unit too
+        return None
+    unit = tube.radius
+    if given["flow_rate"] is not None:
+        given["flow_rate"] = as_load("flow_rate", given["flow_rate"]) / unit**3
+    given["tube"] = Tube(radius=1.0, thickness=np.divide(tube.thickness, unit), length=np.divide(tube.length, unit))
+    try:
+        inner = function(**given)
+    except FactorRangeError:
+        return None
+    q = np.asarray(inner.state.flow_rate, dtype=float) * unit**3
+    live = np.isfinite(q) & (np.asarray(inner.state.pressure_drop) > 0)
+    if np.any(live & ~((q >= np.finfo(float).tiny) & (q < math.inf))):
+        return None                    # the flow rate itself leaves the doubles: the error stands
+    state = State(q if q.ndim else float(q), inner.state.pressure_drop, inner.state.inlet_strain,
+                  inner.state.log_stretch)
+    return Solution(scene=scene, coupler=Rescaled(inner=inner.coupler, unit=unit), state=state, scalar=inner.scalar,
+                    coupler_name=inner.coupler_name, feasible=inner.feasible, controlled=inner.controlled)
+
+
+def _radius_power_in_range(scene):
+    """Raise FactorRangeError where a power law's :math:`a^{3n+1}` leaves the normal doubles (the
+    engine's normalization of the separated integral; then :func:`solve` works in units of the
+    radius). One scalar test for a scalar radius."""
+    k = scene.rheology.radius_exponent
+    if type(k) is not float:
+        return
+    a = scene.tube.radius
+    if type(a) is float:
+        if k * abs(math.log(a)) <= 700.0:
+            return
+    elif not isinstance(a, np.ndarray) or k * float(np.max(np.abs(np.log(a)))) <= 700.0:
+        return                       # (a radius along z: the graded coupler's own range checks)
+    raise FactorRangeError("index", f"indices with a^(3n+1) within double precision at radius a", k,
+                           "R^-(3n+1) leaves the range of double precision")
+
+
+def _plain(value) -> bool:
+    """A tube field of numbers (not a profile along z)."""
+    return type(value) is float or isinstance(value, np.ndarray)

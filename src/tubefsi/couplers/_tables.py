@@ -181,8 +181,10 @@ class SeparatedTable:
         self.tabulate_pressure = tabulate_pressure
 
     def for_scene(self, scene):
-        """The table bound to a scene of its key: the target normalization and the pressure."""
-        return _Bound(self, scene)
+        """The table bound to a scene of its key: the target normalization and the pressure (None
+        where the normalization a^k P_scale leaves the normal doubles: a power law of a large index)."""
+        bound = _Bound(self, scene)
+        return bound if 2.2250738585072014e-308 <= bound.norm < math.inf else None
 
 
 class _Bound:

@@ -528,8 +528,15 @@ class SeparatedVariables(Coupler):
         def dF(x, i):
             return self._slope(scene.at(sub[i]), x)
 
+        # a drop far below the outlet pressure: the strain difference is rounding noise (it may
+        # be 0), and Newton on ln F from far above a tiny root only bisects; the linearized rise,
+        # dp / (s P'(s)) at the outlet, is within O(v) of the root
+        guess = np.maximum(v[polish], 0.0)
+        small = dp[polish] <= _SMALL_DROP * np.abs(np.asarray(pts.outlet_pressure) + np.zeros(dp.shape))[polish]
+        if np.any(small):
+            guess[small] = dp[polish][small] / dF(np.zeros(int(np.count_nonzero(small))), np.flatnonzero(small))
         with quiet():
-            w, _ = solve_increasing(F, dF, dp[polish], guess=np.maximum(v[polish], 0.0), max_step=2.0, log=True)
+            w, _ = solve_increasing(F, dF, dp[polish], guess=guess, max_step=2.0, log=True)
         v = v.copy()
         v[polish] = w
         return v
@@ -824,6 +831,10 @@ _START_NODES, _START_WEIGHTS = 0.5 * (_START_NODES + 1.0), 0.5 * _START_WEIGHTS 
 #: Tolerance of a curve interpolated between direct solves, in ln v: the direct solves' own
 #: accuracy (the quadrature's 1e-14, a little more near a yield point), not tighter.
 _CURVE_TOL = 1e-13
+#: A pressure drop below this fraction of the outlet pressure starts its inlet-stretch Newton
+#: iteration from the linearized rise (SeparatedVariables._inlet_log_stretch): the strain
+#: difference then holds fewer than ~3 significant digits.
+_SMALL_DROP = 1e-3
 _SPENT: dict = {}
 _BUILD_SECONDS = [0.1]          # running estimate of a build's cost, updated by every build
 

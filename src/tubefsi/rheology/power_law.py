@@ -16,11 +16,18 @@ from ..errors import InvalidParameterError
 from ..fields import positive
 from .base import Rheology
 
-__all__ = ["PowerLaw"]
+__all__ = ["PowerLaw", "FactorRangeError"]
 
 
 _TINY = float(np.finfo(float).tiny)
 _HUGE = 1.0 / _TINY
+
+
+class FactorRangeError(InvalidParameterError):
+    r"""A factor of the separated form :math:`G = \phi(q)\,\psi(R)` leaves the normal doubles
+    (a large index: :math:`R^{-(3n+1)}` overflows at R = 1e-4 m for n >= 26) where :math:`G` itself
+    may not: :func:`tubefsi.solve` then solves the problem again in units of the tube's radius
+    (``docs/verification.md``, "Fuzzing")."""
 
 
 def _representable(value, load, name, index):
@@ -34,7 +41,7 @@ def _representable(value, load, name, index):
     if np.any(bad):
         q = float(np.ravel(np.broadcast_to(load, np.shape(bad)))[np.argmax(np.ravel(bad))])
         what = f"2 m [(3n+1) q / (pi n)]^n, n = {index!r}"
-        raise InvalidParameterError(name, f"values for which {what} is within double precision "
+        raise FactorRangeError(name, f"values for which {what} is within double precision "
                                     f"[{_TINY:.3g}, {_HUGE:.3g}]", q, "the pressure gradient would underflow "
                                     "or overflow")
 
@@ -70,6 +77,12 @@ class _PowerLawForms(Rheology):
 
     def _flow_factor_inverse(self, factor):
         n = self.index
+        # a factor below the normal doubles (a tiny drop, a J that underflows) has lost its digits
+        if (0.0 < factor < _TINY) if type(factor) is float else np.any((factor > 0) & (factor < _TINY)):
+            low = float(np.min(np.where(np.asarray(factor) > 0, factor, math.inf)))
+            raise FactorRangeError("pressure_drop", f"drops whose flow factor J/L = 2 m [(3n+1) q / (pi n)]^n "
+                                   f"is a normal double (>= {_TINY:.3g})", None,
+                                   f"J/L = {low:.3g} underflows (n = {n!r}): the flow rate would lose its digits")
         return math.pi * n / (3.0 * n + 1.0) * (factor / (2.0 * self.consistency)) ** (1.0 / n)
 
     def _radius_factor(self, radius):
@@ -81,10 +94,24 @@ class _PowerLawForms(Rheology):
             big = out > _HUGE                    # its reciprocal (the engine divides by it) underflows
         if np.any(big):
             r = float(np.ravel(np.broadcast_to(radius, np.shape(out)))[np.argmax(np.ravel(big))])
-            raise InvalidParameterError(
+            raise FactorRangeError(
                 "index", f"(0, {(-math.log(_TINY) / abs(math.log(r)) - 1.0) / 3.0:.6g}) at radius {r:g} m",
                 self.index, "R^-(3n+1) leaves the range of double precision")
         return out
+
+    def _pressure_gradient(self, flow_rate, radius):
+        # G = (2m/R) [(3n+1) q / (pi n R^3)]^n: the apparent shear rate first, so that G is a
+        # double wherever it is one, whatever phi(q) and R^-(3n+1) are alone (n >= 26)
+        n = self.index
+        try:
+            return 2.0 * self.consistency / radius * ((3.0 * n + 1.0) * flow_rate / (math.pi * n * radius**3)) ** n
+        except OverflowError:
+            return math.inf
+
+    def _flow_rate(self, radius, pressure_gradient):
+        n = self.index
+        return math.pi * n / (3.0 * n + 1.0) * radius**3 * (pressure_gradient * radius / (2.0 * self.consistency)) ** (
+            1.0 / n)
 
     @property
     def radius_exponent(self) -> float:

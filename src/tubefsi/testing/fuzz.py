@@ -23,9 +23,11 @@ the same code as the built-ins):
   coupler and each argument of each public entry point (``solve``, ``max_flow_rate``,
   ``Tube``, the :class:`~tubefsi.Solution` accessors, the wall and rheology methods,
   ``advise``) given NaN, infinities, values outside the field's admissible range, strings,
-  booleans, complex numbers, ``None`` and arrays with one bad entry; and extreme *valid*
-  inputs (loads of ``1e-300`` and ``1e300``, stretches of ``1e300``), which must give a
-  typed error or a finite value that passes its check.
+  booleans, complex numbers, ``None`` and arrays with one bad entry; misspelt, unknown and
+  missing keywords of every constructor and entry point (a :class:`~tubefsi.KeywordError`
+  naming the keyword and suggesting the intended one); and extreme *valid* inputs (loads of
+  ``1e-300`` and ``1e300``, tiny drops on a loaded outlet, stretches of ``1e300``), which must
+  give a typed error or a finite value that passes its check.
 * :func:`scene_outcomes` — random valid scenes drawn by hypothesis (a registered rheology,
   wall and coupler, their example parameters scaled, a tube, a load below the limits), each
   solved and checked: finite results, the flow-controlled and pressure-controlled solves
@@ -74,8 +76,10 @@ from hypothesis import strategies as st
 
 from .. import registry
 from ..advise import advise
-from ..errors import InvalidParameterError, NoSteadyStateError, TubefsiError
+from ..errors import InvalidParameterError, KeywordError, NoSteadyStateError, TubefsiError
+from ..fit import fit
 from ..geometry import Tube
+from ..network import Network
 from ..solution import Solution
 from ..solve import max_flow_rate, solve
 
@@ -137,6 +141,8 @@ class Probe:
     parameter: str | None = None
     check: Callable | None = None
     allow_inf: bool = False
+    #: for a typed error: a function of it returning ``None`` or what is wrong with its words
+    words: Callable | None = None
 
 
 @dataclasses.dataclass(frozen=True)
@@ -212,6 +218,9 @@ def run_probe(probe: Probe, time_limit: float | None = TIME_LIMIT) -> Outcome:
             return out("accepted", f"{type(error).__name__}: {error}"[:200])
         if probe.bad and probe.parameter and not _names(error.parameter, probe.parameter):
             return out("wrong", f"names {error.parameter!r}, not {probe.parameter!r}")
+        why = probe.words(error) if probe.words is not None else None
+        if why:
+            return out("wrong", why)
         return out("typed", f"{type(error).__name__}")
     if probe.bad:
         return out("accepted", f"returned {_short(result)}")
@@ -276,6 +285,74 @@ def _model_probes(kind, name):
             kwargs = {**example, field.name: value}
             yield Probe(entry, f"{field.name}={_short(value)}", lambda kw=kwargs: cls(**kw), bad=True,
                         parameter=field.name)
+    yield from _keyword_probes(entry, cls, example)
+
+
+def _keyword_probes(entry, target, good, args=(), label=""):
+    """Wrong and missing keywords of a call ``target(*args, **good)``: a misspelt keyword (its last
+    letter dropped, or doubled), a keyword no callable has, and each required keyword left out
+    must each raise :class:`~tubefsi.KeywordError` (a ``TypeError`` too) naming it, with the
+    intended keyword suggested and the valid ones listed."""
+    import inspect
+
+    params = [p for p in inspect.signature(target).parameters.values()
+              if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)][len(args):]
+    names = [p.name for p in params]
+    tag = f"{label} " if label else ""
+
+    def words(intended=None, missing=None):
+        def check(error):
+            if not (isinstance(error, KeywordError) and isinstance(error, TypeError)):
+                return f"{type(error).__name__}, not a KeywordError"
+            if intended and error.suggestion != intended:
+                return f"suggests {error.suggestion!r}, not {intended!r}"
+            if missing and missing not in error.missing:
+                return f"missing {error.missing!r}, not {missing!r}"
+            if not all(n in str(error) for n in names):
+                return "does not list the valid keywords"
+            return None
+        return check
+
+    if names:
+        first = max(names, key=len) if len(names[0]) <= 3 else names[0]
+        for typo in (first[:-1], first + first[-1]):
+            if sum(n.startswith(typo) or typo.startswith(n) for n in names) != 1:     # ambiguous
+                continue
+            kwargs = {**good, typo: good.get(first, 1.0)}
+            kwargs.pop(first, None)
+            yield Probe(entry, f"{tag}keyword {typo}=", lambda kw=kwargs: target(*args, **kw), bad=True,
+                        parameter=typo, words=words(intended=first))
+    yield Probe(entry, f"{tag}keyword no_such_keyword=", lambda: target(*args, **good, no_such_keyword=1.0), bad=True,
+                parameter="no_such_keyword", words=words())
+    for p in params:
+        if p.default is p.empty:
+            kwargs = {k: v for k, v in good.items() if k != p.name}
+            yield Probe(entry, f"{tag}without {p.name}=", lambda kw=kwargs: target(*args, **kw), bad=True,
+                        parameter=p.name, words=words(missing=p.name))
+
+
+def _entry_keyword_probes():
+    """Wrong and missing keywords of every public entry point that takes any (the models' own
+    constructors are probed with their bad values, :func:`_model_probes`)."""
+    R, W = registry.rheologies, registry.walls
+    fluid = R["power-law"](consistency=0.017, index=0.7) if "power-law" in R else None
+    wall = W["thick-neo-hookean"](shear_modulus=2e3) if "thick-neo-hookean" in W else None
+    tube = Tube(**_TUBE)
+    yield from _keyword_probes("Tube", Tube, dict(_TUBE))
+    yield from _keyword_probes("Network", Network, dict(rheology=fluid))
+    net = Network(rheology=fluid)
+    yield from _keyword_probes("Network", net.add_tube, dict(name="t"), args=("a", "b", wall, tube), label="add_tube")
+    yield from _keyword_probes("Network", net.set_pressure, dict(pressure=1.0), args=("a",), label="set_pressure")
+    yield from _keyword_probes("Network", net.set_inflow, dict(flow_rate=1e-12), args=("a",), label="set_inflow")
+    yield from _keyword_probes("Network", net.solve, dict(rtol=1e-13), label="solve")
+    if fluid is None or wall is None:
+        return
+    pair = (fluid, wall, tube)
+    yield from _keyword_probes("solve", solve, dict(flow_rate=1e-12), args=pair)
+    yield from _keyword_probes("solve", solve, dict(flow_rate=1e-12), args=pair[:2], label="two positional")
+    yield from _keyword_probes("max_flow_rate", max_flow_rate, dict(outlet_pressure=0.0), args=pair)
+    yield from _keyword_probes("advise", advise, dict(flow_rate=1e-12), args=pair)
+    yield from _keyword_probes("fit", fit, dict(parameters=["wall.shear_modulus"]), args=([1e-12], [1.0]) + pair)
 
 
 def _solve_probes(fluid, wall, tube, tag):
@@ -310,8 +387,29 @@ def _solve_probes(fluid, wall, tube, tag):
         yield Probe("solve", f"{tag} {load}=[]", call(**{load: []}))
         yield Probe("solve", f"{tag} {load}=0", call(**{load: 0.0}), check=_zero_load)
     yield Probe("solve", f"{tag} outlet_pressure=1e300", call(flow_rate=1e-12, outlet_pressure=1e300))
+    # tiny drops on a loaded outlet: the small-drop limit, the rigid-tube flow at the outlet radius
+    if not wall.is_rigid:
+        tb = tube.thickness / tube.radius
+        p_out = min(87.6, 0.25 * wall.limit_pressure(tb), 0.01 * wall.small_strain_modulus(tb) * tb)
+        for value in (1e-14, 1e-100, 1e-300):
+            yield Probe("solve", f"{tag} pressure_drop={value:g}, outlet_pressure={p_out:.4g}",
+                        call(pressure_drop=value, outlet_pressure=p_out), check=_small_drop(value))
     yield Probe("max_flow_rate", tag, lambda: max_flow_rate(fluid, wall, tube), check=_max_flow_check(fluid, wall, tube),
                 allow_inf=True)
+
+
+def _small_drop(dp):
+    """A drop far below the outlet pressure: the flow of the rigid tube at the outlet radius (the
+    limit Δp → 0; the tube's radius varies by a relative Δp / (λ P'(λ)) along it)."""
+    def check(sol):
+        scene = sol.scene
+        radius, length = scene.tube.radius * scene.outlet_stretch, scene.tube.length
+        q_ref = sol.rheology.flow_rate(radius, dp / length)
+        if q_ref < 1e-250 or not q_ref > 0:                  # below what the doubles resolve
+            return None if sol.flow_rate <= max(q_ref, 1e-250) else f"q={sol.flow_rate!r}, reference {q_ref!r}"
+        return None if abs(sol.flow_rate - q_ref) <= 1e-9 * q_ref else f"q={sol.flow_rate!r}, reference {q_ref!r}"
+
+    return check
 
 
 def _zero_load(sol):
@@ -565,16 +663,20 @@ def _known_probes():
 
     if have("power-law", "thick-neo-hookean", "rigid", "thin-linear"):
         nh = W["thick-neo-hookean"](shear_modulus=2e3)
-        for n in (26.0, 30.0):
+        # 40-digit references (mpmath: the Lame tube law and the separated integral, tests/test_large_index.py)
+        for n, reference in ((26.0, 1.3803462372831439), (30.0, 1.1497201863833393)):
             fluid = R["power-law"](consistency=0.017, index=n)
-            # reference 1.3675 Pa at n = 26 (mpmath, the issue's campaign)
             out.append(Probe("solve", f"known: power law n={n:g}, thick NH, q=1e-12",
-                             lambda f=fluid: solve(f, nh, tube, flow_rate=1e-12),
-                             check=drop_near(1.3675, 1e-3) if n == 26.0 else None))
+                             lambda f=fluid: solve(f, nh, tube, flow_rate=1e-12), check=drop_near(reference, 1e-12)))
+            out.append(Probe("solve", f"known: power law n={n:g}, thick NH, dp={reference}",
+                             lambda f=fluid, d=reference: solve(f, nh, tube, pressure_drop=d),
+                             check=lambda sol: None if abs(sol.flow_rate - 1e-12) <= 1e-11 * 1e-12
+                             else f"q={sol.flow_rate!r}, reference 1e-12"))
             for w in ("rigid", "thin-linear"):
                 wall = W[w](**W[w]._examples[0])
                 out.append(Probe("solve", f"known: power law n={n:g}, {w}, q=1e-12",
-                                 lambda f=fluid, wl=wall: solve(f, wl, tube, flow_rate=1e-12)))
+                                 lambda f=fluid, wl=wall: solve(f, wl, tube, flow_rate=1e-12),
+                                 check=_round_trip("flow_rate", 1e-12)))
         fluid = R["power-law"](consistency=0.017, index=0.7)
         out.append(Probe("solve", "known: solve(0.999999 max_flow_rate)",
                          lambda f=fluid, w=nh: solve(f, w, tube, flow_rate=0.999999 * max_flow_rate(f, w, tube))))
@@ -636,6 +738,13 @@ def _known_probes():
                              lambda f=fluid, w=nh: solve(f, w, tube, pressure_drop=1e-11),
                              check=lambda sol, f=fluid: None if abs(sol.flow_rate / f.flow_rate(
                                  tube.radius, 1e-11 / tube.length) - 1) < 1e-10 else f"q={sol.flow_rate!r}"))
+    if have("carreau-yasuda", "thick-linear"):     # the networks' dead end: NaN once, then ConvergenceError
+        fluid = R["carreau-yasuda"](**R["carreau-yasuda"]._examples[0])
+        lin = W["thick-linear"](youngs_modulus=6e3, poisson_ratio=0.5)
+        for dp in (1e-14, 1e-100):
+            out.append(Probe("solve", f"known: carreau-yasuda thick-linear dp={dp:g}, p_out=87.6",
+                             lambda f=fluid, w=lin, d=dp: solve(f, w, tube, pressure_drop=d, outlet_pressure=87.6),
+                             check=_small_drop(dp)))
     if have("carreau", "thick-gent"):
         fluid = R["carreau"](**R["carreau"]._examples[0])
         out.append(Probe("solve", "known: carreau thick-gent q=1e-300", lambda f=fluid: solve(
@@ -670,6 +779,7 @@ def bad_input_probes(rheologies=None, walls=None, couplers=None, *, core=True):
         probes += _model_probes("couplers", name)
     if core:
         probes += _tube_probes()
+        probes += _entry_keyword_probes()
         probes += _known_probes()
     # every named model in pairs: each rheology with a few walls, each wall with a few fluids
     partners_w = [w for w in ("thick-neo-hookean", "thin-linear", "rigid") if w in registry.walls]

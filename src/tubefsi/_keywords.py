@@ -1,0 +1,112 @@
+"""Wrong or missing keywords as :class:`~tubefsi.KeywordError` (``docs/verification.md``, "Fuzzing").
+
+Python binds a call's arguments before the callee runs, and a keyword it cannot bind is its own
+``TypeError``. Here every public entry point (:func:`checked_keywords`) and every model, coupler
+and tube class (the metaclasses :class:`KeywordChecked` and :class:`KeywordCheckedABC`, which
+the base classes use, so plugins' models get it too) catch that ``TypeError``, and only when the
+arguments do not bind to the signature replace it by a :class:`~tubefsi.KeywordError` that names
+the keyword, suggests the closest valid one and lists the valid ones. The success path costs one
+Python call frame; the signature is read only on the error path.
+"""
+
+from __future__ import annotations
+
+import abc
+import functools
+
+from .errors import KeywordError
+
+__all__ = ["checked_keywords", "KeywordChecked", "KeywordCheckedABC", "keyword_error"]
+
+
+def keyword_error(target, args, kwargs, name=None):
+    """The :class:`~tubefsi.KeywordError` of a call of ``target`` with ``args`` and ``kwargs``
+    that does not bind to its signature; ``None`` if it binds (the ``TypeError`` came from inside).
+    A method's ``self`` or ``cls`` is in ``args`` and is not listed as a keyword."""
+    import difflib
+    import inspect
+
+    try:
+        signature = inspect.signature(target)
+    except (TypeError, ValueError):
+        return None
+    try:
+        signature.bind(*args, **kwargs)
+    except TypeError:
+        pass
+    else:
+        return None
+    kinds = inspect.Parameter
+    params = signature.parameters.values()
+    bound_self = 1 if "." in getattr(target, "__qualname__", "") and args and next(iter(signature.parameters), "") in (
+        "self", "cls") else 0
+    valid = [p.name for p in params if p.kind in (kinds.POSITIONAL_OR_KEYWORD, kinds.KEYWORD_ONLY)][bound_self:]
+    name = name or f"{getattr(target, '__qualname__', repr(target))}()"
+    if not any(p.kind is kinds.VAR_KEYWORD for p in params):
+        unknown = [k for k in kwargs if k not in valid]
+        if unknown:
+            word = unknown[0]
+            close = [v for v in valid if v.startswith(word) or word.startswith(v)]     # a short form first
+            close = close or difflib.get_close_matches(word, valid, n=1, cutoff=0.6)
+            return KeywordError(name, word, valid, suggestion=close[0] if close else None)
+    positional = [p for p in params if p.kind in (kinds.POSITIONAL_ONLY, kinds.POSITIONAL_OR_KEYWORD)]
+    if not any(p.kind is kinds.VAR_POSITIONAL for p in params) and len(args) > len(positional):
+        return KeywordError(name, "positional arguments", valid,
+                            detail=f"takes {len(positional) - bound_self} positional arguments but "
+                                   f"{len(args) - bound_self} were given "
+                                   "(give the others by keyword)")
+    given = {p.name for p in positional[:len(args)]} | set(kwargs)
+    twice = [p.name for p in positional[:len(args)] if p.name in kwargs]
+    if twice:
+        return KeywordError(name, twice[0], valid, detail=f"got {twice[0]!r} both by position and by keyword")
+    missing = [p.name for p in params if p.default is p.empty and p.name not in given
+               and p.kind not in (kinds.VAR_POSITIONAL, kinds.VAR_KEYWORD)]
+    if missing:
+        return KeywordError(name, missing[0], valid, missing=missing)
+    return None
+
+
+def checked_keywords(function):
+    """Decorate a public function or method: a call whose arguments do not bind raises
+    :class:`~tubefsi.KeywordError` instead of Python's ``TypeError``."""
+
+    @functools.wraps(function)
+    def wrapper(*args, **kwargs):
+        try:
+            return function(*args, **kwargs)
+        except TypeError:
+            error = keyword_error(function, args, kwargs)
+            if error is None:
+                raise
+        raise error
+
+    return wrapper
+
+
+class KeywordChecked(type):
+    """Metaclass: constructing the class with arguments that do not bind to its ``__init__``
+    raises :class:`~tubefsi.KeywordError`."""
+
+    def __call__(cls, *args, **kwargs):
+        try:
+            return type.__call__(cls, *args, **kwargs)     # (no metaclass in between overrides it)
+        except TypeError:
+            # the signature of __init__ (the metaclass's own __call__ takes anything)
+            error = keyword_error(cls.__init__, (cls,) + args, kwargs, name=f"{cls.__name__}()")
+            if error is None:
+                raise
+        raise error
+
+
+    @property
+    def __signature__(cls):
+        # what ``inspect.signature`` (and so the documentation) shows: ``__init__`` without ``self``
+        import inspect
+
+        signature = inspect.signature(cls.__init__)
+        return signature.replace(parameters=list(signature.parameters.values())[1:],
+                                 return_annotation=inspect.Signature.empty)
+
+
+class KeywordCheckedABC(KeywordChecked, abc.ABCMeta):
+    """:class:`KeywordChecked` for abstract bases (``WallModel``, ``Rheology``, ``Coupler``)."""

@@ -1,0 +1,107 @@
+"""Wrong and missing keywords are a KeywordError (issue 11): an InvalidParameterError that is also a
+TypeError, naming the keyword, suggesting the closest valid one and listing the valid ones."""
+
+import inspect
+import pickle
+
+import attrs
+import pytest
+
+import tubefsi
+from tubefsi import InvalidParameterError, KeywordError, Network, Tube, advise, fit, max_flow_rate, solve
+from tubefsi._keywords import checked_keywords
+from tubefsi.fields import positive
+from tubefsi.registry import couplers, rheologies, walls
+from tubefsi.walls.linear import ThinLinear
+
+TUBE = Tube(radius=1e-4, thickness=3e-5, length=1e-2)
+FLUID = rheologies["power-law"](consistency=0.017, index=0.7)
+WALL = walls["thick-neo-hookean"](shear_modulus=2e3)
+
+
+@pytest.mark.parametrize("call, keyword, suggestion", [
+    (lambda: solve(FLUID, WALL, TUBE, flow_rat=1e-9), "flow_rat", "flow_rate"),
+    (lambda: solve(FLUID, WALL, TUBE, flow_rate=1e-9, outlet=1.0), "outlet", "outlet_pressure"),
+    (lambda: max_flow_rate(FLUID, WALL, TUBE, outlet_presure=0.0), "outlet_presure", "outlet_pressure"),
+    (lambda: advise(FLUID, WALL, TUBE, flowrate=1e-9), "flowrate", "flow_rate"),
+    (lambda: fit([1e-9], [1.0], FLUID, WALL, TUBE, parameter=["wall.shear_modulus"]), "parameter", "parameters"),
+    (lambda: walls["thick-neo-hookean"](shear_modulos=2e3), "shear_modulos", "shear_modulus"),
+    (lambda: rheologies["carreau"](zero_shear_viscosity=1.0, infinite_shear_viscosity=0.0, relaxation_time=1.0,
+                                   idx=0.5), "idx", "index"),
+    (lambda: couplers["quadrature"](ordr=4), "ordr", "order"),
+    (lambda: Tube(radius=1e-4, thicknes=3e-5, length=1e-2), "thicknes", "thickness"),
+    (lambda: Network(fluid=FLUID), "fluid", None),
+    (lambda: Network().add_tube("a", "b", WALL, TUBE, nme="t"), "nme", "name"),
+    (lambda: Network().solve(tol=1e-9), "tol", "rtol"),
+])
+def test_an_unknown_keyword_is_named_with_a_suggestion(call, keyword, suggestion):
+    with pytest.raises(KeywordError) as info:
+        call()
+    error = info.value
+    assert isinstance(error, TypeError) and isinstance(error, InvalidParameterError)
+    assert error.parameter == keyword and error.suggestion == suggestion and not error.missing
+    assert f"unexpected keyword {keyword!r}" in str(error)
+    if suggestion:
+        assert f"did you mean {suggestion!r}" in str(error) and suggestion in error.valid
+    assert all(name in str(error) for name in error.valid)
+
+
+def test_a_missing_required_keyword_is_named():
+    with pytest.raises(KeywordError, match="missing required keyword 'shear_modulus'") as info:
+        walls["thick-neo-hookean"]()
+    assert info.value.missing == ("shear_modulus",) and info.value.valid == ("shear_modulus", "axial_stretch")
+    with pytest.raises(KeywordError, match="missing required keywords 'relaxation_time', 'index'") as info:
+        rheologies["carreau"](zero_shear_viscosity=1.0, infinite_shear_viscosity=0.0)
+    assert info.value.parameter == "relaxation_time"
+    with pytest.raises(KeywordError, match="missing required keyword 'tube'"):
+        solve(FLUID, WALL, flow_rate=1e-9)
+    with pytest.raises(KeywordError, match="missing required keyword 'parameters'"):
+        fit([1e-9], [1.0], FLUID, WALL, TUBE)
+    with pytest.raises(KeywordError, match="takes 0 positional arguments but 1 were given"):
+        walls["thick-neo-hookean"](2e3)
+    with pytest.raises(KeywordError, match="both by position and by keyword"):
+        solve(FLUID, WALL, TUBE, tube=TUBE, flow_rate=1e-9)
+
+
+def test_existing_except_clauses_keep_working():
+    for kind in (TypeError, ValueError, InvalidParameterError, tubefsi.TubefsiError):
+        with pytest.raises(kind):
+            solve(FLUID, WALL, TUBE, flow_rat=1e-9)
+
+
+def test_a_plugin_model_gets_it_from_its_base_class():
+    @attrs.frozen(kw_only=True)
+    class Stiff(ThinLinear):
+        extra: float = positive(doc="a plugin's own parameter", default=1.0)
+
+    with pytest.raises(KeywordError, match="did you mean 'extra'"):
+        Stiff(youngs_modulus=1e4, poisson_ratio=0.3, extr=2.0)
+    assert Stiff(youngs_modulus=1e4, poisson_ratio=0.3).extra == 1.0
+
+
+def test_a_type_error_from_inside_is_left_alone():
+    @checked_keywords
+    def broken(x, *, y=1):
+        return x + "text"
+
+    with pytest.raises(TypeError) as info:
+        broken(1, y=2)
+    assert not isinstance(info.value, KeywordError)
+    with pytest.raises(KeywordError, match="did you mean 'y'"):
+        broken(1, yy=2)
+
+
+def test_signatures_pickling_and_values_are_unchanged():
+    sig = inspect.signature(walls["thick-neo-hookean"])
+    assert list(sig.parameters) == ["shear_modulus", "axial_stretch"]
+    assert inspect.signature(Tube).parameters["radius"].kind is inspect.Parameter.KEYWORD_ONLY
+    assert list(inspect.signature(solve).parameters)[:4] == ["rheology", "wall", "tube", "flow_rate"]
+    assert pickle.loads(pickle.dumps(solve)) is solve
+    assert pickle.loads(pickle.dumps(WALL)) == WALL
+    with pytest.raises(KeywordError) as info:
+        solve(FLUID, WALL, TUBE, flow_rat=1e-9)
+    error = info.value
+    back = pickle.loads(pickle.dumps(error))
+    assert type(back) is KeywordError and str(back) == str(error) and back.suggestion == "flow_rate"
+    other = pickle.loads(pickle.dumps(InvalidParameterError("x", "(0, inf)", -1.0)))
+    assert other.parameter == "x" and str(other) == "x must be in (0, inf) (got -1.0)"
