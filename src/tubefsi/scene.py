@@ -381,6 +381,9 @@ def make_scene(rheology, wall, tube, *, outlet_pressure=0.0, external_pressure=0
     if tube.graded or varies(wall):
         return _graded_scene(rheology, wall, tube, outlet_pressure, external_pressure)
     tube = wall._installed_tube(tube)        # an axial pre-stretch installs the tube longer and narrower
+    if (type(outlet_pressure) is float and outlet_pressure == 0.0 and type(external_pressure) is float
+            and external_pressure == 0.0):   # the common case: an unloaded outlet is below every limit
+        return Scene(rheology=rheology, wall=wall, tube=tube, outlet_pressure=0.0)
     p_out = as_array("outlet_pressure", outlet_pressure, "[0, inf)", lambda a: a >= 0)
     p_out = float(p_out) if p_out.ndim == 0 else p_out
     p_e = as_array("external_pressure", external_pressure, "the real numbers", lambda a: a == a)
