@@ -179,6 +179,9 @@ def integrate_graded(f, upper, pole, *, gap=None, reach=1.0, order=16, panel_wid
     return out.reshape(upper.shape)
 
 
+_SUBNORMAL_ULPS = 8 * float(np.finfo(float).smallest_subnormal)
+
+
 def solve_increasing(F, dF, target, *, guess, upper=None, xmax=np.inf, maxiter=200,
                      rtol=4 * EPS, max_step=np.inf, log=False, evaluated=None):
     r"""Solve ``F(x) = target`` for increasing ``F`` with ``F(0) = 0``, elementwise.
@@ -220,6 +223,9 @@ def solve_increasing(F, dF, target, *, guess, upper=None, xmax=np.inf, maxiter=2
                 xn = xa - np.log(fa / target[active]) * fa / d
             else:
                 xn = xa - r / d
+        # Newton cannot move x (its step rounds away: a residual of a few ulps, e.g. at a root
+        # below the normal doubles): x is the root as far as doubles resolve it, not a bad step
+        stay = np.isfinite(xn) & (np.abs(xn - xa) <= _SUBNORMAL_ULPS)
         bad = ~np.isfinite(xn) | (xn <= lo_a) | (xn >= hi_a)
         bisect = np.where(np.isfinite(hi_a), 0.5 * (lo_a + hi_a),
                           np.minimum(np.maximum(2.0 * xa, xa + 1.0), xa + max_step))
@@ -229,11 +235,13 @@ def solve_increasing(F, dF, target, *, guess, upper=None, xmax=np.inf, maxiter=2
         xn = np.where(runaway, xmax, xn)
         lo[active], hi[active] = lo_a, hi_a
         step = np.abs(xn - xa)
-        done = ((np.abs(r) <= 8 * EPS * target[active]) | (step <= rtol * np.abs(xn))
-                | (hi_a - lo_a <= rtol * np.abs(xn)))
+        # (a few ulps of the subnormals: a root below the normal doubles, e.g. the strain at a
+        # subnormal pressure, is resolved only that far)
+        done = ((np.abs(r) <= 8 * EPS * target[active]) | (step <= rtol * np.abs(xn) + _SUBNORMAL_ULPS)
+                | (hi_a - lo_a <= rtol * np.abs(xn) + _SUBNORMAL_ULPS) | stay)
         stuck = runaway & (xa >= xmax)
         ok[active[stuck]] = False
-        met = np.abs(r) <= 8 * EPS * target[active]
+        met = (np.abs(r) <= 8 * EPS * target[active]) | stay
         x[active] = np.where(met, xa, xn)
         if evaluated is not None:
             evaluated.ravel()[active] = met
