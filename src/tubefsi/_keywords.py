@@ -66,9 +66,16 @@ def keyword_error(target, args, kwargs, name=None):
     return None
 
 
-def checked_keywords(function):
+class _Never(Exception):
+    """Raised by nothing: the exception a wrapper without ``recover`` catches."""
+
+
+def checked_keywords(function, recover=None):
     """Decorate a public function or method: a call whose arguments do not bind raises
-    :class:`~tubefsi.KeywordError` instead of Python's ``TypeError``."""
+    :class:`~tubefsi.KeywordError` instead of Python's ``TypeError``. ``recover``, optional, is
+    ``(exception class, handler)``: where the call raises that exception, ``handler(function, args,
+    kwargs)`` answers instead (None: the exception stands). One call frame on the ordinary path."""
+    caught, handler = recover if recover is not None else (_Never, None)
 
     @functools.wraps(function)
     def wrapper(*args, **kwargs):
@@ -78,6 +85,11 @@ def checked_keywords(function):
             error = keyword_error(function, args, kwargs)
             if error is None:
                 raise
+        except caught:
+            found = handler(function, args, kwargs)
+            if found is None:
+                raise
+            return found
         raise error
 
     return wrapper

@@ -9,7 +9,6 @@ loads and returns a :class:`~tubefsi.Solution`.
 from __future__ import annotations
 
 import contextlib
-import functools
 import math
 
 import attrs
@@ -17,12 +16,12 @@ import numpy as np
 
 from . import registry
 from ._progress import bar
-from ._keywords import checked_keywords, keyword_error
+from ._keywords import checked_keywords
 from ._validation import as_load
 from .couplers.base import Coupler
 from .couplers.checked import checked
 from .couplers.graded import Graded
-from .couplers.rescaled import Rescaled
+from .couplers.rescaled import Rescaled, in_units
 from .errors import InvalidParameterError, NoSteadyStateError, StretchRangeError
 from .couplers.separated import _TABLES, SeparatedVariables, curve_span
 from .geometry import Tube
@@ -50,28 +49,11 @@ def _auto(rheology, wall):
 
 
 def _in_radius_units(function):
-    """:func:`~tubefsi._keywords.checked_keywords` for ``solve``, and: solve again in units of the
-    tube's radius where a factor of the separated form left the doubles
-    (:class:`~tubefsi.rheology.power_law.FactorRangeError`: a power law of a large index) though
-    the answer may not (:mod:`tubefsi.couplers.rescaled`); the error stands where that cannot
-    help. One call frame on the ordinary path, for both."""
-
-    @functools.wraps(function)
-    def wrapper(*args, **kwargs):
-        try:
-            return function(*args, **kwargs)
-        except TypeError:
-            error = keyword_error(function, args, kwargs)
-            if error is None:
-                raise
-        except FactorRangeError:
-            found = _radius_units(function, args, kwargs)
-            if found is None:
-                raise
-            return found
-        raise error
-
-    return wrapper
+    """:func:`~tubefsi._keywords.checked_keywords` for ``solve``, recovering from
+    :class:`~tubefsi.rheology.power_law.FactorRangeError` (a factor of the separated form left
+    the doubles: a power law of a large index) by solving again in units of the tube's radius
+    (:mod:`tubefsi.couplers.rescaled`); the error stands where that cannot help."""
+    return checked_keywords(function, recover=(FactorRangeError, lambda f, a, k: _radius_units(f, a, k)))
 
 
 @checked_keywords
@@ -411,8 +393,7 @@ def max_flow_rate(rheology, wall, tube, *, outlet_pressure=0.0, external_pressur
         if type(tube.radius) is not float or not (_plain(tube.thickness) and _plain(tube.length)):
             raise
         unit = tube.radius       # in units of the radius (the limit is a flow rate: times unit^3)
-        scaled = Tube(radius=1.0, thickness=np.divide(tube.thickness, unit), length=np.divide(tube.length, unit))
-        return max_flow_rate(rheology, wall, scaled, outlet_pressure=outlet_pressure,
+        return max_flow_rate(rheology, wall, in_units(tube, unit), outlet_pressure=outlet_pressure,
                              external_pressure=external_pressure, coupler=coupler) * unit**3
     chosen = _graded(scene, coupler) if scene.graded else select_coupler(scene.rheology, scene.wall, coupler)
     if scene.shape == ():
@@ -444,7 +425,7 @@ def _radius_units(function, args, kwargs):
     unit = tube.radius
     if given["flow_rate"] is not None:
         given["flow_rate"] = as_load("flow_rate", given["flow_rate"]) / unit**3
-    given["tube"] = Tube(radius=1.0, thickness=np.divide(tube.thickness, unit), length=np.divide(tube.length, unit))
+    given["tube"] = in_units(tube, unit)
     try:
         inner = function(**given)
     except FactorRangeError:

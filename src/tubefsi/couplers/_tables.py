@@ -46,14 +46,13 @@ class Chebyshev:
         self.breaks = np.asarray(breaks, dtype=float)
         self.coef = np.asarray(coef, dtype=float)
         self._breaks = self.breaks.tolist()
-        self._coef = [row.tolist() for row in self.coef]
         self.lo, self.hi = float(self.breaks[0]), float(self.breaks[-1])
         self._width = np.diff(self.breaks)
         # 2t = 4 (x - a) / width - 2 on the panel [a, a + width], as one multiply and one add
         self._t2_scale = 4.0 / self._width
         self._t2_offset = -2.0 - self.breaks[:-1] * self._t2_scale
         self._t2_scale_list, self._t2_offset_list = self._t2_scale.tolist(), self._t2_offset.tolist()
-        self._coef_parts = [(row[-1], tuple(row[-2:0:-1]), row[0]) for row in self._coef]
+        self._coef_parts = [(row[-1], tuple(row[-2:0:-1]), row[0]) for row in self.coef.tolist()]
         self._last = len(self._breaks) - 2
         self._coefT = np.ascontiguousarray(self.coef.T)
         # panel lookup by equal buckets as narrow as the narrowest panel (the panels come from

@@ -24,6 +24,12 @@ from .base import Coupler
 __all__ = ["Rescaled"]
 
 
+def in_units(tube: Tube, unit) -> Tube:
+    """``tube`` with its lengths measured in units of ``unit`` metres."""
+    return Tube(radius=np.divide(tube.radius, unit), thickness=np.divide(tube.thickness, unit),
+                length=np.divide(tube.length, unit))
+
+
 @final
 @attrs.frozen(kw_only=True)
 class Rescaled(Coupler):
@@ -36,9 +42,7 @@ class Rescaled(Coupler):
         return self.inner.supports(rheology, wall)
 
     def _scene(self, scene):
-        t, u = scene.tube, self.unit
-        return attrs.evolve(scene, tube=Tube(radius=np.divide(t.radius, u), thickness=np.divide(t.thickness, u),
-                                             length=np.divide(t.length, u)))
+        return attrs.evolve(scene, tube=in_units(scene.tube, self.unit))
 
     def _state(self, state, factor):
         return State(np.asarray(state.flow_rate) * factor, state.pressure_drop, state.inlet_strain, state.log_stretch)
