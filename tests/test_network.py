@@ -162,8 +162,10 @@ def test_reversing_a_tube_negates_its_flow():
 
     forward, backward = build(False), build(True)
     assert forward.flow_rate["branch"] > 0
-    assert backward.flow_rate["branch"] == -forward.flow_rate["branch"]
-    assert backward.pressure["j"] == forward.pressure["j"]
+    # to rounding, not bit for bit: the node balances and the Jacobian's diagonal sum the same
+    # terms in another order when an edge is reversed
+    assert abs(backward.flow_rate["branch"] + forward.flow_rate["branch"]) <= 2e-15 * forward.flow_rate["branch"]
+    assert abs(backward.pressure["j"] - forward.pressure["j"]) <= 2e-15 * forward.pressure["j"]
 
 
 def test_flow_reverses_in_a_loop():

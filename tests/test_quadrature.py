@@ -12,8 +12,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tubefsi._quadrature import (GAUSS_WEIGHTS, KRONROD_NODES, KRONROD_WEIGHTS, adaptive, adaptive_to_pole,
-                                 quiet, recording, warn_unconverged)
+from tubefsi._quadrature import (GAUSS_WEIGHTS, KRONROD_NODES, KRONROD_WEIGHTS, LOBATTO_NODES, adaptive,
+                                 adaptive_to_pole, quiet, recording, solve_integral, warn_unconverged)
 from tubefsi.errors import AccuracyWarning
 
 
@@ -124,3 +124,66 @@ def test_newton_reports_where_its_answer_was_evaluated():
     assert evaluated[0] and x[0] == 2.0
     for k in np.flatnonzero(evaluated):      # every marked answer was evaluated as it stands
         assert any(np.any(values == x[k]) for values in seen)
+
+
+# ------------------------------------------------------------------ solve_integral (one-shot Chebyshev)
+def test_interpolation_maps_against_numpy_chebyshev():
+    """The value -> coefficient map is the Chebyshev interpolant at the Lobatto nodes
+    (numpy's chebfit through the same 17 points), and its antiderivative vanishes at 0."""
+    from tubefsi._quadrature import _ANTI, _COEF, _MAP
+    rng = np.random.default_rng(3)
+    y = rng.standard_normal((5, 17))
+    t = 2.0 * LOBATTO_NODES - 1.0
+    coef = (_MAP[_COEF] @ y.T).T
+    ref = np.array([np.polynomial.chebyshev.chebfit(t, row, 16) for row in y])
+    np.testing.assert_allclose(coef, ref, rtol=0, atol=1e-13)
+    anti = (_MAP[_ANTI] @ y.T).T
+    np.testing.assert_allclose(np.polynomial.chebyshev.chebval(-1.0, anti.T), 0.0, atol=1e-14)
+    np.testing.assert_allclose(np.polynomial.chebyshev.chebder(anti.T).T, ref, rtol=0, atol=1e-13)
+
+
+@settings(deadline=None, max_examples=30)
+@given(st.floats(0.0, 4.0), st.floats(0.2, 3.0), st.floats(0.01, 0.6))
+def test_solved_points_meet_the_tolerance_against_mpmath(k, c, target):
+    """int_0^x e^{ku} (c + u) du = T, solved where the estimate says so, against mpmath's root."""
+    x, solved, short = solve_integral(lambda u, i: np.exp(k * u) * (c + u), np.array([target]),
+                                      np.array([1.5 * target / c]))
+    with mpmath.workdps(40):
+        f = lambda xx: mpmath.quad(lambda u: mpmath.exp(k * u) * (c + u), [0, xx]) - target
+        root = mpmath.findroot(f, target / c)
+    if solved[0]:
+        assert abs(x[0] / float(root) - 1) < 4e-15
+    else:                         # not solved: either the root is beyond 1.5 T / c or the tail said no
+        assert short[0] or float(root) < 1.5 * target / c
+
+
+def test_what_is_not_resolved_is_left_to_the_caller():
+    """A kink (|u - 0.3|), a steep exponential, a non-positive and a non-finite integrand, and
+    a root beyond the interval: none of them is answered."""
+    target = np.array([0.3, 0.5, 0.5, 0.5, 5.0])
+    upper = np.array([1.0, 1.0, 1.0, 1.0, 1.0])
+
+    def f(u, i):
+        out = np.empty(u.shape)
+        out[0] = 0.2 + np.abs(u[0] - 0.3)
+        out[1] = 0.01 * np.exp(40.0 * u[1])
+        out[2] = u[2] - 0.5
+        out[3] = np.where(u[3] > 0.9, np.inf, 1.0)
+        out[4] = 1.0
+        return out
+
+    x, solved, short = solve_integral(f, target, upper)
+    assert not np.any(solved)
+    assert list(short) == [False, False, False, False, True]
+
+
+def test_vectorized_solve_equals_one_at_a_time():
+    k = np.array([0.5, 2.0, 3.5])
+    target = np.array([0.05, 0.2, 0.3])
+    x, solved, _ = solve_integral(lambda u, i: np.exp(k[i, None] * u), target, 1.5 * target)
+    for j in range(3):
+        xj, sj, _ = solve_integral(lambda u, i: np.exp(k[j] * u), target[j:j + 1], 1.5 * target[j:j + 1])
+        assert sj[0] == solved[j]
+        assert xj[0] == x[j]
+    # the closed form: (e^{kx} - 1)/k = T
+    np.testing.assert_allclose(x[solved], (np.log1p(k * target) / k)[solved], rtol=4e-15)

@@ -39,6 +39,23 @@ __all__ = ["solve", "max_flow_rate", "select_coupler"]
 _AUTO: dict = {}
 
 
+_CONTRACT_COUPLERS: dict = {}
+
+
+def _contract_couplers():
+    """The registered couplers that meet the accuracy contract, one (immutable) instance each,
+    cheapest first (by cost rank, then name); built once per state of the registry."""
+    generation = registry.couplers.generation
+    found = _CONTRACT_COUPLERS.get(generation)
+    if found is None:
+        ranked = sorted((registry.couplers[name].cost_rank, name) for name in registry.couplers
+                        if registry.couplers[name].meets_accuracy_contract)
+        found = tuple(registry.couplers[name]() for _, name in ranked)
+        _CONTRACT_COUPLERS.clear()
+        _CONTRACT_COUPLERS[generation] = found
+    return found
+
+
 def _auto(rheology, wall):
     key = (registry.couplers.generation, type(rheology), type(wall))
     found = _AUTO.get(key)
@@ -60,17 +77,11 @@ def _in_radius_units(function):
 def select_coupler(rheology, wall, coupler="auto") -> Coupler:
     """The coupler ``solve`` would use: a name, an instance, or ``"auto"`` (cheapest accurate)."""
     if isinstance(coupler, str) and coupler == "auto":
-        candidates = []
-        for name in registry.couplers:
-            cls = registry.couplers[name]
-            if cls.meets_accuracy_contract:
-                inst = cls()
-                if inst.supports(rheology, wall):
-                    candidates.append((cls.cost_rank, name, inst))
-        if not candidates:
-            raise InvalidParameterError("coupler", "a coupler that supports this pair",
-                                        "auto", "no registered coupler supports it")
-        return min(candidates, key=lambda c: (c[0], c[1]))[2]
+        for inst in _contract_couplers():
+            if inst.supports(rheology, wall):
+                return inst
+        raise InvalidParameterError("coupler", "a coupler that supports this pair",
+                                    "auto", "no registered coupler supports it")
     inst = _resolve("coupler", coupler, Coupler, registry.couplers)
     if not inst.supports(rheology, wall):
         raise InvalidParameterError("coupler", "a coupler that supports this pair", coupler,

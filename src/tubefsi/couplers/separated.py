@@ -43,11 +43,14 @@ import numpy as np
 
 from .._lazy import lazy_module
 from .._numerics import EPS, integrate_graded, solve_increasing
-from .._quadrature import adaptive_to_pole, quiet, recording, warn_unconverged
+from .._quadrature import adaptive_to_pole, quiet, recording, solve_integral, warn_unconverged
 from ..errors import ConvergenceError, InvalidParameterError, NoSteadyStateError, StretchRangeError
 from ..scene import Points, Scene, State
 from ._tables import SeparatedTable, fit_chebyshev
 from .base import Coupler
+
+#: Half the exponent range of doubles: a product of two factors within it stays a normal double.
+_LOG_RANGE = 0.5 * math.log(np.finfo(float).tiny) * -1.0
 
 # SciPy on first use (tubefsi._lazy): listing the models must not import it
 interpolate = lazy_module("scipy.interpolate", globals(), "interpolate")
@@ -104,7 +107,10 @@ class SeparatedVariables(Coupler):
     @staticmethod
     def stretch_at(points: Points, u):
         """Hoop stretch at log-stretch ``u``."""
-        return points.outlet_stretch * np.exp(u)
+        s_out = points.outlet_stretch
+        if type(s_out) is float and s_out == 1.0:       # an unloaded outlet: no pass to multiply by 1
+            return np.exp(u)
+        return s_out * np.exp(u)
 
     @staticmethod
     def strain_at(points: Points, u):
@@ -152,15 +158,26 @@ class SeparatedVariables(Coupler):
     @staticmethod
     def _slope(points: Points, u):
         s = SeparatedVariables.stretch_at(points, u)
-        return s * points.wall._stiffness(s, points.tb)
+        return points.wall._log_slope(s, points.tb)
 
     def integrand(self, points: Points, u, q=None):
         r""":math:`s P'(s)/\psi(a s)` (separable) or :math:`s P'(s)/G(q, a s)`."""
         s = self.stretch_at(points, u)
         a = points.radius
-        slope = s * points.wall._stiffness(s, points.tb)
+        slope = points.wall._log_slope(s, points.tb)
         rheo = points.rheology
         if rheo.separable:
+            k = rheo.radius_exponent
+            if k is not None:
+                # psi = R^-k: (a s)^k = (a s_out)^k e^{ku}, an exp per node instead of a power with
+                # a per-point exponent (several times dearer); the power of the per-point factor
+                # keeps its one rounding, and where it leaves double range psi itself says so
+                with np.errstate(over="ignore", under="ignore"):
+                    scale = (a * points.outlet_stretch) ** k
+                reach = np.max(np.abs(k)) * max(np.max(u), -np.min(u)) if np.size(u) else 0.0
+                if reach < _LOG_RANGE and np.all(np.abs(np.log(scale)) < _LOG_RANGE):
+                    ku = k * u
+                    return slope * (scale * np.exp(ku, out=ku))
             return slope / rheo._radius_factor(a * s)
         qq = np.broadcast_to(q, np.shape(u))
         return slope / rheo._pressure_gradient(qq, a * s)
@@ -337,11 +354,18 @@ class SeparatedVariables(Coupler):
             return None
         return cached.for_scene(scene)
 
-    def solve_log_stretch(self, scene: Scene, target, index, q=None, upper=None, *, check=True):
+    def solve_log_stretch(self, scene: Scene, target, index, q=None, upper=None, *, check=True, one_batch=True):
         r"""Log-stretch :math:`v` with :math:`J(v; q) = ` ``target`` at the points ``index``;
         returns ``(v, ok)``.
 
-        Safeguarded Newton on :math:`\ln J`. For a separable rheology in a scene whose
+        First, with ``one_batch``, the points of a broadcast solve (not one long curve) are
+        solved from one batch of 17 integrand values each: a Chebyshev interpolant of the
+        integrand on :math:`[0, 2v_0]` (:math:`v_0` the linear guess), integrated exactly, with an
+        a-posteriori estimate from the tail of its coefficients
+        (:func:`~tubefsi._quadrature.solve_integral`); a point is answered there only where that
+        estimate meets ``_RTOL``.
+
+        The others: safeguarded Newton on :math:`\ln J`. For a separable rheology in a scene whose
         quantities are shared by all points (a curve), a coarse solve on a few quantiles of the
         targets gives every point a starting value within a few Newton steps of its root. Trial
         points do not warn (:func:`~tubefsi._quadrature.quiet`); with ``check`` the integral at
@@ -389,6 +413,19 @@ class SeparatedVariables(Coupler):
         if upper is not None:
             guess = np.minimum(guess, upper)
         cap = self._log_stretch_cap(scene, index) + np.zeros(target.shape)
+        if one_batch and not self._coarse and not (sep and shared and positive.size > 256):
+            bound = 0.5 * cap if upper is None else np.minimum(0.5 * cap, upper)
+            v, solved = self._solve_by_interpolation(scene, index, target, guess, bound, qflat)
+            if np.any(solved):
+                ok = np.ones(target.shape, dtype=bool)
+                rest = np.flatnonzero(~solved.ravel())
+                if rest.size:
+                    v, ok = v.ravel(), ok.ravel()
+                    v[rest], ok[rest] = self.solve_log_stretch(
+                        scene, target.ravel()[rest], index.ravel()[rest], None if sep else qflat.ravel()[rest],
+                        None if upper is None else (np.asarray(upper, dtype=float) + np.zeros(target.shape)).ravel()[rest],
+                        check=check, one_batch=False)
+                return v.reshape(target.shape), ok.reshape(target.shape)
         if _GAUSS_START and not (sep and shared and positive.size > 256):
             guess = self._gauss_start(scene, index, target, guess, qflat, np.minimum(
                 0.5 * cap, np.inf if upper is None else upper))
@@ -416,6 +453,38 @@ class SeparatedVariables(Coupler):
                 ok = ok.copy()
                 ok.ravel()[at_cap[short]] = False
         return v, ok
+
+    def _solve_by_interpolation(self, scene, index, target, guess, bound, q):
+        """:func:`~tubefsi._quadrature.solve_integral` at the points with a positive target, on
+        :math:`[0, 1.5 v_0]` (:math:`v_0` the linear ``guess``: the root is within a few tens of
+        per cent of it for a moderate strain, and a short interval keeps the interpolant's
+        degree low), and on three times that where the integral fell short; never beyond
+        ``bound``. Returns ``(v, solved)`` shaped like ``target``."""
+        v = np.zeros(target.shape)
+        solved = np.zeros(target.shape, dtype=bool)
+        top = np.minimum(1.5 * guess, bound) + np.zeros(target.shape)
+        live = np.flatnonzero((target.ravel() > 0) & (top.ravel() > 0))
+        for _ in range(2):
+            if live.size == 0:
+                break
+            ids = index.ravel()[live]
+            if q is None:
+                def f(u, i):
+                    return self.integrand(scene.at(ids[i], column=True), u)
+            else:
+                q_live = q.ravel()[live]
+
+                def f(u, i):
+                    return self.integrand(scene.at(ids[i], column=True), u, q_live[i, None])
+            with np.errstate(all="ignore"):
+                x, good, short = solve_integral(f, target.ravel()[live], top.ravel()[live], rtol=self._RTOL)
+            v.ravel()[live[good]] = x[good]
+            solved.ravel()[live[good]] = True
+            wider = np.minimum(3.0 * top.ravel()[live], (np.asarray(bound) + np.zeros(target.shape)).ravel()[live])
+            short &= wider > top.ravel()[live]
+            top.ravel()[live] = wider
+            live = live[short]
+        return v, solved
 
     def _gauss_start(self, scene, index, target, guess, q, top):
         r"""A starting value near the root for the Newton iteration on :math:`\ln J`: Newton on a

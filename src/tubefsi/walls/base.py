@@ -63,6 +63,8 @@ class WallModel(abc.ABC, metaclass=KeywordCheckedABC):
     ``_strain(pressure, tb)``                               ``_stretch - 1``, or the inverse of
                                                             ``_pressure_at_strain`` (Newton, then bracketing)
     ``_stiffness(stretch, tb)``                             :math:`dP/d\lambda` by ``scipy.differentiate``
+    ``_log_slope(stretch, tb)``                             :math:`\lambda\,dP/d\lambda` (the wall's factor of
+                                                            the separated integrand): ``stretch * _stiffness``
     ``_limit_pressure(tb)``                                 ``inf`` (no limit pressure)
     ``_max_stretch(tb)``                                    ``inf`` (no locking stretch, no peak)
     ``_min_pressure(tb)``                                   0 (inflation only); the most negative transmural
@@ -226,6 +228,11 @@ class WallModel(abc.ABC, metaclass=KeywordCheckedABC):
                                        step_direction=np.where(p > 4 * step, 0, 1),
                                        initial_step=step, tolerances=_DIFF_TOL)
         return (1.0 / res.df).reshape(shape)
+
+    def _log_slope(self, stretch, tb):
+        r""":math:`\lambda\,dP/d\lambda = dP/d\ln\lambda` (override where a closed form saves work:
+        the separated integrand evaluates it at every node)."""
+        return stretch * self._stiffness(stretch, tb)
 
     def _limit_pressure(self, tb):
         return math.inf

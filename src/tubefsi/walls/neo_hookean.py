@@ -166,6 +166,23 @@ class _ThickForms(_NeoHookeanLaw):
         num /= den
         return num
 
+    def _log_slope(self, stretch, tb):
+        # lam P' = mu d (lam^2 (d + 2) + d) / (lam^2 (lam^2 + d)^2): the stiffness's form with the
+        # factor lam cancelled, two passes fewer over (points x nodes); a subclass that overrides
+        # the stiffness gets its own
+        if type(self)._stiffness is not _ThickForms._stiffness:
+            return stretch * self._stiffness(stretch, tb)
+        lam2 = np.multiply(stretch, stretch)
+        d = tb * (2.0 + tb)
+        den = lam2 + d
+        den *= den
+        den *= lam2
+        num = lam2 * (d + 2.0)
+        num += d
+        num *= self._installed_modulus() * d
+        num /= den
+        return num
+
     def _strain(self, pressure, tb):
         # the law per unit modulus: no parameter but t/a, which is gathered for the active points
         shape = np.broadcast_shapes(np.shape(pressure), np.shape(tb), np.shape(self._installed_modulus()))
