@@ -160,3 +160,20 @@ def test_rheology_methods_broadcast_over_parameters(cls, first, second):
     assert g.shape == (2,)
     flow = both.flow_rate(radius, g)
     np.testing.assert_allclose(flow, 1e-9, rtol=1e-12)
+
+
+def test_a_scalar_argument_with_array_parameters_in_the_generic_wall_paths():
+    """The generic thick-wall integral, the thin law at small strain and the generic inverse take
+    a scalar stretch or pressure with array parameters (they used to index one point only)."""
+    from tubefsi.registry import walls
+    moduli = np.array([1.0e3, 1.5e3, 2.0e3])
+    for name, extra in (("thick-fung", {"stiffening": 20.0}), ("thin-fung", {"stiffening": 2.0})):
+        wall = walls[name](shear_modulus=moduli, **extra)
+        got = wall.pressure(1.05, 0.3)
+        strain = wall.strain(50.0, 0.3)
+        for i, mu in enumerate(moduli):
+            one = walls[name](shear_modulus=float(mu), **extra)
+            assert got[i] == one.pressure(1.05, 0.3)
+            assert abs(strain[i] / one.strain(50.0, 0.3) - 1) <= 1e-15     # a root: to its last bits
+        limit = wall.limit_pressure(0.3)
+        assert np.shape(limit) == (3,)

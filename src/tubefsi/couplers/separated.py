@@ -175,9 +175,17 @@ class SeparatedVariables(Coupler):
                 with np.errstate(over="ignore", under="ignore"):
                     scale = (a * points.outlet_stretch) ** k
                 reach = np.max(np.abs(k)) * max(np.max(u), -np.min(u)) if np.size(u) else 0.0
-                if reach < _LOG_RANGE and np.all(np.abs(np.log(scale)) < _LOG_RANGE):
+                near = np.abs(np.log(scale)) < _LOG_RANGE
+                if reach < _LOG_RANGE and np.all(near):
                     ku = k * u
                     return slope * (scale * np.exp(ku, out=ku))
+                # some factor beyond half the exponent range: the power where the exponential
+                # form could leave the doubles, decided node by node (a point's answer must not
+                # depend on the batch it came in); the power raises where psi itself leaves them
+                ku = k * u
+                with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+                    fast = slope * (scale * np.exp(ku))
+                return np.where(near & (np.abs(ku) < _LOG_RANGE), fast, slope / rheo._radius_factor(a * s))
             return slope / rheo._radius_factor(a * s)
         qq = np.broadcast_to(q, np.shape(u))
         return slope / rheo._pressure_gradient(qq, a * s)
@@ -358,9 +366,10 @@ class SeparatedVariables(Coupler):
         r"""Log-stretch :math:`v` with :math:`J(v; q) = ` ``target`` at the points ``index``;
         returns ``(v, ok)``.
 
-        First, with ``one_batch``, the points of a broadcast solve (not one long curve) are
-        solved from one batch of 17 integrand values each: a Chebyshev interpolant of the
-        integrand on :math:`[0, 2v_0]` (:math:`v_0` the linear guess), integrated exactly, with an
+        First, with ``one_batch``, the points of a separable fluid's broadcast solve (at least
+        ``_ONE_BATCH_MIN_POINTS``, not one long curve) are solved from one batch of 17 integrand
+        values each: a Chebyshev interpolant of the integrand on :math:`[0, 1.5v_0]`
+        (:math:`v_0` the linear guess), integrated exactly, with an
         a-posteriori estimate from the tail of its coefficients
         (:func:`~tubefsi._quadrature.solve_integral`); a point is answered there only where that
         estimate meets ``_RTOL``.
@@ -413,7 +422,8 @@ class SeparatedVariables(Coupler):
         if upper is not None:
             guess = np.minimum(guess, upper)
         cap = self._log_stretch_cap(scene, index) + np.zeros(target.shape)
-        if one_batch and not self._coarse and not (sep and shared and positive.size > 256):
+        if (one_batch and sep and not self._coarse and positive.size >= _ONE_BATCH_MIN_POINTS
+                and not (shared and positive.size > 256)):
             bound = 0.5 * cap if upper is None else np.minimum(0.5 * cap, upper)
             v, solved = self._solve_by_interpolation(scene, index, target, guess, bound, qflat)
             if np.any(solved):
@@ -891,6 +901,12 @@ def curve_span(scene: Scene, flow_rate):
 #: solving their key directly has reached the time a build takes (a ski-rental rule: never more
 #: than twice the cost of the better choice in hindsight, whatever the sequence of calls).
 _TABLE_MIN_POINTS = 64
+#: The one-batch solve (:func:`~tubefsi._quadrature.solve_integral`) for a separable fluid's
+#: broadcast solves of at least this many points: below, its fixed cost (a few dozen array
+#: operations) outweighs the integrand values it saves, and a point it cannot accept (a large
+#: strain) costs its 17 values on top of the adaptive path. A non-separable fluid's integrand
+#: (an interpolated flow law) is left to the adaptive path, whose panels follow its smoothness.
+_ONE_BATCH_MIN_POINTS = 64
 #: Start the direct Newton iteration from a Gauss estimate (SeparatedVariables._gauss_start).
 _GAUSS_START = True
 _START_NODES, _START_WEIGHTS = np.polynomial.legendre.leggauss(8)

@@ -308,7 +308,7 @@ class WallModel(abc.ABC, metaclass=KeywordCheckedABC):
         """Hoop strain at ``pressure``: safeguarded Newton iteration with the stiffness (vectorized,
         bracketed below a maximum stretch), else bracketed root finding on ``_pressure_at_strain``."""
         shape, wall, (p, tb) = flat_points(self, pressure, tb)
-        p = np.broadcast_to(p, (max(1, p.size),))             # the root finders index their points
+        p = np.broadcast_to(p, (max(1, math.prod(shape)),))   # the root finders index their points
         lam_max = np.asarray(wall._max_stretch(tb), dtype=float) + 0.0 * p
         emax = lam_max - 1.0
         scale = np.maximum(wall._stiffness(np.ones(p.shape), tb), 1e-300)
@@ -393,7 +393,7 @@ class WallModel(abc.ABC, metaclass=KeywordCheckedABC):
     def _invert_strain(self, strain, tb):
         """Pressure at a strain when only the inverse law ``_strain`` is natural."""
         shape, wall, (e, tb) = flat_points(self, strain, tb)
-        e = np.broadcast_to(e, (max(1, e.size),))
+        e = np.broadcast_to(e, (max(1, math.prod(shape)),))   # with the parameters: a scalar strain too
         index = np.arange(e.size)
 
         def f(p, e, i):

@@ -215,7 +215,7 @@ class ThinWall(HyperelasticWall):
         costs nothing).
         """
         shape, wall, (e,) = flat_points(self, strain)
-        e = np.broadcast_to(e, (max(1, e.size),))
+        e = np.broadcast_to(e, (max(1, math.prod(shape)),))   # with the parameters: a scalar strain too
         out = wall._dW(1.0 + e)
         small = np.flatnonzero(np.abs(e) < self._SMALL_STRAIN)
         if small.size:
@@ -255,7 +255,7 @@ class ThickWall(HyperelasticWall):
         Gauss–Kronrod quadrature with an a-posteriori error estimate per point; graded toward a
         locking stretch in :math:`\ln(\ln\lambda_{max} - u)`."""
         shape, wall, (e, tb) = flat_points(self, strain, tb)
-        e = np.broadcast_to(e, (max(1, e.size),))            # the quadrature indexes its points
+        e = np.broadcast_to(e, (max(1, math.prod(shape)),))   # the quadrature indexes its points
         b = (1.0 + tb) ** 2
         x = e * (2.0 + e)                                   # lam^2 - 1
         log_lam_o = 0.5 * np.log1p(x / b)
