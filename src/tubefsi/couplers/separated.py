@@ -514,11 +514,13 @@ class SeparatedVariables(Coupler):
         with np.errstate(all="ignore"):
             for _ in range(_START_STEPS):
                 pts = scene.at(ids[act], column=True)
-                ends = scene.at(ids[act])             # the same points, for the slope at v
                 va = v[act]
-                values = self.integrand(pts, va[:, None] * _START_NODES, None if q is None else q_live[act][:, None])
-                estimate = va * (values @ _START_WEIGHTS)
-                slope = self.integrand(ends, va, None if q is None else q_live[act])
+                # the eight nodes and the end v (the slope) in one evaluation: an integrand with
+                # a fixed cost per call (an interpolated flow law) pays it once per step
+                values = self.integrand(pts, va[:, None] * _START_NODES_AND_END,
+                                        None if q is None else q_live[act][:, None])
+                estimate = va * (values[:, :-1] @ _START_WEIGHTS)
+                slope = values[:, -1]
                 nxt = np.clip(va - np.log(estimate / t[act]) * estimate / slope, 0.5 * va, np.minimum(2.0 * va, hi[act]))
                 nxt = np.where(np.isfinite(nxt) & (nxt > 0), nxt, va)
                 v[act] = nxt
@@ -913,6 +915,7 @@ _START_NODES, _START_WEIGHTS = np.polynomial.legendre.leggauss(8)
 #: at most this many Newton steps on the Gauss estimate (a start far out needs 6-8, most 3)
 _START_STEPS = 8
 _START_NODES, _START_WEIGHTS = 0.5 * (_START_NODES + 1.0), 0.5 * _START_WEIGHTS      # on [0, 1]
+_START_NODES_AND_END = np.append(_START_NODES, 1.0)
 #: Tolerance of a curve interpolated between direct solves, in ln v: the direct solves' own
 #: accuracy (the quadrature's 1e-14, a little more near a yield point), not tighter.
 _CURVE_TOL = 1e-13
