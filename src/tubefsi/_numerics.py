@@ -183,7 +183,7 @@ _SUBNORMAL_ULPS = 8 * float(np.finfo(float).smallest_subnormal)
 
 
 def solve_increasing(F, dF, target, *, guess, upper=None, xmax=np.inf, maxiter=200,
-                     rtol=4 * EPS, max_step=np.inf, log=False, evaluated=None):
+                     rtol=4 * EPS, max_step=np.inf, log=False, evaluated=None, quadratic=None):
     r"""Solve ``F(x) = target`` for increasing ``F`` with ``F(0) = 0``, elementwise.
 
     Safeguarded Newton: a bracket ``[lo, hi]`` is kept, Newton steps that leave
@@ -195,7 +195,11 @@ def solve_increasing(F, dF, target, *, guess, upper=None, xmax=np.inf, maxiter=2
 
     Returns ``(x, ok)``; ``ok`` is False where no root exists below ``xmax``. ``evaluated`` (a
     boolean array of the target's size, optional) is set True where the returned ``x`` is the
-    last point ``F`` was evaluated at (its residual met the tolerance there).
+    last point ``F`` was evaluated at (its residual met the tolerance there), or, with
+    ``quadratic`` (a relative step, e.g. 1e-8), where the last Newton step from that point was
+    below ``quadratic`` times ``x``: for a smooth ``F`` Newton's error after such a step is of
+    order its square, so the step is taken as the last one, and the evaluation it came from
+    (an ``x`` that close) stands for the answer's.
     """
     target = np.asarray(target, dtype=float)
     shape = target.shape
@@ -243,8 +247,13 @@ def solve_increasing(F, dF, target, *, guess, upper=None, xmax=np.inf, maxiter=2
         ok[active[stuck]] = False
         met = (np.abs(r) <= 8 * EPS * target[active]) | stay
         x[active] = np.where(met, xa, xn)
+        last = met
+        if quadratic is not None:
+            near = ~bad & ~runaway & (step <= quadratic * np.abs(xn))
+            done |= near
+            last = met | near
         if evaluated is not None:
-            evaluated.ravel()[active] = met
+            evaluated.ravel()[active] = last
         active = active[~(done | stuck)]
     else:
         if active.size:

@@ -447,7 +447,7 @@ class SeparatedVariables(Coupler):
         evaluated = np.zeros(target.size, dtype=bool)
         with quiet():
             v, ok = solve_increasing(F, dF, target, guess=guess, upper=upper, xmax=MAX_LOG_STRETCH, max_step=2.0,
-                                     log=True, evaluated=evaluated)
+                                     log=True, evaluated=evaluated, quadratic=_QUADRATIC_STEP)
         # the answer's own error estimate: where the iteration ended on an evaluation that met its
         # tolerance, that evaluation is the estimate; elsewhere the integral is evaluated once more
         answered = np.flatnonzero(ok.ravel() & (target.ravel() > 0) & ~(evaluated & ~unchecked))
@@ -501,7 +501,8 @@ class SeparatedVariables(Coupler):
         eight-point Gauss–Legendre estimate of :math:`J(v)` over :math:`[0, v]` (eight integrand
         values per point and step, no error estimate; ~1e-10 for smooth integrands over moderate
         strains), its slope the exact :math:`J'(v)`, from the linear guess until a step moves less
-        than 1e-10 (at most ``_START_STEPS``; each step only for the points still moving). Eight
+        than 1e-5 (then, Newton being quadratic, the start is within ~1e-10, the rule's own error;
+        at most ``_START_STEPS``; each step only for the points still moving). Eight
         nodes, not six: at large strain six leave half the points two adaptive passes from the
         root, eight one. Only a start: the error-controlled iteration that follows decides the answer."""
         live = np.flatnonzero((target > 0) & (guess > 0))
@@ -524,8 +525,9 @@ class SeparatedVariables(Coupler):
                 nxt = np.clip(va - np.log(estimate / t[act]) * estimate / slope, 0.5 * va, np.minimum(2.0 * va, hi[act]))
                 nxt = np.where(np.isfinite(nxt) & (nxt > 0), nxt, va)
                 v[act] = nxt
-                # the rule's own error is ~1e-10: closer than that, Newton on the exact J takes over
-                act = act[np.abs(nxt - va) > 1e-10 * va]
+                # Newton converges quadratically: after a step below 1e-5 the error is ~1e-10, the
+                # rule's own; from there Newton on the exact J takes over
+                act = act[np.abs(nxt - va) > 1e-5 * va]
                 if act.size == 0:
                     break
         out = guess.copy()
@@ -916,6 +918,10 @@ _START_NODES, _START_WEIGHTS = np.polynomial.legendre.leggauss(8)
 _START_STEPS = 8
 _START_NODES, _START_WEIGHTS = 0.5 * (_START_NODES + 1.0), 0.5 * _START_WEIGHTS      # on [0, 1]
 _START_NODES_AND_END = np.append(_START_NODES, 1.0)
+#: Newton on ln J stops after a step below this (relative): its error is then ~(step)^2 / 2
+#: relative (ln J ~ ln v near the root's scale), and the evaluation it came from, that close,
+#: is the answer's error estimate (:func:`tubefsi._numerics.solve_increasing`)
+_QUADRATIC_STEP = 1e-8
 #: Tolerance of a curve interpolated between direct solves, in ln v: the direct solves' own
 #: accuracy (the quadrature's 1e-14, a little more near a yield point), not tighter.
 _CURVE_TOL = 1e-13
