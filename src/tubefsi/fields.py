@@ -231,8 +231,10 @@ def _array_fields(cls) -> tuple[str, ...]:
 
 def parameter_shape(model) -> tuple[int, ...]:
     """The broadcast shape of a model's array parameters (``()`` when all are scalars)."""
-    shapes = [np.shape(getattr(model, name)) for name in _array_fields(type(model))]
-    shapes = [s for s in shapes if s != ()]          # scalars (the common case) broadcast with anything
+    # scalars (the common case) broadcast with anything, and a float needs no np.shape
+    shapes = [np.shape(v) for v in (getattr(model, name) for name in _array_fields(type(model)))
+              if type(v) is not float]
+    shapes = [s for s in shapes if s != ()]
     return np.broadcast_shapes(*shapes) if shapes else ()
 
 

@@ -188,7 +188,7 @@ class Scene:
     @property
     def size(self) -> int:
         """The number of points of the scene (1 when all its parameters are scalars)."""
-        return int(np.prod(self.shape, dtype=int))
+        return math.prod(self.shape)           # a tuple of ints: no NumPy call (asked several times a solve)
 
     def flat(self, shape) -> Scene:
         """This scene broadcast to ``shape`` and flattened: every array quantity becomes a 1-D

@@ -73,10 +73,12 @@ class Chebyshev:
         if self._search:
             return np.clip(np.searchsorted(self.breaks, x, side="right") - 1, 0, len(self.breaks) - 2)
         b = ((x - self.lo) * self._bucket_scale).astype(np.intp)
-        np.clip(b, 0, self._buckets - 1, out=b)
+        # (two ufuncs, not np.clip: its Python wrapper costs more than the work at a few points)
+        np.minimum(b, self._buckets - 1, out=b)
+        np.maximum(b, 0, out=b)
         j = self._bucket_panel[b]
         j += x >= self._bucket_break[b]           # the second panel of a bucket that holds two
-        np.clip(j, 0, len(self.breaks) - 2, out=j)
+        np.minimum(j, len(self.breaks) - 2, out=j)
         return j
 
     def __call__(self, x):
