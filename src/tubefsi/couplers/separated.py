@@ -178,7 +178,11 @@ class SeparatedVariables(Coupler):
                 near = np.abs(np.log(scale)) < _LOG_RANGE
                 if reach < _LOG_RANGE and np.all(near):
                     ku = k * u
-                    return slope * (scale * np.exp(ku, out=ku))
+                    if type(ku) is not np.ndarray or ku.shape != np.shape(slope):
+                        return slope * (scale * np.exp(ku))
+                    np.exp(ku, out=ku)               # in place: one array for the product
+                    ku *= scale
+                    return np.multiply(slope, ku, out=ku)
                 # some factor beyond half the exponent range: the power where the exponential
                 # form could leave the doubles, decided node by node (a point's answer must not
                 # depend on the batch it came in); the power raises where psi itself leaves them
