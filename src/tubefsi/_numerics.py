@@ -183,7 +183,7 @@ _SUBNORMAL_ULPS = 8 * float(np.finfo(float).smallest_subnormal)
 
 
 def solve_increasing(F, dF, target, *, guess, upper=None, xmax=np.inf, maxiter=200,
-                     rtol=4 * EPS, max_step=np.inf, log=False, evaluated=None, quadratic=None):
+                     rtol=4 * EPS, max_step=np.inf, log=False, evaluated=None, quadratic=None, pole=None):
     r"""Solve ``F(x) = target`` for increasing ``F`` with ``F(0) = 0``, elementwise.
 
     Safeguarded Newton: a bracket ``[lo, hi]`` is kept, Newton steps that leave
@@ -197,9 +197,11 @@ def solve_increasing(F, dF, target, *, guess, upper=None, xmax=np.inf, maxiter=2
     boolean array of the target's size, optional) is set True where the returned ``x`` is the
     last point ``F`` was evaluated at (its residual met the tolerance there), or, with
     ``quadratic`` (a relative step, e.g. 1e-8), where the last Newton step from that point was
-    below ``quadratic`` times ``x``: for a smooth ``F`` Newton's error after such a step is of
-    order its square, so the step is taken as the last one, and the evaluation it came from
-    (an ``x`` that close) stands for the answer's.
+    below ``quadratic`` times ``x`` and times the distance to ``pole`` (optional, per entry: a
+    singularity of ``F`` above the root, e.g. a locking stretch): Newton's error after a step
+    ``d`` is ``|F''/2F'| d^2``, and ``F''/F'`` is of order ``1/x`` for ``ln J ~ ln x`` and
+    ``1/(pole - x)`` near a pole, so the error is then ~1e-16 relative to both; the step is
+    taken as the last one, and the evaluation it came from (that close) stands for the answer's.
     """
     target = np.asarray(target, dtype=float)
     shape = target.shape
@@ -211,6 +213,7 @@ def solve_increasing(F, dF, target, *, guess, upper=None, xmax=np.inf, maxiter=2
         np.asarray(upper, dtype=float), shape).ravel().copy()
     x = np.clip(x, lo, np.where(np.isfinite(hi), hi, np.inf))
     ok = np.ones(n, dtype=bool)
+    pole_flat = None if pole is None else np.broadcast_to(np.asarray(pole, dtype=float), shape).ravel()
     active = np.flatnonzero(target > 0)
     x[target == 0] = 0.0
     for _ in range(maxiter):
@@ -249,7 +252,8 @@ def solve_increasing(F, dF, target, *, guess, upper=None, xmax=np.inf, maxiter=2
         x[active] = np.where(met, xa, xn)
         last = met
         if quadratic is not None:
-            near = ~bad & ~runaway & (step <= quadratic * np.abs(xn))
+            scale = np.abs(xn) if pole is None else np.minimum(np.abs(xn), pole_flat[active] - xn)
+            near = ~bad & ~runaway & (step <= quadratic * scale)
             done |= near
             last = met | near
         if evaluated is not None:

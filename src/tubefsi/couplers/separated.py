@@ -451,7 +451,8 @@ class SeparatedVariables(Coupler):
         evaluated = np.zeros(target.size, dtype=bool)
         with quiet():
             v, ok = solve_increasing(F, dF, target, guess=guess, upper=upper, xmax=MAX_LOG_STRETCH, max_step=2.0,
-                                     log=True, evaluated=evaluated, quadratic=_QUADRATIC_STEP)
+                                     log=True, evaluated=evaluated, quadratic=_QUADRATIC_STEP,
+                                     pole=np.where(capped, cap, np.inf))
         # the answer's own error estimate: where the iteration ended on an evaluation that met its
         # tolerance, that evaluation is the estimate; elsewhere the integral is evaluated once more
         answered = np.flatnonzero(ok.ravel() & (target.ravel() > 0) & ~(evaluated & ~unchecked))
@@ -922,9 +923,10 @@ _START_NODES, _START_WEIGHTS = np.polynomial.legendre.leggauss(8)
 _START_STEPS = 8
 _START_NODES, _START_WEIGHTS = 0.5 * (_START_NODES + 1.0), 0.5 * _START_WEIGHTS      # on [0, 1]
 _START_NODES_AND_END = np.append(_START_NODES, 1.0)
-#: Newton on ln J stops after a step below this (relative): its error is then ~(step)^2 / 2
-#: relative (ln J ~ ln v near the root's scale), and the evaluation it came from, that close,
-#: is the answer's error estimate (:func:`tubefsi._numerics.solve_increasing`)
+#: Newton on ln J stops after a step below this, relative to v and to the distance to a
+#: maximum stretch: its error is then ~(step)^2 / 2 relative to both (ln J ~ ln v, or
+#: -ln(v_max - v) near a locking stretch), and the evaluation it came from, that close, is the
+#: answer's error estimate (:func:`tubefsi._numerics.solve_increasing`)
 _QUADRATIC_STEP = 1e-8
 #: Tolerance of a curve interpolated between direct solves, in ln v: the direct solves' own
 #: accuracy (the quadrature's 1e-14, a little more near a yield point), not tighter.
