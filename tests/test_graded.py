@@ -329,16 +329,14 @@ def test_graded_beyond_the_limit_is_no_steady_state():
 
 def test_separable_taper_derivatives_and_unsupported_ones():
     """The derivatives of a separable taper are the equivalent uniform tube's (against central
-    differences of solves, 1e-7); a graded tube that does not separate says it has none."""
+    differences of solves, 1e-7); the parameter derivatives and the diagnostics of a graded tube
+    say they have none."""
     tube = tubefsi.Tube(radius=taper(), thickness=lambda z: TB * taper()(z), length=L)
     wall = walls["thick-neo-hookean"](shear_modulus=MU)
     q, h = 1e-7, 1e-5
     sol = tubefsi.solve(power_law(0.6), wall, tube, flow_rate=q)
     plus, minus = (tubefsi.solve(power_law(0.6), wall, tube, flow_rate=q * (1 + s * h)).pressure_drop for s in (1, -1))
     assert sol.dpressure_drop_dflow_rate == pytest.approx((plus - minus) / (2 * q * h), rel=1e-7)
-    graded = tubefsi.solve(power_law(0.6), wall, tubefsi.Tube(radius=taper(), thickness=2e-4, length=L), flow_rate=q)
-    with pytest.raises(tubefsi.InvalidParameterError, match="difference two solves"):
-        graded.dpressure_drop_dflow_rate
     with pytest.raises(tubefsi.InvalidParameterError, match="difference two solves"):
         sol.dpressure_drop_dparameter("rheology.consistency")
     with pytest.raises(tubefsi.InvalidParameterError, match="graded"):
@@ -353,3 +351,74 @@ def test_networks_take_no_graded_tube():
     with pytest.raises(tubefsi.InvalidParameterError, match="varies along z"):
         net.add_tube("a", "b", walls["thick-neo-hookean"](shear_modulus=lambda z: MU),
                      tubefsi.Tube(radius=A0, thickness=2e-4, length=L))
+
+
+# ------------------------------------------------------------------ derivatives of a graded solve
+def _central(f, x, h):
+    """Richardson-extrapolated central difference of ``f`` at ``x`` with steps ``h``, ``h/2`` (error
+    O(h^4) plus rounding ~ 1e-13 |f| / h), and the same at ``2h``, ``h``: their difference bounds
+    the truncation error of the first. ``f`` is called once, with the six abscissae as an array."""
+    steps = np.array([h / 2, h, 2 * h])
+    values = f(np.concatenate([x + steps, x - steps]))
+    c = (values[:3] - values[3:]) / (2 * steps)
+    return (4 * c[0] - c[1]) / 3, (4 * c[1] - c[2]) / 3
+
+
+DERIVATIVE_CASES = {
+    "graded-modulus": (power_law(0.6), _nh(lambda z: MU * (1.0 + 1.5 * z / L)),
+                       tubefsi.Tube(radius=A0, thickness=TB * A0, length=L)),
+    "taper-constant-thickness-carreau": (
+        fluids["carreau"](zero_shear_viscosity=0.05, infinite_shear_viscosity=0.0035, relaxation_time=3.3, index=0.5),
+        _nh(MU), tubefsi.Tube(radius=taper(), thickness=2e-4, length=L)),
+    "linear-graded": (fluids["newtonian"](viscosity=0.05), _linear(lambda z: 3 * MU * np.exp(z / L)),
+                      tubefsi.Tube(radius=A0, thickness=TB * A0, length=L)),
+}
+
+
+@pytest.mark.parametrize("case", sorted(DERIVATIVE_CASES))
+def test_graded_derivatives_match_finite_differences(case):
+    r"""The derivatives of a graded solve that does not separate (the variational equations
+    integrated along z with the pressure) against central differences of flow-controlled solves,
+    Richardson-extrapolated: :math:`d\Delta p/dq` and :math:`\partial\Delta p/\partial p_{out}|_q`,
+    whence :math:`\partial q/\partial p_{in} = 1/(d\Delta p/dq)` and :math:`\partial q/\partial
+    p_{out} = -(1 + \partial\Delta p/\partial p_{out})/(d\Delta p/dq)`; agreement within ten times
+    the difference's own truncation estimate plus 1e-9 (its rounding), at an outlet pressure of
+    200 Pa, and the pressure-controlled solve's derivatives equal the flow-controlled ones."""
+    fluid, wall, tube = DERIVATIVE_CASES[case]
+    q, p_out = 1e-7, 200.0
+    sol = tubefsi.solve(fluid, wall, tube, flow_rate=q, outlet_pressure=p_out)
+    assert sol.coupler_name == "Graded"
+    drop = lambda x, po: tubefsi.solve(fluid, wall, tube, flow_rate=x, outlet_pressure=po).pressure_drop  # noqa: E731
+    dq, dq2 = _central(lambda x: drop(x, p_out), q, 1e-3 * q)
+    assert abs(sol.dpressure_drop_dflow_rate - dq) <= 10 * abs(dq - dq2) + 1e-9 * abs(dq)
+    dpo, dpo2 = _central(lambda x: drop(q, x), p_out, 1e-2 * p_out)
+    expected = -(1 + dpo) / dq
+    bound = 10 * (abs(dpo - dpo2) / abs(1 + dpo) + abs(dq - dq2) / abs(dq)) + 1e-9
+    assert sol.dflow_rate_dinlet_pressure == pytest.approx(1 / dq, rel=10 * abs(dq - dq2) / abs(dq) + 1e-9)
+    assert sol.dflow_rate_doutlet_pressure == pytest.approx(expected, rel=bound)
+    assert sol.dflow_rate_doutlet_pressure < 0 < sol.dflow_rate_dinlet_pressure
+    if case == "linear-graded":        # a pressure-controlled state (the cheapest case)
+        back = tubefsi.solve(fluid, wall, tube, pressure_drop=sol.pressure_drop, outlet_pressure=p_out)
+        assert back.dflow_rate_doutlet_pressure == pytest.approx(sol.dflow_rate_doutlet_pressure, rel=1e-10)
+
+
+def test_graded_derivatives_limits():
+    r"""Two independent references: a constant modulus *function* with a Carreau fluid (never
+    separable: the integration along z) gives the uniform tube's derivatives (the separated
+    engine's :math:`K = \int k\,dz`) to 1e-10; and at q = 0 a Newtonian fluid in a linear taper of
+    constant thickness has :math:`d\Delta p/dq = (8\mu/\pi)\int_0^L a^{-4}dz
+    = 8\mu L(a_0^{-3} - a_1^{-3})/(3\pi(a_1 - a_0))` (the rigid-tube law of the unloaded tube)."""
+    carreau = fluids["carreau"](zero_shear_viscosity=0.05, infinite_shear_viscosity=0.0035, relaxation_time=3.3,
+                                index=0.6)
+    tube = tubefsi.Tube(radius=A0, thickness=TB * A0, length=L)
+    q = np.array([1e-8, 1e-7])
+    uniform = tubefsi.solve(carreau, _nh(MU), tube, flow_rate=q, outlet_pressure=100.0)
+    graded = tubefsi.solve(carreau, _nh(lambda z: MU), tube, flow_rate=q, outlet_pressure=100.0)
+    assert graded.coupler_name == "Graded"
+    for name in ("dpressure_drop_dflow_rate", "dflow_rate_dinlet_pressure", "dflow_rate_doutlet_pressure"):
+        np.testing.assert_allclose(getattr(graded, name), getattr(uniform, name), rtol=1e-10)
+    mu = 0.05
+    rest = tubefsi.solve(fluids["newtonian"](viscosity=mu), _nh(MU), tubefsi.Tube(radius=taper(), thickness=2e-4,
+                                                                                  length=L), flow_rate=0.0)
+    exact = 8 * mu * L * (A0**-3 - A1**-3) / (3 * math.pi * (A1 - A0))
+    assert rest.dpressure_drop_dflow_rate == pytest.approx(exact, rel=1e-11)

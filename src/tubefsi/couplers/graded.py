@@ -242,14 +242,28 @@ class Graded(Coupler):
                                     "implemented (solve raises NoSteadyStateError beyond it)")
 
     def sensitivities(self, scene, state):
-        """The derivatives of a solve: those of the equivalent uniform tube where the scene
+        r"""The derivatives of a solve: those of the equivalent uniform tube where the scene
         separates (its pressure drop is the same function of the flow rate and the end pressures);
-        otherwise not implemented (``InvalidParameterError``: difference two solves)."""
+        otherwise from the variational equations integrated along z with the pressure
+        (:meth:`_integrate`): :math:`d\Delta p/dq = W(0)/q`, :math:`\partial q/\partial p_{in} =
+        q/W(0)`, :math:`\partial q/\partial p_{out} = -V(0)\,q/W(0)`, checked at 100 ``rtol``
+        like the pressure. At ``q = 0`` the limit :math:`q \to 0^+` (an apparent shear rate of
+        1e-30/s at the outlet, as for uniform tubes)."""
         found = self._uniform(scene)
-        if found is None:
-            raise InvalidParameterError("tube", "a uniform tube or a separable taper for the derivatives of a solve",
-                                        scene.tube, "a graded tube that does not separate: difference two solves")
-        return found[1].sensitivities(found[0], state)
+        if found is not None:
+            return found[1].sensitivities(found[0], state)
+        q = np.asarray(state.flow_rate, dtype=float).ravel()
+        index = _points(scene, q.size)
+        L = np.broadcast_to(np.asarray(scene.tube.length, dtype=float), (scene.size,))[index]
+        wall_l, a_l, tb_l = scene.at_position(L, index)
+        p_out = np.broadcast_to(np.asarray(scene.outlet_pressure, dtype=float), (scene.size,))[index]
+        r_out = a_l * (1.0 + wall_l._strain(p_out, tb_l))
+        q_use = np.where(q > 0, q, 0.25e-30 * math.pi * r_out**3)
+        _, w, v = self._integrate(scene, q_use, np.zeros(q.size), self.rtol, variational=True)
+        _, w_c, v_c = self._integrate(scene, q_use, np.zeros(q.size), 100 * self.rtol, variational=True)
+        self._judge(w, w_c, "sensitivity q dp/dq")
+        self._judge(v, v_c, "sensitivity dp_in/dp_out")
+        return w / q_use, q_use / w, -v * q_use / w
 
     def length_integral(self, scene, state, weight, *, uniform=False):
         """Not implemented along a graded tube (the separated identity behind the weighted length
@@ -306,9 +320,25 @@ class Graded(Coupler):
         ``index`` of a flat scene (default: one per point), integrating from the outlet. Where the
         pressure reaches a local limit pressure on the way: ``NoSteadyStateError`` (``strict``) or
         ``inf``."""
+        return self._integrate(scene, q, z_end, rtol, index, strict=strict)[0]
+
+    def _integrate(self, scene, q, z_end, rtol, index=None, *, strict=True, variational=False):
+        r"""The integration along z from the outlet to ``z_end``: the pressure rise (Pa) and, with
+        ``variational``, its sensitivities :math:`W = q\,\partial p/\partial q` (Pa) and
+        :math:`V = \partial p/\partial p_{out}` integrated with it (one error control for the three):
+
+        .. math::
+
+            \frac{dW}{dz} = -kG - cW,\qquad \frac{dV}{dz} = -cV,\qquad W(L) = 0,\ V(L) = 1,
+
+        :math:`k = \partial\ln G/\partial\ln q`, :math:`c = \partial G/\partial p|_z
+        = -(1 + 3k)\,G/(\lambda P_\lambda)` (:math:`\partial\ln G/\partial\ln R = -(1 + 3k)` for every
+        generalized Newtonian fluid: :math:`q = R^3 f(GR/2)`). Returns ``(rise, W, V)`` in the
+        shape of ``q`` (``W, V`` None without ``variational``)."""
         shape = np.shape(q)
         q = np.asarray(q, dtype=float).ravel()
         n = q.size
+        m = 3 if variational else 1
         index = _points(scene, n) if index is None else np.asarray(index, dtype=int).ravel()
         L = np.broadcast_to(np.asarray(scene.tube.length, dtype=float), (scene.size,))[index] if np.ndim(
             scene.tube.length) else np.full(n, float(scene.tube.length))
@@ -316,10 +346,12 @@ class Graded(Coupler):
         rheo = scene.rheology
         p_out = np.broadcast_to(np.asarray(scene.outlet_pressure, dtype=float), (scene.size,))[index] if np.ndim(
             scene.outlet_pressure) else np.full(n, float(scene.outlet_pressure))
-        out = np.zeros(n)
+        out = np.zeros((m, n))
+        if variational:
+            out[2] = 1.0
         live = np.flatnonzero((q > 0) & (z_end < L))
         if live.size == 0:
-            return out.reshape(shape)
+            return _unpack(out, shape, variational)
         idx = index[live]
         # the scale of the pressure: the rigid-tube drop at the outlet radius
         wall_l, a_l, tb_l = scene.at_position(L[live], idx)
@@ -332,19 +364,30 @@ class Graded(Coupler):
             """dy/dz at (zs, ys) for the live entries ``sel`` (NaN beyond the local tube law)."""
             pts = idx[sel]
             wall, a, tb = scene.at_position(zs, pts)
-            p = p_out[live][sel] + ys * scale[sel]
+            p = p_out[live][sel] + ys[0] * scale[sel]
             lim = np.asarray(wall._limit_pressure(tb), dtype=float) + 0.0 * p
             low = np.asarray(wall._min_pressure(tb), dtype=float) + 0.0 * p
             bad = ~((p < lim) & (p >= low)) | ~np.isfinite(p)
+            fluid = model_at(rheo, pts)
             with np.errstate(all="ignore"):
                 e = wall._strain(np.where(bad, p_out[live][sel], p), tb)
-                g = model_at(rheo, pts)._pressure_gradient(q[live][sel], a * (1.0 + e))
-            return np.where(bad | ~np.isfinite(g) | (e > STRETCH_CAP - 1.0), np.nan, -g / scale[sel])
+                g = fluid._pressure_gradient(q[live][sel], a * (1.0 + e))
+                bad = bad | ~np.isfinite(g) | (e > STRETCH_CAP - 1.0)
+                dy = np.empty((m, sel.size))
+                dy[0] = -g / scale[sel]
+                if variational:
+                    k = fluid._flow_index(q[live][sel], a * (1.0 + e))
+                    c = -(1.0 + 3.0 * k) * g / ((1.0 + e) * wall._stiffness(1.0 + e, tb))
+                    dy[1] = -k * g / scale[sel] - c * ys[1]
+                    dy[2] = -c * ys[2]
+            return np.where(bad, np.nan, dy)
 
         stages = _dop.N_STAGES
         A, B, C, E3, E5 = _dop.A[:stages, :stages], _dop.B, _dop.C[:stages], _dop.E3, _dop.E5
         z = L[live].copy()
-        y = np.zeros(live.size)
+        y = np.zeros((m, live.size))
+        if variational:
+            y[2] = 1.0
         span = z - z_end[live]
         h = -np.minimum(span, span * rtol ** 0.125 * 4)
         f = rhs(z, y, np.arange(live.size))
@@ -354,35 +397,35 @@ class Graded(Coupler):
             sel = np.flatnonzero(active)
             if sel.size == 0:
                 break
-            zs, ys, hs = z[sel], y[sel], h[sel]
+            zs, ys, hs = z[sel], y[:, sel], h[sel]
             target = z_end[live][sel]
             if breaks.size:          # the next breakpoint below z (strictly), else the end
                 j = np.searchsorted(breaks, zs, side="left") - 1
                 nxt = np.where(j >= 0, breaks[np.maximum(j, 0)], -np.inf)
                 target = np.maximum(target, nxt)
             hs = np.maximum(hs, target - zs)              # h < 0: not beyond the stop
-            K = np.empty((stages + 1, sel.size))
-            K[0] = f[sel]
+            K = np.empty((stages + 1, m, sel.size))
+            K[0] = f[:, sel]
             for s in range(1, stages):
-                dy = (K[:s].T @ A[s, :s]) * hs
-                K[s] = rhs(zs + C[s] * hs, ys + dy, sel)
-            y_new = ys + hs * (K[:-1].T @ B)
+                K[s] = rhs(zs + C[s] * hs, ys + np.einsum("s,smn->mn", A[s, :s], K[:s]) * hs, sel)
+            y_new = ys + hs * np.einsum("s,smn->mn", B, K[:-1])
             land = np.abs(target - (zs + hs)) <= 1e-15 * np.abs(zs) + 1e-300
             z_new = np.where(land, target, zs + hs)
             K[-1] = rhs(z_new, y_new, sel)
             sc = atol + rtol * np.maximum(np.abs(ys), np.abs(y_new))
             with np.errstate(all="ignore"):
-                e5 = (K.T @ E5) / sc
-                e3 = (K.T @ E3) / sc
+                e5 = np.einsum("s,smn->mn", E5, K) / sc
+                e3 = np.einsum("s,smn->mn", E3, K) / sc
                 denom = np.sqrt(e5**2 + 0.01 * e3**2)
-                err = np.abs(hs) * np.where(denom > 0, e5**2 / denom, 0.0)
-            broken = ~(np.isfinite(err) & np.isfinite(y_new) & np.all(np.isfinite(K), axis=0))   # beyond the law
+                err = np.abs(hs) * np.max(np.where(denom > 0, e5**2 / denom, 0.0), axis=0)
+            broken = ~(np.isfinite(err) & np.all(np.isfinite(y_new), axis=0)
+                       & np.all(np.isfinite(K), axis=(0, 1)))   # beyond the law
             good = ~broken & (err <= 1.0)
             with np.errstate(all="ignore", divide="ignore"):
                 factor = np.where(np.isfinite(err) & (err > 0), 0.9 * err ** -0.125, 10.0)
             factor = np.where(good, np.clip(factor, 1.0, 10.0), np.where(broken, 0.1, np.clip(factor, 0.2, 0.9)))
             acc = sel[good]
-            z[acc], y[acc], f[acc] = z_new[good], y_new[good], K[-1][good]
+            z[acc], y[:, acc], f[:, acc] = z_new[good], y_new[:, good], K[-1][:, good]
             h[sel] = hs * factor
             done = good & (z_new <= z_end[live][sel])
             active[sel[done]] = False
@@ -402,11 +445,12 @@ class Graded(Coupler):
             if not math.isfinite(limit):
                 raise StretchRangeError(math.nan, float(q[live][i]), where.replace("the pressure reaches the local "
                                         "limit of the tube law", "the tube inflates beyond").split(":")[0])
-            raise NoSteadyStateError("pressure", limit, float(p_out[live][i] + y[i] * scale[i]), where,
+            raise NoSteadyStateError("pressure", limit, float(p_out[live][i] + y[0, i] * scale[i]), where,
                                      name="the (transmural) pressure")
         y = np.where(stopped, np.inf, y)
-        out[live] = y * scale
-        return out.reshape(shape)
+        out[:, live] = y
+        out[:2, live] *= scale
+        return _unpack(out, shape, variational)
 
     def _flow_rate(self, scene, dp):
         r"""The flow rates with pressure drop ``dp`` (per point): bracketed root finding on
@@ -463,6 +507,13 @@ class Graded(Coupler):
         miss_coarse = f(x, ids, log_dp, 100 * self.rtol) - f(x, ids, log_dp, self.rtol)
         q[live] = np.exp(x)
         return q, np.max(np.abs(miss_coarse / slope), initial=0.0)
+
+
+def _unpack(out, shape, variational):
+    """``(rise, W, V)`` from the integration's rows, in ``shape`` (``W, V`` None unless variational)."""
+    if not variational:
+        return out[0].reshape(shape), None, None
+    return tuple(row.reshape(shape) for row in out)
 
 
 def _uniform_coupler(choice, scene):
