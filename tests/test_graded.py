@@ -319,11 +319,12 @@ def test_other_typed_errors():
 
 
 def test_graded_beyond_the_limit_is_no_steady_state():
-    """A graded shear-thinning flow above what the tube carries: NoSteadyStateError naming the
-    local limit pressure, from the integration along z."""
+    """A graded shear-thinning flow above what the tube carries: the integration along z fails, and
+    the NoSteadyStateError gives the maximum flow rate (that of
+    ``test_graded_max_flow_rate_at_the_inlet``, 9.0909716e-6 m^3/s)."""
     wall = walls["thick-neo-hookean"](shear_modulus=lambda z: MU * (1 + z / L))
     tube = tubefsi.Tube(radius=A0, thickness=TB * A0, length=L)
-    with pytest.raises(tubefsi.NoSteadyStateError, match="local limit"):
+    with pytest.raises(tubefsi.NoSteadyStateError, match="maximum flow rate 9.09097"):
         tubefsi.solve(power_law(0.5), wall, tube, flow_rate=1e-5)
 
 
@@ -422,3 +423,67 @@ def test_graded_derivatives_limits():
                                                                                   length=L), flow_rate=0.0)
     exact = 8 * mu * L * (A0**-3 - A1**-3) / (3 * math.pi * (A1 - A0))
     assert rest.dpressure_drop_dflow_rate == pytest.approx(exact, rel=1e-11)
+
+
+# ------------------------------------------------------------------ the maximum flow rate of a graded tube
+def _thick_nh_float(mu, tb, lam):
+    """The thick neo-Hookean tube law (as :func:`thick_nh`) in floats."""
+    lo2 = 1 + (lam**2 - 1) / (1 + tb) ** 2
+    return mu * (math.log(lam) - 0.5 * math.log(lo2) - 1 / (2 * lam**2) + 1 / (2 * lo2))
+
+
+def _touch_reference(mu_of, n, m, q0, q1, a=A0, tb=TB, length=L):
+    r"""The flow rate at which the pressure of a power-law fluid in a uniform thick neo-Hookean tube
+    with a modulus :math:`\mu(z)` reaches the inlet's limit pressure :math:`\mu(0)\ln(1 + \bar t)`:
+    SciPy's DOP853 (``solve_ivp``, rtol 1e-13) of :math:`dp/dz = -\phi(q)(a\lambda)^{-k}`, the
+    stretch by ``brentq`` on the closed-form law, and secant steps on the inlet's margin
+    :math:`p_{lim}(0) - p(0; q)` from below (it is linear in q there: the limit pressure rises
+    along z), extrapolated to zero from a margin below 2e-7 Pa."""
+    from scipy.integrate import solve_ivp
+    from scipy.optimize import brentq
+
+    def stretch(p, mu):
+        if p <= 0:
+            return 1.0
+        hi = 1.0
+        while _thick_nh_float(mu, tb, math.exp(hi)) < p:
+            hi *= 2
+        return math.exp(brentq(lambda x: _thick_nh_float(mu, tb, math.exp(x)) - p, 0.0, hi, xtol=1e-16, rtol=1e-15))
+
+    def margin(q):
+        k, phi = 3 * n + 1, 2 * m * ((3 * n + 1) * q / (math.pi * n)) ** n
+        sol = solve_ivp(lambda z, y: [-phi * (a * stretch(y[0], mu_of(z))) ** -k], (length, 0.0), [0.0],
+                        method="DOP853", rtol=1e-13, atol=1e-10)
+        return mu_of(0.0) * math.log(1 + tb) - sol.y[0, -1]
+
+    f0, f1 = margin(q0), margin(q1)
+    for _ in range(40):
+        q2 = q1 - f1 * (q1 - q0) / (f1 - f0)
+        if abs(f1) < 2e-7:
+            return q2
+        q2 = q1 + 0.9 * (q2 - q1)          # stay below the limit
+        q0, f0, q1, f1 = q1, f1, q2, margin(q2)
+    raise AssertionError("the reference did not converge")
+
+
+def test_graded_max_flow_rate_at_the_inlet():
+    r"""A modulus rising along the tube, :math:`\mu = \mu_0(1 + z/L)`, with a shear-thinning fluid
+    (n = 0.5): the pressure first reaches the local limit at the inlet; the maximum flow rate
+    against the independent DOP853/brentq reference (1e-11; measured 4e-13); below it a solve
+    works and ``on_infeasible="nan"`` masks only the point beyond."""
+    mu_of = lambda z: MU * (1 + z / L)   # noqa: E731
+    fluid, wall = power_law(0.5), _nh(mu_of)
+    tube = tubefsi.Tube(radius=A0, thickness=TB * A0, length=L)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", tubefsi.AccuracyWarning)
+        q_max = tubefsi.max_flow_rate(fluid, wall, tube)
+    ref = _touch_reference(mu_of, 0.5, 0.5, 0.99 * q_max, 0.995 * q_max)
+    assert q_max == pytest.approx(ref, rel=1e-11)
+    loose = tubefsi.couplers.Graded(rtol=1e-10, check_threshold=1e-6)     # the masking only (cheaper)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", tubefsi.ModelValidityWarning)     # R_in/L > 0.1 near the limit
+        sol = tubefsi.solve(fluid, wall, tube, flow_rate=np.array([0.999 * q_max, 1.001 * q_max]),
+                            on_infeasible="nan", coupler=loose)
+    assert list(sol.feasible) == [True, False]
+    assert math.isfinite(sol.pressure_drop[0]) and math.isnan(sol.pressure_drop[1])
+    assert sol.pressure_drop[0] < MU * math.log(1 + TB)

@@ -64,6 +64,14 @@ _CONSTANT = 1e-14
 STRETCH_CAP = 1e3
 #: Steps (rounds over all points) before the integration gives up.
 _MAX_ROUNDS = 20_000
+#: A pressure this close (relative) to the local limit pressure short of the end of an integration
+#: stops it as beyond the steady state (the tube law's stretch there is near 1e2.5 for a limit
+#: approached as lambda^-4; the maximum flow rate extrapolates from there).
+_NEAR_LIMIT = 1e-10
+#: Newton steps (each one integration) of the maximum flow rate per candidate touch position.
+_TOUCH_ROUNDS = 60
+#: The estimated relative error of the maximum flow rate at which its Newton iteration stops.
+_TOUCH_TOL = 1e-13
 
 
 def _profiles(model):
@@ -223,23 +231,171 @@ class Graded(Coupler):
         return self._state(scene, q, dp)
 
     def max_flow_rate(self, scene, *, strict=True):
-        """The maximum flow rate: the equivalent uniform tube's where separable; ``inf`` where no
-        section has a limit pressure. Otherwise ``strict`` raises ``InvalidParameterError`` (not
-        implemented) and ``strict=False`` gives ``inf`` (what :func:`tubefsi.solve` asks: its
-        integration raises ``NoSteadyStateError`` where the pressure reaches a local limit)."""
+        r"""The maximum flow rate (m^3/s): the equivalent uniform tube's where separable; otherwise
+        the flow rate at which the pressure first touches the local limit pressure somewhere
+        (:meth:`touch`; ``inf`` where no section has one, or where the limit pressure never falls
+        toward the inlet). ``strict`` is accepted for the solve's call and changes nothing."""
         q_max = self._on_uniform(scene, "max_flow_rate")
         if q_max is not None:
             return q_max
+        q, _ = self.touch(scene)
+        return float(q[0]) if scene.size == 1 else q
+
+    def touch(self, scene):
+        r"""``(q_max, z_touch)`` per point of a flat scene: the largest flow rate with a steady
+        state and where its pressure reaches the local limit pressure :math:`p_{lim}(z)`
+        (``docs/graded.md``, "The maximum flow rate").
+
+        At the touch :math:`\lambda \to \infty`, so :math:`G = 0` there and the margin
+        :math:`\varepsilon = p_{lim} - p` (:math:`\varepsilon' = p_{lim}' + G`) has a minimum 0:
+        the touch is at the inlet if :math:`p_{lim}' \ge 0` there, or at an interior local minimum
+        of :math:`p_{lim}` (a breakpoint, or a smooth minimum located by golden sections to 1e-10
+        of the length). For each candidate :math:`z_c` the flow rate with
+        :math:`p(z_c) = p_{lim}(z_c)` is found by safeguarded Newton steps on
+        :math:`\ln(p(z_c) - p_{out})` against :math:`\ln q`, the slope :math:`W/(p - p_{out})` from
+        the variational equations, from the feasible side (a bracket where a trial is beyond a
+        limit); :math:`q_{max}` is the smallest. The answer is the Newton extrapolation from the last
+        feasible iterate; its error, estimated from the step and the change of the slope, is stated
+        by an :class:`~tubefsi.AccuracyWarning` above ``check_threshold`` (a touch where
+        :math:`p_{lim}' = 0` — a smooth minimum, a uniform inlet section — makes the margin vanish
+        faster than linearly in :math:`q`: ill-conditioned)."""
         n = scene.size
-        z = np.linspace(0.0, 1.0, 65)[:, None] * np.broadcast_to(np.asarray(scene.tube.length, dtype=float), (n,))
-        wall, _, tb = scene.at_position(z.ravel(), np.tile(np.arange(n), 65))
-        limited = np.isfinite(np.asarray(wall._limit_pressure(tb), dtype=float) + np.zeros(65 * n))
-        if not np.any(limited) or not strict:
-            return math.inf if n == 1 else np.full(n, np.inf)
-        raise InvalidParameterError("tube", "a tube law without a limit pressure, or a separable taper, for "
-                                    "max_flow_rate", scene.tube,
-                                    "the maximum flow rate of a graded tube whose wall has a limit pressure is not "
-                                    "implemented (solve raises NoSteadyStateError beyond it)")
+        L = np.broadcast_to(np.asarray(scene.tube.length, dtype=float), (n,))
+        p_out = np.broadcast_to(np.asarray(scene.outlet_pressure, dtype=float), (n,))
+        zc, pts = self._touch_candidates(scene, L)
+        q_max, z_touch = np.full(n, np.inf), np.full(n, np.nan)
+        if zc.size == 0:
+            return q_max, z_touch
+        wall, _, tb = scene.at_position(zc, pts)
+        target = np.asarray(wall._limit_pressure(tb), dtype=float) + 0.0 * zc - p_out[pts]
+        q_c, err = np.zeros(zc.size), np.zeros(zc.size)
+        room = target > 0
+        if np.any(room):
+            q_c[room], err[room] = self._touch_flow_rate(scene, zc[room], pts[room], target[room], L[pts[room]])
+        for i in range(zc.size):          # the smallest per point (a few candidates each)
+            if q_c[i] < q_max[pts[i]]:
+                q_max[pts[i]], z_touch[pts[i]] = q_c[i], zc[i]
+        chosen = np.isin(zc, z_touch) & (q_c == q_max[pts])
+        self._judge_error(float(np.max(err[chosen], initial=0.0)), "maximum flow rate")
+        return q_max, z_touch
+
+    def _touch_candidates(self, scene, L):
+        """``(z, point)`` of the candidate touch positions: the inlet where the limit pressure does
+        not fall along z there, and the interior local minima of the limit pressure (on 257
+        positions and the breakpoints; smooth minima refined by golden sections)."""
+        n = scene.size
+        breaks = _breakpoints(scene)
+        grid = np.linspace(0.0, 1.0, 257)[:, None] * L
+        inner = np.broadcast_to(breaks[:, None], (breaks.size, n))
+        inner = np.where((inner > 0) & (inner < L), inner, L)          # outside: a duplicate of L
+        z = np.concatenate([grid, inner])
+        kink = np.concatenate([np.isin(grid, breaks), np.ones(inner.shape, bool)])
+        order = np.argsort(z, axis=0, kind="stable")
+        z, kink = np.take_along_axis(z, order, 0), np.take_along_axis(kink, order, 0)
+        lim = self._limit_along(scene, z)
+        if not np.any(np.isfinite(lim)):
+            return np.zeros(0), np.zeros(0, dtype=int)
+        with np.errstate(invalid="ignore"):
+            first = np.isfinite(lim[0]) & (lim[0] <= lim[1])
+            local = np.isfinite(lim[1:-1]) & (lim[1:-1] < lim[:-2]) & (lim[1:-1] <= lim[2:])
+        rows, cols = np.nonzero(local)
+        rows = rows + 1
+        smooth = ~kink[rows, cols]
+        zc = z[rows, cols].copy()
+        if np.any(smooth):
+            lo, hi = z[rows[smooth] - 1, cols[smooth]], z[rows[smooth] + 1, cols[smooth]]
+            zc[smooth] = self._golden(scene, lo, hi, cols[smooth])
+        zc = np.concatenate([np.zeros(int(np.sum(first))), zc])
+        pts = np.concatenate([np.flatnonzero(first), cols])
+        return zc, pts
+
+    def _limit_along(self, scene, z):
+        """The local limit pressure at the positions ``z`` (shape (m, n): n points)."""
+        m, n = z.shape
+        wall, _, tb = scene.at_position(z.ravel(), np.tile(np.arange(n), m))
+        return (np.asarray(wall._limit_pressure(tb), dtype=float) + 0.0 * z.ravel()).reshape(m, n)
+
+    def _golden(self, scene, lo, hi, pts):
+        """The minimum of the limit pressure in ``[lo, hi]`` by golden sections, to 1e-10 of the span."""
+        r = (math.sqrt(5.0) - 1.0) / 2.0
+        a, b = lo.copy(), hi.copy()
+        c, d = b - r * (b - a), a + r * (b - a)
+
+        def lim(z):
+            wall, _, tb = scene.at_position(z, pts)
+            return np.asarray(wall._limit_pressure(tb), dtype=float) + 0.0 * z
+
+        fc, fd = lim(c), lim(d)
+        for _ in range(math.ceil(math.log(1e-10) / math.log(r))):
+            left = fc <= fd
+            b, a = np.where(left, d, b), np.where(left, a, c)
+            d, fd = np.where(left, c, d), np.where(left, fc, fd)
+            c, fc = np.where(left, b - r * (b - a), c), np.where(left, 0.0, fc)
+            d = np.where(left, d, a + r * (b - a))
+            fc, fd = np.where(left, lim(c), fc), np.where(left, fd, lim(d))
+        return 0.5 * (a + b)
+
+    def _touch_flow_rate(self, scene, zc, pts, target, L):
+        r"""The flow rates with :math:`p(z_c) - p_{out} =` ``target`` (the local limit) and the
+        estimated relative errors: safeguarded Newton on :math:`f(x) = \ln(p(z_c) - p_{out}) -
+        \ln(\text{target})`, :math:`x = \ln q`, :math:`f' = W/(p - p_{out})`, integrated at
+        ``rtol``/10; the integration's share of the error from the difference of :math:`f` at
+        10 ``rtol``."""
+        rheo = scene.rheology
+        _, a, _ = scene.at_position(zc, pts)
+        # start: the rigid tube of the section's radius under the mean gradient
+        x = np.log(model_at(rheo, pts)._flow_rate(a, target / (L - zc)))
+        x_hi = np.full(zc.size, np.inf)
+        rtol = max(1e-15, 0.1 * self.rtol)     # the slope d ln p/d ln q < 1 amplifies the pressure's error
+        x, x_hi, f, d, err = self._touch_newton(scene, zc, pts, target, x, x_hi, rtol)
+        root = x - f / d
+        rise = self._integrate(scene, np.exp(x), zc, 100 * rtol, index=pts, strict=False)[0]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            err = err + np.abs((np.log(rise) - np.log(target) - f) / d)
+        return np.exp(root), np.where(np.isfinite(err), err, np.inf)
+
+    def _touch_newton(self, scene, zc, pts, target, x, x_hi, rtol):
+        """Safeguarded Newton steps (see :meth:`_touch_flow_rate`) at the integration tolerance
+        ``rtol``: ``(x_lo, x_hi, f, f', error)``, ``x_lo`` the last feasible iterate."""
+        m = zc.size
+        x = x.copy()
+        x_lo, f_lo, d_lo = np.full(m, -np.inf), np.zeros(m), np.ones(m)
+        d_prev, x_prev = np.full(m, np.nan), np.full(m, np.nan)
+        err = np.full(m, np.inf)
+        active = np.ones(m, dtype=bool)
+        for _ in range(_TOUCH_ROUNDS):
+            sel = np.flatnonzero(active)
+            if sel.size == 0:
+                break
+            rise, w, _ = self._integrate(scene, np.exp(x[sel]), zc[sel], rtol, index=pts[sel], strict=False,
+                                         variational=True, control=1)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                ok = np.isfinite(rise) & (rise < target[sel]) & (w > 0)
+                f = np.log(rise) - np.log(target[sel])
+                d = w / rise
+            good, bad = sel[ok], sel[~ok]
+            x_hi[bad] = np.minimum(x_hi[bad], x[bad])
+            x_prev[good], d_prev[good] = x_lo[good], d_lo[good]
+            x_lo[good], f_lo[good], d_lo[good] = x[good], f[ok], d[ok]
+            step = -f_lo[sel] / d_lo[sel]
+            known = np.isfinite(x_lo[sel])
+            # the error of the Newton extrapolation: |step| times the relative change of the slope
+            with np.errstate(divide="ignore", invalid="ignore"):
+                curvature = np.abs((d_lo[sel] - d_prev[sel]) / (x_lo[sel] - x_prev[sel])) / d_lo[sel]
+                e = np.where(np.isfinite(curvature) & np.isfinite(x_prev[sel]), 0.5 * curvature * step**2,
+                             np.abs(step))
+            err[sel] = np.where(known, e, np.inf)
+            trial = np.where(known, x_lo[sel] + step, x[sel] - 2.0)
+            beyond = trial >= x_hi[sel]
+            trial = np.where(beyond & known, 0.5 * (x_lo[sel] + x_hi[sel]), trial)
+            done = known & ((err[sel] <= _TOUCH_TOL) | (x_hi[sel] - x_lo[sel] <= 1e-15))
+            x[sel] = trial
+            active[sel[done]] = False
+        if not np.all(np.isfinite(x_lo)):
+            raise ConvergenceError("the maximum flow rate of a graded tube: no flow rate below the limit was found")
+        step = -f_lo / d_lo
+        err = np.where(active, np.maximum(err, np.minimum(np.abs(step), x_hi - x_lo)), err)
+        return x_lo, x_hi, f_lo, d_lo, err
 
     def sensitivities(self, scene, state):
         r"""The derivatives of a solve: those of the equivalent uniform tube where the scene
@@ -322,7 +478,7 @@ class Graded(Coupler):
         ``inf``."""
         return self._integrate(scene, q, z_end, rtol, index, strict=strict)[0]
 
-    def _integrate(self, scene, q, z_end, rtol, index=None, *, strict=True, variational=False):
+    def _integrate(self, scene, q, z_end, rtol, index=None, *, strict=True, variational=False, control=None):
         r"""The integration along z from the outlet to ``z_end``: the pressure rise (Pa) and, with
         ``variational``, its sensitivities :math:`W = q\,\partial p/\partial q` (Pa) and
         :math:`V = \partial p/\partial p_{out}` integrated with it (one error control for the three):
@@ -334,7 +490,8 @@ class Graded(Coupler):
         :math:`k = \partial\ln G/\partial\ln q`, :math:`c = \partial G/\partial p|_z
         = -(1 + 3k)\,G/(\lambda P_\lambda)` (:math:`\partial\ln G/\partial\ln R = -(1 + 3k)` for every
         generalized Newtonian fluid: :math:`q = R^3 f(GR/2)`). Returns ``(rise, W, V)`` in the
-        shape of ``q`` (``W, V`` None without ``variational``)."""
+        shape of ``q`` (``W, V`` None without ``variational``). ``control``: the rows whose error
+        the step control bounds (default all; ``1``: the pressure only, for a Newton slope)."""
         shape = np.shape(q)
         q = np.asarray(q, dtype=float).ravel()
         n = q.size
@@ -417,7 +574,7 @@ class Graded(Coupler):
                 e5 = np.einsum("s,smn->mn", E5, K) / sc
                 e3 = np.einsum("s,smn->mn", E3, K) / sc
                 denom = np.sqrt(e5**2 + 0.01 * e3**2)
-                err = np.abs(hs) * np.max(np.where(denom > 0, e5**2 / denom, 0.0), axis=0)
+                err = np.abs(hs) * np.max(np.where(denom > 0, e5**2 / denom, 0.0)[:control], axis=0)
             broken = ~(np.isfinite(err) & np.all(np.isfinite(y_new), axis=0)
                        & np.all(np.isfinite(K), axis=(0, 1)))   # beyond the law
             good = ~broken & (err <= 1.0)
@@ -426,6 +583,14 @@ class Graded(Coupler):
             factor = np.where(good, np.clip(factor, 1.0, 10.0), np.where(broken, 0.1, np.clip(factor, 0.2, 0.9)))
             acc = sel[good]
             z[acc], y[:, acc], f[:, acc] = z_new[good], y_new[:, good], K[-1][:, good]
+            if acc.size:              # within 1e-10 of a local limit pressure short of the end: stop
+                wall, _, tb = scene.at_position(z[acc], idx[acc])
+                lim = np.asarray(wall._limit_pressure(tb), dtype=float) + 0.0 * z[acc]
+                p = p_out[live][acc] + y[0, acc] * scale[acc]
+                with np.errstate(invalid="ignore"):
+                    near = np.isfinite(lim) & (p >= lim - _NEAR_LIMIT * np.abs(lim)) & (z[acc] > z_end[live][acc])
+                stopped[acc[near]] = True
+                active[acc[near]] = False
             h[sel] = hs * factor
             done = good & (z_new <= z_end[live][sel])
             active[sel[done]] = False
