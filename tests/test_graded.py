@@ -23,6 +23,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import tubefsi
+from tubefsi.couplers import Graded
 
 walls = tubefsi.registry.walls
 fluids = tubefsi.registry.rheologies
@@ -325,7 +326,7 @@ def test_graded_beyond_the_limit_is_no_steady_state():
     wall = walls["thick-neo-hookean"](shear_modulus=lambda z: MU * (1 + z / L))
     tube = tubefsi.Tube(radius=A0, thickness=TB * A0, length=L)
     with pytest.raises(tubefsi.NoSteadyStateError, match="maximum flow rate 9.09097"):
-        tubefsi.solve(power_law(0.5), wall, tube, flow_rate=1e-5)
+        tubefsi.solve(power_law(0.5), wall, tube, flow_rate=1e-5, coupler=Graded(rtol=1e-10, check_threshold=1e-6))
 
 
 def test_separable_taper_derivatives_and_unsupported_ones():
@@ -479,7 +480,7 @@ def test_graded_max_flow_rate_at_the_inlet():
         q_max = tubefsi.max_flow_rate(fluid, wall, tube)
     ref = _touch_reference(mu_of, 0.5, 0.5, 0.99 * q_max, 0.995 * q_max)
     assert q_max == pytest.approx(ref, rel=1e-11)
-    loose = tubefsi.couplers.Graded(rtol=1e-10, check_threshold=1e-6)     # the masking only (cheaper)
+    loose = Graded(rtol=1e-10, check_threshold=1e-6)     # the masking only (cheaper)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", tubefsi.ModelValidityWarning)     # R_in/L > 0.1 near the limit
         sol = tubefsi.solve(fluid, wall, tube, flow_rate=np.array([0.999 * q_max, 1.001 * q_max]),
@@ -487,3 +488,22 @@ def test_graded_max_flow_rate_at_the_inlet():
     assert list(sol.feasible) == [True, False]
     assert math.isfinite(sol.pressure_drop[0]) and math.isnan(sol.pressure_drop[1])
     assert sol.pressure_drop[0] < MU * math.log(1 + TB)
+
+
+def test_graded_pressure_beyond_a_soft_section_is_no_steady_state():
+    r"""A sampled modulus dipping to half at mid-tube (a breakpoint): the pressure first touches the
+    local limit there, so the largest inlet pressure with a steady state is that of the maximum
+    flow rate, below the inlet section's limit :math:`\mu_0\ln(1 + \bar t)`; a pressure drop beyond
+    it is a ``NoSteadyStateError`` giving that pressure (not the flow rate at the edge, which the
+    bracketing alone would return), bounded by the inlet pressures of the flows just below and at
+    the maximum."""
+    wall = _nh(tubefsi.sampled([0, L / 2, L], [MU, 0.5 * MU, MU], kind="linear"))
+    tube = tubefsi.Tube(radius=A0, thickness=TB * A0, length=L)
+    loose = Graded(rtol=1e-10, check_threshold=1e-6)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", tubefsi.ModelValidityWarning)
+        with pytest.raises(tubefsi.NoSteadyStateError) as info:
+            tubefsi.solve(power_law(0.5), wall, tube, pressure_drop=1.1 * MU * math.log(1 + TB) * 0.8, coupler=loose)
+        below = tubefsi.solve(power_law(0.5), wall, tube, flow_rate=0.99 * 9.0909715833e-6, coupler=loose)
+    limit = info.value.limit
+    assert below.inlet_pressure < limit < 0.8 * MU * math.log(1 + TB)

@@ -428,9 +428,25 @@ class Graded(Coupler):
                                     "a graded tube: difference two solves")
 
     def limit_pressure(self, scene):
-        """The limit pressure of the inlet section (a necessary bound on the inlet pressure)."""
-        wall, _, tb = scene.at_position(np.zeros(scene.size), np.arange(scene.size))
-        return wall._limit_pressure(tb)
+        """The largest inlet pressure with a steady state: the inlet section's limit pressure where
+        the pressure can only touch its local limit at the inlet (or nowhere); where it can touch
+        it downstream first (a softer section: :meth:`touch`), the inlet pressure just below the
+        maximum flow rate (1e-9 below it)."""
+        n = scene.size
+        wall, _, tb = scene.at_position(np.zeros(n), np.arange(n))
+        inlet = wall._limit_pressure(tb)
+        L = np.broadcast_to(np.asarray(scene.tube.length, dtype=float), (n,))
+        if self._uniform(scene) is not None or not np.any(self._touch_candidates(scene, L)[0] > 0):
+            return inlet
+        out = np.asarray(inlet, dtype=float) + np.zeros(n)
+        q_max, z_touch = self.touch(scene)
+        inside = np.flatnonzero(np.isfinite(q_max) & (z_touch > 0))
+        if inside.size:
+            p_out = np.broadcast_to(np.asarray(scene.outlet_pressure, dtype=float), (n,))[inside]
+            rise = self.rise(scene, q_max[inside] * (1.0 - 1e-9), np.zeros(inside.size), self.rtol, index=inside,
+                             strict=False)
+            out[inside] = np.minimum(out[inside], np.where(np.isfinite(rise), p_out + rise, out[inside]))
+        return out
 
     def profile(self, scene, state, z):
         z = np.asarray(z, dtype=float)
@@ -620,8 +636,9 @@ class Graded(Coupler):
     def _flow_rate(self, scene, dp):
         r"""The flow rates with pressure drop ``dp`` (per point): bracketed root finding on
         :math:`\ln\Delta p(\ln q)` with a loose integration (1e-9), then Newton steps with the
-        integration at ``rtol`` (the slope differenced from the loose one); the flow rate's error
-        is estimated from the pressure drop at 100 ``rtol`` over that slope."""
+        integration at ``rtol`` (the slope from the variational equations); the flow rate's error
+        is estimated from the pressure drop at 100 ``rtol`` over that slope. A drop whose residual
+        stays above 1e-9 there is beyond every steady state (``NoSteadyStateError``)."""
         n = dp.size
         q = np.zeros(n)
         live = np.flatnonzero(dp > 0)
@@ -659,16 +676,29 @@ class Graded(Coupler):
         res = elementwise.find_root(f, br.bracket, args=(ids, log_dp), tolerances=dict(xrtol=1e-11, xatol=1e-11))
         if not np.all(res.success):
             raise ConvergenceError("the flow rate of a graded tube under a pressure drop did not converge")
-        x = res.x
-        step = 1e-4
-        slope = (f(x + step, ids, log_dp) - f(x - step, ids, log_dp)) / (2 * step)   # d ln dp / d ln q
-        if not np.all(np.isfinite(slope) & (slope > 0)):
-            raise ConvergenceError("the pressure drop of a graded tube does not increase with the flow rate")
+        # the root, or the end of the bracket below the limit (a drop beyond every steady state
+        # brackets the edge of the feasible flow rates instead: its residual stays large below)
+        x = np.where(res.f_x < 50.0, res.x, res.bracket[0])
+        rise, w, _ = self._integrate(scene, np.exp(x), np.zeros(x.size), loose, index=ids, strict=False,
+                                     variational=True, control=1)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            slope = w / rise                                     # d ln dp / d ln q, exact
+        slope = np.where(np.isfinite(slope) & (slope > 0), slope, 1.0)
         for _ in range(4):
             miss = f(x, ids, log_dp, self.rtol)
-            x = x - miss / slope
+            x = x - np.where(miss < 50.0, miss, 0.0) / slope
             if np.all(np.abs(miss / slope) <= 1e-15 * np.maximum(1.0, np.abs(x))):
                 break
+        miss = f(x, ids, log_dp, self.rtol)
+        beyond = ~(np.abs(miss) <= 1e-9)
+        if np.any(beyond):
+            i = int(np.flatnonzero(beyond)[0])
+            reached = float(p_out[i] + dp[live][i] * math.exp(min(float(miss[i]), 0.0)))
+            raise NoSteadyStateError("pressure", reached, float(p_out[i] + dp[live][i]),
+                                     "the largest inlet pressure with a steady state, that of the maximum flow rate "
+                                     "(the pressure touches the local limit pressure of a section downstream); "
+                                     "the limit given is the inlet pressure reached below it",
+                                     name="the inlet pressure")
         miss_coarse = f(x, ids, log_dp, 100 * self.rtol) - f(x, ids, log_dp, self.rtol)
         q[live] = np.exp(x)
         return q, np.max(np.abs(miss_coarse / slope), initial=0.0)
