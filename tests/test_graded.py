@@ -24,6 +24,7 @@ from hypothesis import strategies as st
 
 import tubefsi
 from tubefsi.couplers import Graded
+from tubefsi.scene import make_scene
 
 walls = tubefsi.registry.walls
 fluids = tubefsi.registry.rheologies
@@ -507,3 +508,20 @@ def test_graded_pressure_beyond_a_soft_section_is_no_steady_state():
         below = tubefsi.solve(power_law(0.5), wall, tube, flow_rate=0.99 * 9.0909715833e-6, coupler=loose)
     limit = info.value.limit
     assert below.inlet_pressure < limit < 0.8 * MU * math.log(1 + TB)
+
+
+def test_touch_candidates_of_a_soft_section():
+    r"""Where the pressure can first reach the local limit (no integration): the inlet when the limit
+    pressure rises along z there; the minimum of a smooth dip (golden sections, to 1e-8 of the
+    length: the limit pressure is flat there); nowhere when it falls along the whole tube."""
+    tube = tubefsi.Tube(radius=A0, thickness=TB * A0, length=L)
+    scene = lambda mu: make_scene(power_law(0.5), _nh(mu), tube)   # noqa: E731
+    cases = [(lambda z: MU * (1 + z / L), [0.0]),
+             (lambda z: MU * (1 - 0.5 * np.exp(-((z - 0.37 * L) / (L / 10)) ** 2)), [0.37 * L]),
+             (lambda z: MU * (1 + (z / L - 0.3) ** 2), [0.3 * L]),
+             (lambda z: MU * (2 - z / L), [])]
+    for mu, expected in cases:
+        zc, pts = Graded()._touch_candidates(scene(mu), np.array([L]))
+        np.testing.assert_allclose(zc, expected, atol=1e-8 * L)
+        assert list(pts) == [0] * len(expected)
+    assert tubefsi.max_flow_rate(power_law(0.5), _nh(cases[-1][0]), tube) == math.inf

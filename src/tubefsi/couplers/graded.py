@@ -272,10 +272,9 @@ class Graded(Coupler):
         room = target > 0
         if np.any(room):
             q_c[room], err[room] = self._touch_flow_rate(scene, zc[room], pts[room], target[room], L[pts[room]])
-        for i in range(zc.size):          # the smallest per point (a few candidates each)
-            if q_c[i] < q_max[pts[i]]:
-                q_max[pts[i]], z_touch[pts[i]] = q_c[i], zc[i]
-        chosen = np.isin(zc, z_touch) & (q_c == q_max[pts])
+        np.minimum.at(q_max, pts, q_c)            # the smallest per point
+        chosen = q_c == q_max[pts]
+        z_touch[pts[chosen]] = zc[chosen]
         self._judge_error(float(np.max(err[chosen], initial=0.0)), "maximum flow rate")
         return q_max, z_touch
 
@@ -327,12 +326,13 @@ class Graded(Coupler):
 
         fc, fd = lim(c), lim(d)
         for _ in range(math.ceil(math.log(1e-10) / math.log(r))):
-            left = fc <= fd
-            b, a = np.where(left, d, b), np.where(left, a, c)
-            d, fd = np.where(left, c, d), np.where(left, fc, fd)
-            c, fc = np.where(left, b - r * (b - a), c), np.where(left, 0.0, fc)
-            d = np.where(left, d, a + r * (b - a))
-            fc, fd = np.where(left, lim(c), fc), np.where(left, fd, lim(d))
+            left = fc <= fd                        # the minimum is in [a, d]: drop (d, b], else [a, c)
+            a, b = np.where(left, a, c), np.where(left, d, b)
+            keep, f_keep = np.where(left, c, d), np.where(left, fc, fd)
+            new = np.where(left, b - r * (b - a), a + r * (b - a))
+            f_new = lim(new)
+            c, fc = np.where(left, new, keep), np.where(left, f_new, f_keep)
+            d, fd = np.where(left, keep, new), np.where(left, f_keep, f_new)
         return 0.5 * (a + b)
 
     def _touch_flow_rate(self, scene, zc, pts, target, L):
