@@ -208,3 +208,32 @@ def test_network_file_errors(content, extra, message, tmp_path, capsys):
     path = tmp_path / "net.json"
     path.write_text(content)
     assert message in _fail(["network", str(path), *extra], capsys)
+
+
+def test_tapered_tube_on_the_command_line(capsys):
+    """``--tube ...,outlet_radius=..,outlet_thickness=..`` is the linear taper the library solves
+    from ``tubefsi.sampled`` (the same numbers, to the last digit); one outlet value tapers that
+    field only; a bad outlet value is one error line naming the key and its range."""
+    taper = "radius=1e-4,thickness=3e-5,length=1e-2,outlet_radius=6e-5"
+    scene = [*SCENE[:-1], taper]
+    for extra, thickness in ((",outlet_thickness=1.8e-5", tubefsi.sampled([0, 1e-2], [3e-5, 1.8e-5], kind="linear")),
+                             ("", 3e-5)):
+        scene[-1] = taper + extra
+        assert cli.main(["solve", *scene, "--flow-rate", "1e-10,5e-10", "--json"]) == 0
+        result = json.loads(capsys.readouterr().out)
+        tube = tubefsi.Tube(radius=tubefsi.sampled([0, 1e-2], [1e-4, 6e-5], kind="linear"), thickness=thickness,
+                            length=1e-2)
+        sol = tubefsi.solve(FLUID, WALL, tube, flow_rate=np.array([1e-10, 5e-10]))
+        assert result["pressure_drop"] == sol.pressure_drop.tolist()
+        assert result["inlet_radius"] == sol.inlet_radius.tolist()
+        assert result["coupler"] == "Graded"
+    for bad, key in (("outlet_radius=-6e-5", "outlet_radius"), ("outlet_thickness=0", "outlet_thickness")):
+        err = _fail(["solve", *SCENE[:-1], "radius=1e-4,thickness=3e-5,length=1e-2," + bad, "--flow-rate", "1e-10"],
+                    capsys)
+        assert key in err and "(0, inf)" in err
+    err = _fail(["solve", *SCENE[:-1], "radius=1e-4,thickness=3e-5,length=1e-2,outlet_radius=6um", "--flow-rate",
+                 "1e-10"], capsys)
+    assert "outlet_radius" in err and "plain number" in err
+    err = _fail(["solve", *SCENE[:-1], "radius=1e-4,thickness=3e-5,length=1e-2,inlet_radius=1e-4", "--flow-rate",
+                 "1e-10"], capsys)
+    assert "outlet_radius" in err

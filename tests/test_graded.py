@@ -23,6 +23,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import tubefsi
+from tubefsi.couplers import Graded
+from tubefsi.scene import make_scene
 
 walls = tubefsi.registry.walls
 fluids = tubefsi.registry.rheologies
@@ -319,26 +321,25 @@ def test_other_typed_errors():
 
 
 def test_graded_beyond_the_limit_is_no_steady_state():
-    """A graded shear-thinning flow above what the tube carries: NoSteadyStateError naming the
-    local limit pressure, from the integration along z."""
+    """A graded shear-thinning flow above what the tube carries: the integration along z fails, and
+    the NoSteadyStateError gives the maximum flow rate (that of
+    ``test_graded_max_flow_rate_at_the_inlet``, 9.0909716e-6 m^3/s)."""
     wall = walls["thick-neo-hookean"](shear_modulus=lambda z: MU * (1 + z / L))
     tube = tubefsi.Tube(radius=A0, thickness=TB * A0, length=L)
-    with pytest.raises(tubefsi.NoSteadyStateError, match="local limit"):
-        tubefsi.solve(power_law(0.5), wall, tube, flow_rate=1e-5)
+    with pytest.raises(tubefsi.NoSteadyStateError, match="maximum flow rate 9.09097"):
+        tubefsi.solve(power_law(0.5), wall, tube, flow_rate=1e-5, coupler=Graded(rtol=1e-10, check_threshold=1e-6))
 
 
 def test_separable_taper_derivatives_and_unsupported_ones():
     """The derivatives of a separable taper are the equivalent uniform tube's (against central
-    differences of solves, 1e-7); a graded tube that does not separate says it has none."""
+    differences of solves, 1e-7); the parameter derivatives and the diagnostics of a graded tube
+    say they have none."""
     tube = tubefsi.Tube(radius=taper(), thickness=lambda z: TB * taper()(z), length=L)
     wall = walls["thick-neo-hookean"](shear_modulus=MU)
     q, h = 1e-7, 1e-5
     sol = tubefsi.solve(power_law(0.6), wall, tube, flow_rate=q)
     plus, minus = (tubefsi.solve(power_law(0.6), wall, tube, flow_rate=q * (1 + s * h)).pressure_drop for s in (1, -1))
     assert sol.dpressure_drop_dflow_rate == pytest.approx((plus - minus) / (2 * q * h), rel=1e-7)
-    graded = tubefsi.solve(power_law(0.6), wall, tubefsi.Tube(radius=taper(), thickness=2e-4, length=L), flow_rate=q)
-    with pytest.raises(tubefsi.InvalidParameterError, match="difference two solves"):
-        graded.dpressure_drop_dflow_rate
     with pytest.raises(tubefsi.InvalidParameterError, match="difference two solves"):
         sol.dpressure_drop_dparameter("rheology.consistency")
     with pytest.raises(tubefsi.InvalidParameterError, match="graded"):
@@ -353,3 +354,174 @@ def test_networks_take_no_graded_tube():
     with pytest.raises(tubefsi.InvalidParameterError, match="varies along z"):
         net.add_tube("a", "b", walls["thick-neo-hookean"](shear_modulus=lambda z: MU),
                      tubefsi.Tube(radius=A0, thickness=2e-4, length=L))
+
+
+# ------------------------------------------------------------------ derivatives of a graded solve
+def _central(f, x, h):
+    """Richardson-extrapolated central difference of ``f`` at ``x`` with steps ``h``, ``h/2`` (error
+    O(h^4) plus rounding ~ 1e-13 |f| / h), and the same at ``2h``, ``h``: their difference bounds
+    the truncation error of the first. ``f`` is called once, with the six abscissae as an array."""
+    steps = np.array([h / 2, h, 2 * h])
+    values = f(np.concatenate([x + steps, x - steps]))
+    c = (values[:3] - values[3:]) / (2 * steps)
+    return (4 * c[0] - c[1]) / 3, (4 * c[1] - c[2]) / 3
+
+
+DERIVATIVE_CASES = {
+    "graded-modulus": (power_law(0.6), _nh(lambda z: MU * (1.0 + 1.5 * z / L)),
+                       tubefsi.Tube(radius=A0, thickness=TB * A0, length=L)),
+    "taper-constant-thickness-carreau": (
+        fluids["carreau"](zero_shear_viscosity=0.05, infinite_shear_viscosity=0.0035, relaxation_time=3.3, index=0.5),
+        _nh(MU), tubefsi.Tube(radius=taper(), thickness=2e-4, length=L)),
+    "linear-graded": (fluids["newtonian"](viscosity=0.05), _linear(lambda z: 3 * MU * np.exp(z / L)),
+                      tubefsi.Tube(radius=A0, thickness=TB * A0, length=L)),
+}
+
+
+@pytest.mark.parametrize("case", sorted(DERIVATIVE_CASES))
+def test_graded_derivatives_match_finite_differences(case):
+    r"""The derivatives of a graded solve that does not separate (the variational equations
+    integrated along z with the pressure) against central differences of flow-controlled solves,
+    Richardson-extrapolated: :math:`d\Delta p/dq` and :math:`\partial\Delta p/\partial p_{out}|_q`,
+    whence :math:`\partial q/\partial p_{in} = 1/(d\Delta p/dq)` and :math:`\partial q/\partial
+    p_{out} = -(1 + \partial\Delta p/\partial p_{out})/(d\Delta p/dq)`; agreement within ten times
+    the difference's own truncation estimate plus 1e-9 (its rounding), at an outlet pressure of
+    200 Pa, and the pressure-controlled solve's derivatives equal the flow-controlled ones."""
+    fluid, wall, tube = DERIVATIVE_CASES[case]
+    q, p_out = 1e-7, 200.0
+    sol = tubefsi.solve(fluid, wall, tube, flow_rate=q, outlet_pressure=p_out)
+    assert sol.coupler_name == "Graded"
+    drop = lambda x, po: tubefsi.solve(fluid, wall, tube, flow_rate=x, outlet_pressure=po).pressure_drop  # noqa: E731
+    dq, dq2 = _central(lambda x: drop(x, p_out), q, 1e-3 * q)
+    assert abs(sol.dpressure_drop_dflow_rate - dq) <= 10 * abs(dq - dq2) + 1e-9 * abs(dq)
+    dpo, dpo2 = _central(lambda x: drop(q, x), p_out, 1e-2 * p_out)
+    expected = -(1 + dpo) / dq
+    bound = 10 * (abs(dpo - dpo2) / abs(1 + dpo) + abs(dq - dq2) / abs(dq)) + 1e-9
+    assert sol.dflow_rate_dinlet_pressure == pytest.approx(1 / dq, rel=10 * abs(dq - dq2) / abs(dq) + 1e-9)
+    assert sol.dflow_rate_doutlet_pressure == pytest.approx(expected, rel=bound)
+    assert sol.dflow_rate_doutlet_pressure < 0 < sol.dflow_rate_dinlet_pressure
+    if case == "linear-graded":        # a pressure-controlled state (the cheapest case)
+        back = tubefsi.solve(fluid, wall, tube, pressure_drop=sol.pressure_drop, outlet_pressure=p_out)
+        assert back.dflow_rate_doutlet_pressure == pytest.approx(sol.dflow_rate_doutlet_pressure, rel=1e-10)
+
+
+def test_graded_derivatives_limits():
+    r"""Two independent references: a constant modulus *function* with a Carreau fluid (never
+    separable: the integration along z) gives the uniform tube's derivatives (the separated
+    engine's :math:`K = \int k\,dz`) to 1e-10; and at q = 0 a Newtonian fluid in a linear taper of
+    constant thickness has :math:`d\Delta p/dq = (8\mu/\pi)\int_0^L a^{-4}dz
+    = 8\mu L(a_0^{-3} - a_1^{-3})/(3\pi(a_1 - a_0))` (the rigid-tube law of the unloaded tube)."""
+    carreau = fluids["carreau"](zero_shear_viscosity=0.05, infinite_shear_viscosity=0.0035, relaxation_time=3.3,
+                                index=0.6)
+    tube = tubefsi.Tube(radius=A0, thickness=TB * A0, length=L)
+    q = np.array([1e-8, 1e-7])
+    uniform = tubefsi.solve(carreau, _nh(MU), tube, flow_rate=q, outlet_pressure=100.0)
+    graded = tubefsi.solve(carreau, _nh(lambda z: MU), tube, flow_rate=q, outlet_pressure=100.0)
+    assert graded.coupler_name == "Graded"
+    for name in ("dpressure_drop_dflow_rate", "dflow_rate_dinlet_pressure", "dflow_rate_doutlet_pressure"):
+        np.testing.assert_allclose(getattr(graded, name), getattr(uniform, name), rtol=1e-10)
+    mu = 0.05
+    rest = tubefsi.solve(fluids["newtonian"](viscosity=mu), _nh(MU), tubefsi.Tube(radius=taper(), thickness=2e-4,
+                                                                                  length=L), flow_rate=0.0)
+    exact = 8 * mu * L * (A0**-3 - A1**-3) / (3 * math.pi * (A1 - A0))
+    assert rest.dpressure_drop_dflow_rate == pytest.approx(exact, rel=1e-11)
+
+
+# ------------------------------------------------------------------ the maximum flow rate of a graded tube
+def _thick_nh_float(mu, tb, lam):
+    """The thick neo-Hookean tube law (as :func:`thick_nh`) in floats."""
+    lo2 = 1 + (lam**2 - 1) / (1 + tb) ** 2
+    return mu * (math.log(lam) - 0.5 * math.log(lo2) - 1 / (2 * lam**2) + 1 / (2 * lo2))
+
+
+def _touch_reference(mu_of, n, m, q0, q1, a=A0, tb=TB, length=L):
+    r"""The flow rate at which the pressure of a power-law fluid in a uniform thick neo-Hookean tube
+    with a modulus :math:`\mu(z)` reaches the inlet's limit pressure :math:`\mu(0)\ln(1 + \bar t)`:
+    SciPy's DOP853 (``solve_ivp``, rtol 1e-13) of :math:`dp/dz = -\phi(q)(a\lambda)^{-k}`, the
+    stretch by ``brentq`` on the closed-form law, and secant steps on the inlet's margin
+    :math:`p_{lim}(0) - p(0; q)` from below (it is linear in q there: the limit pressure rises
+    along z), extrapolated to zero from a margin below 2e-7 Pa."""
+    from scipy.integrate import solve_ivp
+    from scipy.optimize import brentq
+
+    def stretch(p, mu):
+        if p <= 0:
+            return 1.0
+        hi = 1.0
+        while _thick_nh_float(mu, tb, math.exp(hi)) < p:
+            hi *= 2
+        return math.exp(brentq(lambda x: _thick_nh_float(mu, tb, math.exp(x)) - p, 0.0, hi, xtol=1e-16, rtol=1e-15))
+
+    def margin(q):
+        k, phi = 3 * n + 1, 2 * m * ((3 * n + 1) * q / (math.pi * n)) ** n
+        sol = solve_ivp(lambda z, y: [-phi * (a * stretch(y[0], mu_of(z))) ** -k], (length, 0.0), [0.0],
+                        method="DOP853", rtol=1e-13, atol=1e-10)
+        return mu_of(0.0) * math.log(1 + tb) - sol.y[0, -1]
+
+    f0, f1 = margin(q0), margin(q1)
+    for _ in range(40):
+        q2 = q1 - f1 * (q1 - q0) / (f1 - f0)
+        if abs(f1) < 2e-7:
+            return q2
+        q2 = q1 + 0.9 * (q2 - q1)          # stay below the limit
+        q0, f0, q1, f1 = q1, f1, q2, margin(q2)
+    raise AssertionError("the reference did not converge")
+
+
+def test_graded_max_flow_rate_at_the_inlet():
+    r"""A modulus rising along the tube, :math:`\mu = \mu_0(1 + z/L)`, with a shear-thinning fluid
+    (n = 0.5): the pressure first reaches the local limit at the inlet; the maximum flow rate
+    against the independent DOP853/brentq reference (1e-11; measured 4e-13); below it a solve
+    works and ``on_infeasible="nan"`` masks only the point beyond."""
+    mu_of = lambda z: MU * (1 + z / L)   # noqa: E731
+    fluid, wall = power_law(0.5), _nh(mu_of)
+    tube = tubefsi.Tube(radius=A0, thickness=TB * A0, length=L)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", tubefsi.AccuracyWarning)
+        q_max = tubefsi.max_flow_rate(fluid, wall, tube)
+    ref = _touch_reference(mu_of, 0.5, 0.5, 0.99 * q_max, 0.995 * q_max)
+    assert q_max == pytest.approx(ref, rel=1e-11)
+    loose = Graded(rtol=1e-10, check_threshold=1e-6)     # the masking only (cheaper)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", tubefsi.ModelValidityWarning)     # R_in/L > 0.1 near the limit
+        sol = tubefsi.solve(fluid, wall, tube, flow_rate=np.array([0.999 * q_max, 1.001 * q_max]),
+                            on_infeasible="nan", coupler=loose)
+    assert list(sol.feasible) == [True, False]
+    assert math.isfinite(sol.pressure_drop[0]) and math.isnan(sol.pressure_drop[1])
+    assert sol.pressure_drop[0] < MU * math.log(1 + TB)
+
+
+def test_graded_pressure_beyond_a_soft_section_is_no_steady_state():
+    r"""A sampled modulus dipping to half at mid-tube (a breakpoint): the pressure first touches the
+    local limit there, so the largest inlet pressure with a steady state is that of the maximum
+    flow rate, below the inlet section's limit :math:`\mu_0\ln(1 + \bar t)`; a pressure drop beyond
+    it is a ``NoSteadyStateError`` giving that pressure (not the flow rate at the edge, which the
+    bracketing alone would return), bounded by the inlet pressures of the flows just below and at
+    the maximum."""
+    wall = _nh(tubefsi.sampled([0, L / 2, L], [MU, 0.5 * MU, MU], kind="linear"))
+    tube = tubefsi.Tube(radius=A0, thickness=TB * A0, length=L)
+    loose = Graded(rtol=1e-10, check_threshold=1e-6)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", tubefsi.ModelValidityWarning)
+        with pytest.raises(tubefsi.NoSteadyStateError) as info:
+            tubefsi.solve(power_law(0.5), wall, tube, pressure_drop=1.1 * MU * math.log(1 + TB) * 0.8, coupler=loose)
+        below = tubefsi.solve(power_law(0.5), wall, tube, flow_rate=0.99 * 9.0909715833e-6, coupler=loose)
+    limit = info.value.limit
+    assert below.inlet_pressure < limit < 0.8 * MU * math.log(1 + TB)
+
+
+def test_touch_candidates_of_a_soft_section():
+    r"""Where the pressure can first reach the local limit (no integration): the inlet when the limit
+    pressure rises along z there; the minimum of a smooth dip (golden sections, to 1e-8 of the
+    length: the limit pressure is flat there); nowhere when it falls along the whole tube."""
+    tube = tubefsi.Tube(radius=A0, thickness=TB * A0, length=L)
+    scene = lambda mu: make_scene(power_law(0.5), _nh(mu), tube)   # noqa: E731
+    cases = [(lambda z: MU * (1 + z / L), [0.0]),
+             (lambda z: MU * (1 - 0.5 * np.exp(-((z - 0.37 * L) / (L / 10)) ** 2)), [0.37 * L]),
+             (lambda z: MU * (1 + (z / L - 0.3) ** 2), [0.3 * L]),
+             (lambda z: MU * (2 - z / L), [])]
+    for mu, expected in cases:
+        zc, pts = Graded()._touch_candidates(scene(mu), np.array([L]))
+        np.testing.assert_allclose(zc, expected, atol=1e-8 * L)
+        assert list(pts) == [0] * len(expected)
+    assert tubefsi.max_flow_rate(power_law(0.5), _nh(cases[-1][0]), tube) == math.inf

@@ -228,21 +228,44 @@ def _scene_from_args(args):
     return fluid, wall, tube, coupler
 
 
+#: Optional ``--tube`` keys: the outlet's radius and thickness of a linearly tapered tube.
+_TAPER_KEYS = {"outlet_radius": "radius", "outlet_thickness": "thickness"}
+
+
 def _tube(text, option):
-    """A Tube from ``radius=..,thickness=..,length=..``."""
+    """A Tube from ``radius=..,thickness=..,length=..``; with ``outlet_radius=..`` and/or
+    ``outlet_thickness=..`` the radius and/or the thickness run linearly from the inlet's value
+    (``radius``, ``thickness``) to the outlet's (a :func:`tubefsi.sampled` linear table over
+    ``[0, length]``, ``docs/graded.md``)."""
     tube_params = _parse_pairs(text, text)
     expected = ("radius", "thickness", "length")
-    unknown = [k for k in tube_params if k not in expected]
+    unknown = [k for k in tube_params if k not in expected and k not in _TAPER_KEYS]
     if unknown:
-        raise UsageError(f"{option} has no parameter {unknown[0]!r}; expected radius, thickness, length (m)")
+        raise UsageError(f"{option} has no parameter {unknown[0]!r}; expected radius, thickness, length (m), and "
+                         "optionally outlet_radius, outlet_thickness (m: a linear taper)")
     missing = [k for k in expected if k not in tube_params]
     if missing:
         raise UsageError(f"{option} needs {', '.join(missing)} (m), e.g. radius=1e-4,thickness=3e-5,length=1e-2")
+    from .errors import InvalidParameterError
     from .fields import parameters
     from .geometry import Tube
+    from .profiles import sampled
 
-    _plain_numbers(option, tube_params, {p.name: p for p in parameters(Tube)})
-    return Tube(**tube_params)
+    fields = {p.name: p for p in parameters(Tube)}
+    fields.update({key: fields[of] for key, of in _TAPER_KEYS.items()})
+    _plain_numbers(option, tube_params, fields)
+    outlet = {of: tube_params.pop(key) for key, of in _TAPER_KEYS.items() if key in tube_params}
+    tube = Tube(**tube_params)
+    if not outlet:
+        return tube
+    try:                                  # the outlet's values, validated as the tube's own
+        Tube(**{**tube_params, **outlet})
+    except InvalidParameterError as err:
+        key = next(k for k, of in _TAPER_KEYS.items() if of == err.parameter)
+        raise InvalidParameterError(key, err.admissible, err.value) from None
+    ends = [0.0, tube.length]
+    return Tube(length=tube.length, **{name: sampled(ends, [tube_params[name], outlet[name]], kind="linear")
+                                       if name in outlet else tube_params[name] for name in ("radius", "thickness")})
 
 
 def _cmd_solve(args, out) -> int:
@@ -352,7 +375,8 @@ def _add_scene_args(p):
     p.add_argument("--wall", required=True, metavar="NAME[:k=v,...]",
                    help="e.g. thick-neo-hookean:shear_modulus=2e3")
     p.add_argument("--tube", required=True, metavar="radius=..,thickness=..,length=..",
-                   help="undeformed tube (m)")
+                   help="undeformed tube (m); outlet_radius=.., outlet_thickness=.. make a linear taper from the "
+                        "inlet's radius and thickness to these")
     p.add_argument("--outlet-pressure", type=float, default=0.0, metavar="P",
                    help="outlet (gauge) pressure of the fluid (Pa, default 0)")
     p.add_argument("--external-pressure", type=float, default=0.0, metavar="PE",

@@ -182,7 +182,10 @@ def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="
     n = values.size
     out = _Results(n)
     feasible = np.ones(n, dtype=bool)
-    optimistic = controlled == "flow_rate" and _is(type(chosen), SeparatedVariables)
+    # solve first, and look for the maximum flow rate only if a point failed: the engine's or a
+    # graded tube's (whose maximum costs a dozen integrations along z)
+    optimistic = controlled == "flow_rate" and (_is(type(chosen), SeparatedVariables)
+                                                 or isinstance(chosen, Graded))
     shown = bar(n, progress, "tubefsi.solve")
     with curve_span(flat, values) if optimistic and flat.size == 1 and n > CHUNK else contextlib.nullcontext():
         _solve_chunks(flat, values, method, runner, controlled, optimistic, on_infeasible, out, feasible, shown)
@@ -360,8 +363,7 @@ CHUNK = 1 << 14
 def _feasible(coupler, scene, load, controlled, *, raise_):
     """The points below every limit (None: all of them); raises for the first one beyond if ``raise_``."""
     if controlled == "flow_rate":
-        limit = np.asarray(coupler.max_flow_rate(scene, strict=False) if scene.graded else
-                           coupler.max_flow_rate(scene), dtype=float)
+        limit = np.asarray(coupler.max_flow_rate(scene), dtype=float)
         if not np.any(np.isfinite(limit)):
             return None
         beyond = (load > 0) & (load >= limit)

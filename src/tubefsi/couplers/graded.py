@@ -64,6 +64,14 @@ _CONSTANT = 1e-14
 STRETCH_CAP = 1e3
 #: Steps (rounds over all points) before the integration gives up.
 _MAX_ROUNDS = 20_000
+#: A pressure this close (relative) to the local limit pressure short of the end of an integration
+#: stops it as beyond the steady state (the tube law's stretch there is near 1e2.5 for a limit
+#: approached as lambda^-4; the maximum flow rate extrapolates from there).
+_NEAR_LIMIT = 1e-10
+#: Newton steps (each one integration) of the maximum flow rate per candidate touch position.
+_TOUCH_ROUNDS = 60
+#: The estimated relative error of the maximum flow rate at which its Newton iteration stops.
+_TOUCH_TOL = 1e-13
 
 
 def _profiles(model):
@@ -223,33 +231,195 @@ class Graded(Coupler):
         return self._state(scene, q, dp)
 
     def max_flow_rate(self, scene, *, strict=True):
-        """The maximum flow rate: the equivalent uniform tube's where separable; ``inf`` where no
-        section has a limit pressure. Otherwise ``strict`` raises ``InvalidParameterError`` (not
-        implemented) and ``strict=False`` gives ``inf`` (what :func:`tubefsi.solve` asks: its
-        integration raises ``NoSteadyStateError`` where the pressure reaches a local limit)."""
+        r"""The maximum flow rate (m^3/s): the equivalent uniform tube's where separable; otherwise
+        the flow rate at which the pressure first touches the local limit pressure somewhere
+        (:meth:`touch`; ``inf`` where no section has one, or where the limit pressure never falls
+        toward the inlet). ``strict`` is accepted for the solve's call and changes nothing."""
         q_max = self._on_uniform(scene, "max_flow_rate")
         if q_max is not None:
             return q_max
+        q, _ = self.touch(scene)
+        return float(q[0]) if scene.size == 1 else q
+
+    def touch(self, scene):
+        r"""``(q_max, z_touch)`` per point of a flat scene: the largest flow rate with a steady
+        state and where its pressure reaches the local limit pressure :math:`p_{lim}(z)`
+        (``docs/graded.md``, "The maximum flow rate").
+
+        At the touch :math:`\lambda \to \infty`, so :math:`G = 0` there and the margin
+        :math:`\varepsilon = p_{lim} - p` (:math:`\varepsilon' = p_{lim}' + G`) has a minimum 0:
+        the touch is at the inlet if :math:`p_{lim}' \ge 0` there, or at an interior local minimum
+        of :math:`p_{lim}` (a breakpoint, or a smooth minimum located by golden sections to 1e-10
+        of the length). For each candidate :math:`z_c` the flow rate with
+        :math:`p(z_c) = p_{lim}(z_c)` is found by safeguarded Newton steps on
+        :math:`\ln(p(z_c) - p_{out})` against :math:`\ln q`, the slope :math:`W/(p - p_{out})` from
+        the variational equations, from the feasible side (a bracket where a trial is beyond a
+        limit); :math:`q_{max}` is the smallest. The answer is the Newton extrapolation from the last
+        feasible iterate; its error, estimated from the step and the change of the slope, is stated
+        by an :class:`~tubefsi.AccuracyWarning` above ``check_threshold`` (a touch where
+        :math:`p_{lim}' = 0` — a smooth minimum, a uniform inlet section — makes the margin vanish
+        faster than linearly in :math:`q`: ill-conditioned)."""
         n = scene.size
-        z = np.linspace(0.0, 1.0, 65)[:, None] * np.broadcast_to(np.asarray(scene.tube.length, dtype=float), (n,))
-        wall, _, tb = scene.at_position(z.ravel(), np.tile(np.arange(n), 65))
-        limited = np.isfinite(np.asarray(wall._limit_pressure(tb), dtype=float) + np.zeros(65 * n))
-        if not np.any(limited) or not strict:
-            return math.inf if n == 1 else np.full(n, np.inf)
-        raise InvalidParameterError("tube", "a tube law without a limit pressure, or a separable taper, for "
-                                    "max_flow_rate", scene.tube,
-                                    "the maximum flow rate of a graded tube whose wall has a limit pressure is not "
-                                    "implemented (solve raises NoSteadyStateError beyond it)")
+        L = np.broadcast_to(np.asarray(scene.tube.length, dtype=float), (n,))
+        p_out = np.broadcast_to(np.asarray(scene.outlet_pressure, dtype=float), (n,))
+        zc, pts = self._touch_candidates(scene, L)
+        q_max, z_touch = np.full(n, np.inf), np.full(n, np.nan)
+        if zc.size == 0:
+            return q_max, z_touch
+        wall, _, tb = scene.at_position(zc, pts)
+        target = np.asarray(wall._limit_pressure(tb), dtype=float) + 0.0 * zc - p_out[pts]
+        q_c, err = np.zeros(zc.size), np.zeros(zc.size)
+        room = target > 0
+        if np.any(room):
+            q_c[room], err[room] = self._touch_flow_rate(scene, zc[room], pts[room], target[room], L[pts[room]])
+        np.minimum.at(q_max, pts, q_c)            # the smallest per point
+        chosen = q_c == q_max[pts]
+        z_touch[pts[chosen]] = zc[chosen]
+        self._judge_error(float(np.max(err[chosen], initial=0.0)), "maximum flow rate")
+        return q_max, z_touch
+
+    def _touch_candidates(self, scene, L):
+        """``(z, point)`` of the candidate touch positions: the inlet where the limit pressure does
+        not fall along z there, and the interior local minima of the limit pressure (on 257
+        positions and the breakpoints; smooth minima refined by golden sections)."""
+        n = scene.size
+        breaks = _breakpoints(scene)
+        grid = np.linspace(0.0, 1.0, 257)[:, None] * L
+        inner = np.broadcast_to(breaks[:, None], (breaks.size, n))
+        inner = np.where((inner > 0) & (inner < L), inner, L)          # outside: a duplicate of L
+        z = np.concatenate([grid, inner])
+        kink = np.concatenate([np.isin(grid, breaks), np.ones(inner.shape, bool)])
+        order = np.argsort(z, axis=0, kind="stable")
+        z, kink = np.take_along_axis(z, order, 0), np.take_along_axis(kink, order, 0)
+        lim = self._limit_along(scene, z)
+        if not np.any(np.isfinite(lim)):
+            return np.zeros(0), np.zeros(0, dtype=int)
+        with np.errstate(invalid="ignore"):
+            first = np.isfinite(lim[0]) & (lim[0] <= lim[1])
+            local = np.isfinite(lim[1:-1]) & (lim[1:-1] < lim[:-2]) & (lim[1:-1] <= lim[2:])
+        rows, cols = np.nonzero(local)
+        rows = rows + 1
+        smooth = ~kink[rows, cols]
+        zc = z[rows, cols].copy()
+        if np.any(smooth):
+            lo, hi = z[rows[smooth] - 1, cols[smooth]], z[rows[smooth] + 1, cols[smooth]]
+            zc[smooth] = self._golden(scene, lo, hi, cols[smooth])
+        zc = np.concatenate([np.zeros(int(np.sum(first))), zc])
+        pts = np.concatenate([np.flatnonzero(first), cols])
+        return zc, pts
+
+    def _limit_along(self, scene, z):
+        """The local limit pressure at the positions ``z`` (shape (m, n): n points)."""
+        m, n = z.shape
+        wall, _, tb = scene.at_position(z.ravel(), np.tile(np.arange(n), m))
+        return (np.asarray(wall._limit_pressure(tb), dtype=float) + 0.0 * z.ravel()).reshape(m, n)
+
+    def _golden(self, scene, lo, hi, pts):
+        """The minimum of the limit pressure in ``[lo, hi]`` by golden sections, to 1e-10 of the span."""
+        r = (math.sqrt(5.0) - 1.0) / 2.0
+        a, b = lo.copy(), hi.copy()
+        c, d = b - r * (b - a), a + r * (b - a)
+
+        def lim(z):
+            wall, _, tb = scene.at_position(z, pts)
+            return np.asarray(wall._limit_pressure(tb), dtype=float) + 0.0 * z
+
+        fc, fd = lim(c), lim(d)
+        for _ in range(math.ceil(math.log(1e-10) / math.log(r))):
+            left = fc <= fd                        # the minimum is in [a, d]: drop (d, b], else [a, c)
+            a, b = np.where(left, a, c), np.where(left, d, b)
+            keep, f_keep = np.where(left, c, d), np.where(left, fc, fd)
+            new = np.where(left, b - r * (b - a), a + r * (b - a))
+            f_new = lim(new)
+            c, fc = np.where(left, new, keep), np.where(left, f_new, f_keep)
+            d, fd = np.where(left, keep, new), np.where(left, f_keep, f_new)
+        return 0.5 * (a + b)
+
+    def _touch_flow_rate(self, scene, zc, pts, target, L):
+        r"""The flow rates with :math:`p(z_c) - p_{out} =` ``target`` (the local limit) and the
+        estimated relative errors: safeguarded Newton on :math:`f(x) = \ln(p(z_c) - p_{out}) -
+        \ln(\text{target})`, :math:`x = \ln q`, :math:`f' = W/(p - p_{out})`, integrated at
+        ``rtol``/10; the integration's share of the error from the difference of :math:`f` at
+        10 ``rtol``."""
+        rheo = scene.rheology
+        _, a, _ = scene.at_position(zc, pts)
+        # start: the rigid tube of the section's radius under the mean gradient
+        x = np.log(model_at(rheo, pts)._flow_rate(a, target / (L - zc)))
+        x_hi = np.full(zc.size, np.inf)
+        rtol = max(1e-15, 0.1 * self.rtol)     # the slope d ln p/d ln q < 1 amplifies the pressure's error
+        x, x_hi, f, d, err = self._touch_newton(scene, zc, pts, target, x, x_hi, rtol)
+        root = x - f / d
+        rise = self._integrate(scene, np.exp(x), zc, 100 * rtol, index=pts, strict=False)[0]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            err = err + np.abs((np.log(rise) - np.log(target) - f) / d)
+        return np.exp(root), np.where(np.isfinite(err), err, np.inf)
+
+    def _touch_newton(self, scene, zc, pts, target, x, x_hi, rtol):
+        """Safeguarded Newton steps (see :meth:`_touch_flow_rate`) at the integration tolerance
+        ``rtol``: ``(x_lo, x_hi, f, f', error)``, ``x_lo`` the last feasible iterate."""
+        m = zc.size
+        x = x.copy()
+        x_lo, f_lo, d_lo = np.full(m, -np.inf), np.zeros(m), np.ones(m)
+        d_prev, x_prev = np.full(m, np.nan), np.full(m, np.nan)
+        err = np.full(m, np.inf)
+        active = np.ones(m, dtype=bool)
+        for _ in range(_TOUCH_ROUNDS):
+            sel = np.flatnonzero(active)
+            if sel.size == 0:
+                break
+            rise, w, _ = self._integrate(scene, np.exp(x[sel]), zc[sel], rtol, index=pts[sel], strict=False,
+                                         variational=True, control=1)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                ok = np.isfinite(rise) & (rise < target[sel]) & (w > 0)
+                f = np.log(rise) - np.log(target[sel])
+                d = w / rise
+            good, bad = sel[ok], sel[~ok]
+            x_hi[bad] = np.minimum(x_hi[bad], x[bad])
+            x_prev[good], d_prev[good] = x_lo[good], d_lo[good]
+            x_lo[good], f_lo[good], d_lo[good] = x[good], f[ok], d[ok]
+            step = -f_lo[sel] / d_lo[sel]
+            known = np.isfinite(x_lo[sel])
+            # the error of the Newton extrapolation: |step| times the relative change of the slope
+            with np.errstate(divide="ignore", invalid="ignore"):
+                curvature = np.abs((d_lo[sel] - d_prev[sel]) / (x_lo[sel] - x_prev[sel])) / d_lo[sel]
+                e = np.where(np.isfinite(curvature) & np.isfinite(x_prev[sel]), 0.5 * curvature * step**2,
+                             np.abs(step))
+            err[sel] = np.where(known, e, np.inf)
+            trial = np.where(known, x_lo[sel] + step, x[sel] - 2.0)
+            beyond = trial >= x_hi[sel]
+            trial = np.where(beyond & known, 0.5 * (x_lo[sel] + x_hi[sel]), trial)
+            done = known & ((err[sel] <= _TOUCH_TOL) | (x_hi[sel] - x_lo[sel] <= 1e-15))
+            x[sel] = trial
+            active[sel[done]] = False
+        if not np.all(np.isfinite(x_lo)):
+            raise ConvergenceError("the maximum flow rate of a graded tube: no flow rate below the limit was found")
+        step = -f_lo / d_lo
+        err = np.where(active, np.maximum(err, np.minimum(np.abs(step), x_hi - x_lo)), err)
+        return x_lo, x_hi, f_lo, d_lo, err
 
     def sensitivities(self, scene, state):
-        """The derivatives of a solve: those of the equivalent uniform tube where the scene
+        r"""The derivatives of a solve: those of the equivalent uniform tube where the scene
         separates (its pressure drop is the same function of the flow rate and the end pressures);
-        otherwise not implemented (``InvalidParameterError``: difference two solves)."""
+        otherwise from the variational equations integrated along z with the pressure
+        (:meth:`_integrate`): :math:`d\Delta p/dq = W(0)/q`, :math:`\partial q/\partial p_{in} =
+        q/W(0)`, :math:`\partial q/\partial p_{out} = -V(0)\,q/W(0)`, checked at 100 ``rtol``
+        like the pressure. At ``q = 0`` the limit :math:`q \to 0^+` (an apparent shear rate of
+        1e-30/s at the outlet, as for uniform tubes)."""
         found = self._uniform(scene)
-        if found is None:
-            raise InvalidParameterError("tube", "a uniform tube or a separable taper for the derivatives of a solve",
-                                        scene.tube, "a graded tube that does not separate: difference two solves")
-        return found[1].sensitivities(found[0], state)
+        if found is not None:
+            return found[1].sensitivities(found[0], state)
+        q = np.asarray(state.flow_rate, dtype=float).ravel()
+        index = _points(scene, q.size)
+        L = np.broadcast_to(np.asarray(scene.tube.length, dtype=float), (scene.size,))[index]
+        wall_l, a_l, tb_l = scene.at_position(L, index)
+        p_out = np.broadcast_to(np.asarray(scene.outlet_pressure, dtype=float), (scene.size,))[index]
+        r_out = a_l * (1.0 + wall_l._strain(p_out, tb_l))
+        q_use = np.where(q > 0, q, 0.25e-30 * math.pi * r_out**3)
+        _, w, v = self._integrate(scene, q_use, np.zeros(q.size), self.rtol, variational=True)
+        _, w_c, v_c = self._integrate(scene, q_use, np.zeros(q.size), 100 * self.rtol, variational=True)
+        self._judge(w, w_c, "sensitivity q dp/dq")
+        self._judge(v, v_c, "sensitivity dp_in/dp_out")
+        return w / q_use, q_use / w, -v * q_use / w
 
     def length_integral(self, scene, state, weight, *, uniform=False):
         """Not implemented along a graded tube (the separated identity behind the weighted length
@@ -258,9 +428,25 @@ class Graded(Coupler):
                                     "a graded tube: difference two solves")
 
     def limit_pressure(self, scene):
-        """The limit pressure of the inlet section (a necessary bound on the inlet pressure)."""
-        wall, _, tb = scene.at_position(np.zeros(scene.size), np.arange(scene.size))
-        return wall._limit_pressure(tb)
+        """The largest inlet pressure with a steady state: the inlet section's limit pressure where
+        the pressure can only touch its local limit at the inlet (or nowhere); where it can touch
+        it downstream first (a softer section: :meth:`touch`), the inlet pressure just below the
+        maximum flow rate (1e-9 below it)."""
+        n = scene.size
+        wall, _, tb = scene.at_position(np.zeros(n), np.arange(n))
+        inlet = wall._limit_pressure(tb)
+        L = np.broadcast_to(np.asarray(scene.tube.length, dtype=float), (n,))
+        if self._uniform(scene) is not None or not np.any(self._touch_candidates(scene, L)[0] > 0):
+            return inlet
+        out = np.asarray(inlet, dtype=float) + np.zeros(n)
+        q_max, z_touch = self.touch(scene)
+        inside = np.flatnonzero(np.isfinite(q_max) & (z_touch > 0))
+        if inside.size:
+            p_out = np.broadcast_to(np.asarray(scene.outlet_pressure, dtype=float), (n,))[inside]
+            rise = self.rise(scene, q_max[inside] * (1.0 - 1e-9), np.zeros(inside.size), self.rtol, index=inside,
+                             strict=False)
+            out[inside] = np.minimum(out[inside], np.where(np.isfinite(rise), p_out + rise, out[inside]))
+        return out
 
     def profile(self, scene, state, z):
         z = np.asarray(z, dtype=float)
@@ -306,9 +492,26 @@ class Graded(Coupler):
         ``index`` of a flat scene (default: one per point), integrating from the outlet. Where the
         pressure reaches a local limit pressure on the way: ``NoSteadyStateError`` (``strict``) or
         ``inf``."""
+        return self._integrate(scene, q, z_end, rtol, index, strict=strict)[0]
+
+    def _integrate(self, scene, q, z_end, rtol, index=None, *, strict=True, variational=False, control=None):
+        r"""The integration along z from the outlet to ``z_end``: the pressure rise (Pa) and, with
+        ``variational``, its sensitivities :math:`W = q\,\partial p/\partial q` (Pa) and
+        :math:`V = \partial p/\partial p_{out}` integrated with it (one error control for the three):
+
+        .. math::
+
+            \frac{dW}{dz} = -kG - cW,\qquad \frac{dV}{dz} = -cV,\qquad W(L) = 0,\ V(L) = 1,
+
+        :math:`k = \partial\ln G/\partial\ln q`, :math:`c = \partial G/\partial p|_z
+        = -(1 + 3k)\,G/(\lambda P_\lambda)` (:math:`\partial\ln G/\partial\ln R = -(1 + 3k)` for every
+        generalized Newtonian fluid: :math:`q = R^3 f(GR/2)`). Returns ``(rise, W, V)`` in the
+        shape of ``q`` (``W, V`` None without ``variational``). ``control``: the rows whose error
+        the step control bounds (default all; ``1``: the pressure only, for a Newton slope)."""
         shape = np.shape(q)
         q = np.asarray(q, dtype=float).ravel()
         n = q.size
+        m = 3 if variational else 1
         index = _points(scene, n) if index is None else np.asarray(index, dtype=int).ravel()
         L = np.broadcast_to(np.asarray(scene.tube.length, dtype=float), (scene.size,))[index] if np.ndim(
             scene.tube.length) else np.full(n, float(scene.tube.length))
@@ -316,10 +519,12 @@ class Graded(Coupler):
         rheo = scene.rheology
         p_out = np.broadcast_to(np.asarray(scene.outlet_pressure, dtype=float), (scene.size,))[index] if np.ndim(
             scene.outlet_pressure) else np.full(n, float(scene.outlet_pressure))
-        out = np.zeros(n)
+        out = np.zeros((m, n))
+        if variational:
+            out[2] = 1.0
         live = np.flatnonzero((q > 0) & (z_end < L))
         if live.size == 0:
-            return out.reshape(shape)
+            return _unpack(out, shape, variational)
         idx = index[live]
         # the scale of the pressure: the rigid-tube drop at the outlet radius
         wall_l, a_l, tb_l = scene.at_position(L[live], idx)
@@ -332,19 +537,30 @@ class Graded(Coupler):
             """dy/dz at (zs, ys) for the live entries ``sel`` (NaN beyond the local tube law)."""
             pts = idx[sel]
             wall, a, tb = scene.at_position(zs, pts)
-            p = p_out[live][sel] + ys * scale[sel]
+            p = p_out[live][sel] + ys[0] * scale[sel]
             lim = np.asarray(wall._limit_pressure(tb), dtype=float) + 0.0 * p
             low = np.asarray(wall._min_pressure(tb), dtype=float) + 0.0 * p
             bad = ~((p < lim) & (p >= low)) | ~np.isfinite(p)
+            fluid = model_at(rheo, pts)
             with np.errstate(all="ignore"):
                 e = wall._strain(np.where(bad, p_out[live][sel], p), tb)
-                g = model_at(rheo, pts)._pressure_gradient(q[live][sel], a * (1.0 + e))
-            return np.where(bad | ~np.isfinite(g) | (e > STRETCH_CAP - 1.0), np.nan, -g / scale[sel])
+                g = fluid._pressure_gradient(q[live][sel], a * (1.0 + e))
+                bad = bad | ~np.isfinite(g) | (e > STRETCH_CAP - 1.0)
+                dy = np.empty((m, sel.size))
+                dy[0] = -g / scale[sel]
+                if variational:
+                    k = fluid._flow_index(q[live][sel], a * (1.0 + e))
+                    c = -(1.0 + 3.0 * k) * g / ((1.0 + e) * wall._stiffness(1.0 + e, tb))
+                    dy[1] = -k * g / scale[sel] - c * ys[1]
+                    dy[2] = -c * ys[2]
+            return np.where(bad, np.nan, dy)
 
         stages = _dop.N_STAGES
         A, B, C, E3, E5 = _dop.A[:stages, :stages], _dop.B, _dop.C[:stages], _dop.E3, _dop.E5
         z = L[live].copy()
-        y = np.zeros(live.size)
+        y = np.zeros((m, live.size))
+        if variational:
+            y[2] = 1.0
         span = z - z_end[live]
         h = -np.minimum(span, span * rtol ** 0.125 * 4)
         f = rhs(z, y, np.arange(live.size))
@@ -354,35 +570,43 @@ class Graded(Coupler):
             sel = np.flatnonzero(active)
             if sel.size == 0:
                 break
-            zs, ys, hs = z[sel], y[sel], h[sel]
+            zs, ys, hs = z[sel], y[:, sel], h[sel]
             target = z_end[live][sel]
             if breaks.size:          # the next breakpoint below z (strictly), else the end
                 j = np.searchsorted(breaks, zs, side="left") - 1
                 nxt = np.where(j >= 0, breaks[np.maximum(j, 0)], -np.inf)
                 target = np.maximum(target, nxt)
             hs = np.maximum(hs, target - zs)              # h < 0: not beyond the stop
-            K = np.empty((stages + 1, sel.size))
-            K[0] = f[sel]
+            K = np.empty((stages + 1, m, sel.size))
+            K[0] = f[:, sel]
             for s in range(1, stages):
-                dy = (K[:s].T @ A[s, :s]) * hs
-                K[s] = rhs(zs + C[s] * hs, ys + dy, sel)
-            y_new = ys + hs * (K[:-1].T @ B)
+                K[s] = rhs(zs + C[s] * hs, ys + np.einsum("s,smn->mn", A[s, :s], K[:s]) * hs, sel)
+            y_new = ys + hs * np.einsum("s,smn->mn", B, K[:-1])
             land = np.abs(target - (zs + hs)) <= 1e-15 * np.abs(zs) + 1e-300
             z_new = np.where(land, target, zs + hs)
             K[-1] = rhs(z_new, y_new, sel)
             sc = atol + rtol * np.maximum(np.abs(ys), np.abs(y_new))
             with np.errstate(all="ignore"):
-                e5 = (K.T @ E5) / sc
-                e3 = (K.T @ E3) / sc
+                e5 = np.einsum("s,smn->mn", E5, K) / sc
+                e3 = np.einsum("s,smn->mn", E3, K) / sc
                 denom = np.sqrt(e5**2 + 0.01 * e3**2)
-                err = np.abs(hs) * np.where(denom > 0, e5**2 / denom, 0.0)
-            broken = ~(np.isfinite(err) & np.isfinite(y_new) & np.all(np.isfinite(K), axis=0))   # beyond the law
+                err = np.abs(hs) * np.max(np.where(denom > 0, e5**2 / denom, 0.0)[:control], axis=0)
+            broken = ~(np.isfinite(err) & np.all(np.isfinite(y_new), axis=0)
+                       & np.all(np.isfinite(K), axis=(0, 1)))   # beyond the law
             good = ~broken & (err <= 1.0)
             with np.errstate(all="ignore", divide="ignore"):
                 factor = np.where(np.isfinite(err) & (err > 0), 0.9 * err ** -0.125, 10.0)
             factor = np.where(good, np.clip(factor, 1.0, 10.0), np.where(broken, 0.1, np.clip(factor, 0.2, 0.9)))
             acc = sel[good]
-            z[acc], y[acc], f[acc] = z_new[good], y_new[good], K[-1][good]
+            z[acc], y[:, acc], f[:, acc] = z_new[good], y_new[:, good], K[-1][:, good]
+            if acc.size:              # within 1e-10 of a local limit pressure short of the end: stop
+                wall, _, tb = scene.at_position(z[acc], idx[acc])
+                lim = np.asarray(wall._limit_pressure(tb), dtype=float) + 0.0 * z[acc]
+                p = p_out[live][acc] + y[0, acc] * scale[acc]
+                with np.errstate(invalid="ignore"):
+                    near = np.isfinite(lim) & (p >= lim - _NEAR_LIMIT * np.abs(lim)) & (z[acc] > z_end[live][acc])
+                stopped[acc[near]] = True
+                active[acc[near]] = False
             h[sel] = hs * factor
             done = good & (z_new <= z_end[live][sel])
             active[sel[done]] = False
@@ -402,17 +626,19 @@ class Graded(Coupler):
             if not math.isfinite(limit):
                 raise StretchRangeError(math.nan, float(q[live][i]), where.replace("the pressure reaches the local "
                                         "limit of the tube law", "the tube inflates beyond").split(":")[0])
-            raise NoSteadyStateError("pressure", limit, float(p_out[live][i] + y[i] * scale[i]), where,
+            raise NoSteadyStateError("pressure", limit, float(p_out[live][i] + y[0, i] * scale[i]), where,
                                      name="the (transmural) pressure")
         y = np.where(stopped, np.inf, y)
-        out[live] = y * scale
-        return out.reshape(shape)
+        out[:, live] = y
+        out[:2, live] *= scale
+        return _unpack(out, shape, variational)
 
     def _flow_rate(self, scene, dp):
         r"""The flow rates with pressure drop ``dp`` (per point): bracketed root finding on
         :math:`\ln\Delta p(\ln q)` with a loose integration (1e-9), then Newton steps with the
-        integration at ``rtol`` (the slope differenced from the loose one); the flow rate's error
-        is estimated from the pressure drop at 100 ``rtol`` over that slope."""
+        integration at ``rtol`` (the slope from the variational equations); the flow rate's error
+        is estimated from the pressure drop at 100 ``rtol`` over that slope. A drop whose residual
+        stays above 1e-9 there is beyond every steady state (``NoSteadyStateError``)."""
         n = dp.size
         q = np.zeros(n)
         live = np.flatnonzero(dp > 0)
@@ -450,19 +676,39 @@ class Graded(Coupler):
         res = elementwise.find_root(f, br.bracket, args=(ids, log_dp), tolerances=dict(xrtol=1e-11, xatol=1e-11))
         if not np.all(res.success):
             raise ConvergenceError("the flow rate of a graded tube under a pressure drop did not converge")
-        x = res.x
-        step = 1e-4
-        slope = (f(x + step, ids, log_dp) - f(x - step, ids, log_dp)) / (2 * step)   # d ln dp / d ln q
-        if not np.all(np.isfinite(slope) & (slope > 0)):
-            raise ConvergenceError("the pressure drop of a graded tube does not increase with the flow rate")
+        # the root, or the end of the bracket below the limit (a drop beyond every steady state
+        # brackets the edge of the feasible flow rates instead: its residual stays large below)
+        x = np.where(res.f_x < 50.0, res.x, res.bracket[0])
+        rise, w, _ = self._integrate(scene, np.exp(x), np.zeros(x.size), loose, index=ids, strict=False,
+                                     variational=True, control=1)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            slope = w / rise                                     # d ln dp / d ln q, exact
+        slope = np.where(np.isfinite(slope) & (slope > 0), slope, 1.0)
         for _ in range(4):
             miss = f(x, ids, log_dp, self.rtol)
-            x = x - miss / slope
+            x = x - np.where(miss < 50.0, miss, 0.0) / slope
             if np.all(np.abs(miss / slope) <= 1e-15 * np.maximum(1.0, np.abs(x))):
                 break
+        miss = f(x, ids, log_dp, self.rtol)
+        beyond = ~(np.abs(miss) <= 1e-9)
+        if np.any(beyond):
+            i = int(np.flatnonzero(beyond)[0])
+            reached = float(p_out[i] + dp[live][i] * math.exp(min(float(miss[i]), 0.0)))
+            raise NoSteadyStateError("pressure", reached, float(p_out[i] + dp[live][i]),
+                                     "the largest inlet pressure with a steady state, that of the maximum flow rate "
+                                     "(the pressure touches the local limit pressure of a section downstream); "
+                                     "the limit given is the inlet pressure reached below it",
+                                     name="the inlet pressure")
         miss_coarse = f(x, ids, log_dp, 100 * self.rtol) - f(x, ids, log_dp, self.rtol)
         q[live] = np.exp(x)
         return q, np.max(np.abs(miss_coarse / slope), initial=0.0)
+
+
+def _unpack(out, shape, variational):
+    """``(rise, W, V)`` from the integration's rows, in ``shape`` (``W, V`` None unless variational)."""
+    if not variational:
+        return out[0].reshape(shape), None, None
+    return tuple(row.reshape(shape) for row in out)
 
 
 def _uniform_coupler(choice, scene):
