@@ -199,8 +199,12 @@ class HyperelasticWallContract(WallContract):
             assert _rel(wall.small_strain_modulus(tb), linear.small_strain_modulus(tb)) < 1e-8
 
     def test_closed_forms_match_generic_theory(self, wall):
-        """Overrides agree with the base class's derivation from dW alone."""
+        """Overrides agree with the base class's derivation from dW alone (where the installed
+        tube's rest state is homogeneous: a pre-stretched fibre wall's is not, and its thick law
+        is not the Lamé integral of its membrane law)."""
         theory = ThickWall if isinstance(wall, ThickWall) else ThinWall
+        if theory is ThickWall and not wall._homogeneous_rest():
+            pytest.skip("a rest state that is not homogeneous")
         for tb in (0.05, 0.5):
             lam = np.array([1.0 + 1e-3, 1.3, 2.0, 3.0])
             lam = np.minimum(lam, 1 + 0.999 * (wall.max_stretch(tb) - 1))
