@@ -4,7 +4,9 @@ The tube is clamped (axial stretch 1), so a material point at radius :math:`r`
 moves to :math:`R` with stretches :math:`(r/R, R/r, 1)`. The reduced strain
 energy is :math:`\hat W(\lambda) = W(1/\lambda, \lambda, 1)` and a material
 subclass gives only its derivative ``_dW(stretch)`` (or ``_energy(stretch)``,
-differentiated numerically). The wall theory is chosen by composition:
+differentiated numerically, or, for an isotropic :math:`W(I_1, I_2)`, ``_W1`` and ``_W2``,
+which also serve an axial pre-stretch: ``docs/walls_beyond.md``, section "Axial pre-stretch").
+The wall theory is chosen by composition:
 
 ================================  ==========================================================
 theory                            tube law :math:`P(\lambda; \bar t)`
@@ -79,33 +81,32 @@ class HyperelasticWall(WallModel):
 
     Hooks of a material (arrays of stretches; implement ``_dW``, ``_W1`` or ``_energy``, override
     the others for speed or accuracy). With an ``axial_stretch`` :math:`\lambda_z` field (the
-    :func:`axial_stretch` parameter) the stretch is the installed tube's and ``_dW`` is its law
+    ``axial_stretch()`` parameter) the stretch is the installed tube's and ``_dW`` is its law
     :math:`D(\lambda) = \hat W'(\lambda/\sqrt{\lambda_z};\lambda_z)/\sqrt{\lambda_z}`
     (``docs/walls_beyond.md``, section "Axial pre-stretch"; :math:`\hat W'` at :math:`\lambda_z = 1`):
 
-    ===========================  ============================================================
-    hook                         default
-    ===========================  ============================================================
-    ``_dW(stretch)``             natural hook: :math:`D(\lambda)`, or from ``_W1``/``_W2``, or
-                                 ``_energy`` differentiated numerically
-    ``_W1(i1, i2)``              natural hook of an isotropic material :math:`W(I_1, I_2)`:
-                                 :math:`\partial W/\partial I_1` at :math:`I_1 - 3 =` ``i1``,
-                                 :math:`I_2 - 3 =` ``i2``; the base derives :math:`D = F(\lambda -
-                                 \lambda^{-3})`, :math:`F = 2(W_1 + \lambda_z^2W_2)/\lambda_z`, its
-                                 slope and the thick integrand :math:`F(\lambda^2+1)/\lambda^3`
-                                 (no removable singularity) at every :math:`\lambda_z`
-    ``_W2(i1, i2)``              0; :math:`\partial W/\partial I_2`
-    ``_W_second(i1, i2)``        None (then :math:`D'` numerically);
-                                 ``(W11, W12, W22)``, the second derivatives
-    ``_energy(stretch)``         :math:`\hat W(\lambda)` (optional natural hook, plane strain)
-    ``_d2W(stretch)``            :math:`D'(\lambda)`: from the invariants, else by ``scipy.differentiate``
-    ``_current_slope(stretch)``  :math:`d(D/\lambda)/d\lambda` (thin, current thickness)
-    ``_locking_stretch()``       ``inf``; the stretch where :math:`D` blows up (Gent)
-    ``_thick_integrand(s)``      :math:`D(s)/(s^2-1)`, with the removable singularity at
-                                 :math:`s = 1` taken from ``_d2W``; override with a form free of it
-    ``_installed_cross_section`` the tube over :math:`\sqrt{\lambda_z}` across (a homogeneous rest
-    ``(tube)``                   state); ``(radius, thickness)`` of the installed tube at rest
-    ===========================  ============================================================
+    ================================  ================================================================
+    hook                              default
+    ================================  ================================================================
+    ``_dW(stretch)``                  natural hook: :math:`D(\lambda)`, or from ``_W1``/``_W2``, or
+                                      ``_energy`` differentiated numerically
+    ``_W1(i1, i2)``                   natural hook of an isotropic material :math:`W(I_1, I_2)`:
+                                      :math:`\partial W/\partial I_1` at :math:`I_1 - 3 =` ``i1``, :math:`I_2 - 3 =` ``i2``;
+                                      the base derives :math:`D = F(\lambda - \lambda^{-3})`,
+                                      :math:`F = 2(W_1 + \lambda_z^2W_2)/\lambda_z`, its slope and the thick
+                                      integrand :math:`F(\lambda^2+1)/\lambda^3` at every :math:`\lambda_z`
+    ``_W2(i1, i2)``                   0; :math:`\partial W/\partial I_2`
+    ``_W_second(i1, i2)``             None (then :math:`D'` numerically); ``(W11, W12, W22)``
+    ``_energy(stretch)``              :math:`\hat W(\lambda)` (optional natural hook, plane strain)
+    ``_d2W(stretch)``                 :math:`D'(\lambda)`: from the invariants, else by ``scipy.differentiate``
+    ``_current_slope(stretch)``       :math:`d(D/\lambda)/d\lambda` (thin wall, current thickness)
+    ``_locking_stretch()``            ``inf``; the stretch where :math:`D` blows up (Gent)
+    ``_thick_integrand(s)``           :math:`D(s)/(s^2-1)`, with the removable singularity at
+                                      :math:`s = 1` taken from ``_d2W``; override with a form free of it
+    ``_installed_cross_section``      ``(radius, thickness)`` of the installed tube at rest: the
+                                      stress-free ones over :math:`\sqrt{\lambda_z}` (a homogeneous rest state)
+    ``_homogeneous_rest()``           True; False where the rest state is solved for (fibres)
+    ================================  ================================================================
 
     The theory (:class:`ThinWall` with a ``thickness_convention``, or :class:`ThickWall`) gives
     ``_pressure_at_strain`` and ``_stiffness``; the :class:`~tubefsi.walls.WallModel` hooks
