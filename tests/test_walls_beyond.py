@@ -757,11 +757,14 @@ def test_hgo_in_situ_validates():
 
 
 class TestStiffHGOInSitu(tubefsi.testing.AccuracyContract):
-    """A stiff fibre law (k2 = 20, fibres stretched at rest) pre-stretched (thin), and a stiff
-    Fung (b = 20) at lz = 1.3, against the brute force."""
+    """A stiff fibre law (k2 = 20, fibres stretched at rest) pre-stretched (thin), a thin fibre law
+    whose fibres are slack at rest and engage inside the flow (the quadratures split there), and
+    a stiff Fung (b = 20) at lz = 1.3, against the brute force."""
 
     @pytest.fixture(params=tubefsi.testing.accuracy_cases(
-        [walls["thin-hgo"](axial_stretch=1.3, thickness_convention="current", **STIFF_HGO)]
+        [walls["thin-hgo"](axial_stretch=1.3, thickness_convention="current", **STIFF_HGO),
+         walls["thin-hgo"](shear_modulus=1e3, fibre_stiffness=5e3, fibre_exponent=2.0, fibre_angle=0.7,
+                           thickness_convention="current", axial_stretch=0.9)]
         + ([walls["thick-fung"](shear_modulus=1e3, stiffening=20.0, axial_stretch=1.3)] if "thick-fung" in walls else []),
         [POWER_LAW]))
     def case(self, request):

@@ -150,6 +150,26 @@ class HolzapfelGasserOgden(HyperelasticWall):
     def _rest_kind(self):
         return "installed"
 
+    def _slope_kinks(self, tb):
+        r"""Where the fibres engage: :math:`\lambda = 1` clamped at the stress-free length; in situ the
+        stretches where the lumen fibre (and, thick, the outer one) crosses :math:`I_4 = 1`."""
+        if not self._in_situ():
+            return (1.0 + 0.0 * np.asarray(tb, dtype=float),)
+        shape, wall, (t,) = flat_points(self, tb)
+        t = np.broadcast_to(t, (max(1, np.size(t)),))
+        law = insitu.Law.of(wall)
+        e0 = insitu.rest(wall, t, self._rest_kind())
+        thin = self._rest_kind() == "membrane"
+        w_outer = 1.0 if thin else 1.0 / (1.0 + (1.0 + e0) * t * (2.0 + t))
+        out = []
+        for w in ((1.0,) if thin else (1.0, w_outer)):
+            with np.errstate(divide="ignore", invalid="ignore"):
+                e = -law.x0 * law.lz / (law.c2 * w)
+                lam = np.sqrt((1.0 + e) / (1.0 + e0))
+            out.append(np.where(np.isfinite(lam) & (lam > 0), lam, np.nan).reshape(shape) if shape else
+                       float(np.where(np.isfinite(lam) & (lam > 0), lam, np.nan)[0]))
+        return tuple(out)
+
     def _homogeneous_rest(self) -> bool:
         return not self._in_situ()
 
