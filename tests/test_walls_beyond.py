@@ -597,7 +597,7 @@ def test_axial_stretch_of_plugin_materials_validates_and_locks():
     assert "axial_stretch" in names
 
 
-@settings(deadline=None, max_examples=8)
+@settings(deadline=None, max_examples=6)
 @given(delta=st.floats(-1e-6, 1e-6), name=st.sampled_from(["thick-gent", "thin-fung", "thick-ogden", "thin-yeoh",
                                                            "thick-hgo", "thin-hgo"]),
        lam=st.floats(1.001, 1.5))
@@ -610,7 +610,7 @@ def test_axial_stretch_near_one_gives_todays_walls(delta, name, lam):
     assert abs(near.pressure(lam, tb) / base.pressure(lam, tb) - 1) <= 50 * abs(delta) + 1e-13
 
 
-@settings(deadline=None, max_examples=6)
+@settings(deadline=None, max_examples=4)
 @given(lz=st.lists(st.floats(0.85, 1.8), min_size=2, max_size=3), name=st.sampled_from(["thick-hgo", "thin-hgo",
                                                                                         "thick-fung", "thin-gent"]))
 def test_axial_stretch_broadcasts_like_a_loop(lz, name):
@@ -628,8 +628,8 @@ def test_axial_stretch_broadcasts_like_a_loop(lz, name):
 
 
 # ------------------------------------------------------------------ 7. HGO in situ
-HGO_CASES = [("rabbit-carotid-media", 1.7), ("rabbit-carotid-media", 1.3), ("rabbit-carotid-media", 0.8),
-             ("rabbit-carotid-adventitia", 1.2), ("stiff", 1.3)]
+HGO_CASES = [("rabbit-carotid-media", 1.7), ("rabbit-carotid-media", 1.3), ("rabbit-carotid-adventitia", 0.8),
+             ("stiff", 1.3)]
 STIFF_HGO = dict(shear_modulus=1e3, fibre_stiffness=1e4, fibre_exponent=20.0, fibre_angle=0.7)
 
 
@@ -757,14 +757,13 @@ def test_hgo_in_situ_validates():
 
 
 class TestStiffHGOInSitu(tubefsi.testing.AccuracyContract):
-    """A stiff fibre law (k2 = 20, fibres stretched at rest) pre-stretched (thin), a thin fibre law
-    whose fibres are slack at rest and engage inside the flow (the quadratures split there), and
-    a stiff Fung (b = 20) at lz = 1.3, against the brute force."""
+    """A stiff thin fibre law (k2 = 20) at lz = 1.3, whose fibres are slack at rest and engage at
+    the stretch 1.10, inside the flow (the quadratures split there), and a stiff thick Fung
+    (b = 20) at lz = 1.3, against the brute force."""
 
     @pytest.fixture(params=tubefsi.testing.accuracy_cases(
-        [walls["thin-hgo"](axial_stretch=1.3, thickness_convention="current", **STIFF_HGO),
-         walls["thin-hgo"](shear_modulus=1e3, fibre_stiffness=5e3, fibre_exponent=2.0, fibre_angle=0.7,
-                           thickness_convention="current", axial_stretch=0.9)]
+        [walls["thin-hgo"](shear_modulus=1e3, fibre_stiffness=1e4, fibre_exponent=20.0, fibre_angle=0.3,
+                           thickness_convention="current", axial_stretch=1.3)]
         + ([walls["thick-fung"](shear_modulus=1e3, stiffening=20.0, axial_stretch=1.3)] if "thick-fung" in walls else []),
         [POWER_LAW]))
     def case(self, request):

@@ -27,7 +27,7 @@ import functools
 import numpy as np
 
 from .._lazy import lazy_module
-from .._quadrature import adaptive, quiet, warn_unconverged
+from .._quadrature import Integral, adaptive, quiet, warn_unconverged
 from ..errors import ConvergenceError, InvalidParameterError
 
 elementwise = lazy_module("scipy.optimize.elementwise", globals(), "elementwise")
@@ -135,15 +135,8 @@ def integrate(f, width, kinks, what, atol=0.0):
     # point is judged on its total
     ok |= error <= np.maximum(atol, RTOL * np.abs(value))
     if not np.all(ok):
-        warn_unconverged(what, _Result(value, error, ok))
+        warn_unconverged(what, Integral(value=value, error=error, converged=ok, panels=np.zeros(value.shape, int)))
     return value
-
-
-class _Result:
-    __slots__ = ("value", "error", "converged")
-
-    def __init__(self, value, error, converged):
-        self.value, self.error, self.converged = value, error, converged
 
 
 # ------------------------------------------------------------------ the rest state
@@ -212,6 +205,7 @@ def thick_rest(law, tb, installed):
         res = elementwise.find_root(f, bracket.bracket, args=(np.arange(need.size),), tolerances=_TOL)
     if not np.all(bracket.success & res.success):
         raise ConvergenceError("the rest state of the pre-stretched thick HGO tube did not converge")
+    f(res.x, np.arange(need.size))          # the root's own quadrature, its estimate checked (AccuracyWarning)
     e0[need] = res.x
     return e0
 
