@@ -156,7 +156,7 @@ class HolzapfelGasserOgden(HyperelasticWall):
         if not self._in_situ():
             return (1.0 + 0.0 * np.asarray(tb, dtype=float),)
         shape, wall, (t,) = flat_points(self, tb)
-        t = np.broadcast_to(t, (max(1, np.size(t)),))
+        t = np.broadcast_to(t, (max(1, math.prod(shape)),))
         law = insitu.Law.of(wall)
         e0 = insitu.rest(wall, t, self._rest_kind())
         thin = self._rest_kind() == "membrane"
@@ -224,14 +224,14 @@ class ThickHGO(ThickWall, HolzapfelGasserOgden):
         if not self._in_situ():
             return super()._pressure_at_strain(strain, tb)
         shape, wall, (e, t) = flat_points(self, strain, tb)
-        e = np.broadcast_to(e, (max(1, e.size),))
+        e = np.broadcast_to(e, (max(1, math.prod(shape)),))   # with the parameters: a scalar strain too
         return insitu.thick_pressure(wall, e, t).reshape(shape)
 
     def _stiffness(self, stretch, tb):
         if not self._in_situ():
             return super()._stiffness(stretch, tb)
         shape, wall, (lam, t) = flat_points(self, stretch, tb)
-        lam = np.broadcast_to(lam, (max(1, lam.size),))
+        lam = np.broadcast_to(lam, (max(1, math.prod(shape)),))
         return insitu.thick_pressure(wall, lam - 1.0, t, slope=True).reshape(shape)
 
     def _pressure_needs_quadrature(self) -> bool:
