@@ -23,6 +23,8 @@ from tubefsi.fields import positive
 from tubefsi.walls import HyperelasticWall, ThickWall, ThinWall
 from tubefsi.walls.hyperelastic import axial_stretch
 
+from ._forms import quartic
+
 __all__ = ["Fung", "ThinFung", "ThickFung"]
 
 
@@ -63,6 +65,25 @@ class Fung(HyperelasticWall):
 
     def _W_second(self, i1, i2):
         return self.stiffening * self._W1(i1, i2), 0.0, 0.0
+
+    # the installed law from the invariants, written out in the plane-strain forms' order of
+    # operations: at lz = 1 they are those forms bit for bit (D = F (s - s^-3), F = (mu/lz) e^{b y})
+    def _growth(self, s):
+        with np.errstate(over="ignore"):
+            return np.exp(self.stiffening * self._installed_invariants(s)[0])
+
+    def _dW(self, s):
+        return self.shear_modulus / self.axial_stretch * quartic(s) * self._growth(s)
+
+    def _d2W(self, s):
+        lz = self.axial_stretch
+        with np.errstate(over="ignore", invalid="ignore"):
+            return self.shear_modulus / lz * self._growth(s) * (1.0 + 3.0 * s**-4
+                                                               + 2.0 * (self.stiffening / lz) * quartic(s) ** 2)
+
+    def _thick_integrand(self, s):
+        with np.errstate(over="ignore"):
+            return self.shear_modulus / self.axial_stretch * (s * s + 1.0) / s**3 * self._growth(s)
 
 
 @attrs.frozen(kw_only=True)
