@@ -479,3 +479,306 @@ def test_network_external_pressure_per_tube():
     assert sol.external_pressure == p_e["b"]
     with pytest.raises(tubefsi.InvalidParameterError, match="external_pressure"):
         tubefsi.Network(rheology=fluid).add_tube("x", "y", wall, tube, external_pressure=float("nan"))
+
+
+# ------------------------------------------------------------------ 6. axial pre-stretch of every material
+def axial_dW_of(name, params, lz):
+    r""":math:`\hat W'(s; \lambda_z)` of a 3-D energy, written by hand (the reference materials'
+    ``dW_axial``, or the HGO one below) and checked against ``mpmath.diff`` of the energy
+    :math:`W(1/(s\lambda_z), s, \lambda_z)` at two stretches."""
+    from tubefsi.testing.reference import tube_laws as ref
+
+    if name == "hgo":
+        dW, energy = hgo_axial(**params, lz=lz)
+    else:
+        mat = {"gent": lambda: ref.Gent(params["shear_modulus"], params["locking_parameter"]),
+               "fung": lambda: ref.Fung(params["shear_modulus"], params["stiffening"]),
+               "yeoh": lambda: ref.Yeoh(params["c1"], params["c2"], params["c3"]),
+               "ogden": lambda: ref.Ogden(params["moduli"], params["exponents"])}[name]()
+        L = mp.mpf(lz)
+        dW = lambda s: mat.dW_axial(s, L)     # noqa: E731
+        energy = lambda s: mat.W(1 / (s * L), s, L)     # noqa: E731
+    for s in (mp.mpf("0.83"), mp.mpf("1.37")):
+        assert abs(dW(s) / mp.diff(energy, s) - 1) < mp.mpf(10) ** (8 - mp.mp.dps)
+    return dW
+
+
+def hgo_axial(shear_modulus, fibre_stiffness, fibre_exponent, fibre_angle, lz):
+    r"""The HGO energy under the axial stretch ``lz`` (stretches :math:`1/(s\lambda_z), s, \lambda_z`) and
+    :math:`\hat W'` by hand: :math:`\mu(s - s^{-3}\lambda_z^{-2}) + 4k_1\cos^2\beta\,s\,x\,e^{k_2x^2}[x > 0]`,
+    :math:`x = s^2\cos^2\beta + \lambda_z^2\sin^2\beta - 1`."""
+    mu, k1, k2, L = (mp.mpf(v) for v in (shear_modulus, fibre_stiffness, fibre_exponent, lz))
+    c2, s2 = mp.cos(mp.mpf(fibre_angle)) ** 2, mp.sin(mp.mpf(fibre_angle)) ** 2
+
+    def energy(s):
+        i1 = (s * L) ** -2 + s**2 + L**2
+        x = s**2 * c2 + L**2 * s2 - 1
+        return mu / 2 * (i1 - 3) + (k1 / k2 * (mp.exp(k2 * x**2) - 1) if x > 0 else 0)
+
+    def dW(s):
+        x = s**2 * c2 + L**2 * s2 - 1
+        return mu * (s - s**-3 / L**2) + (4 * k1 * c2 * s * x * mp.exp(k2 * x**2) if x > 0 else 0)
+
+    dW.kink = mp.sqrt((1 - L**2 * s2) / c2) if 1 - L**2 * s2 > 0 else None     # where the fibres engage
+    return dW, energy
+
+
+def s_integral(dW, lz, tb):
+    r"""The thick law in the lumen stretch :math:`s_i` from the stress-free tube,
+    :math:`\int_{s_o}^{s_i}\hat W'(s)/(\lambda_z s^2 - 1)\,ds` (mpmath; split where the fibres engage),
+    and its derivative in :math:`s_i` (Leibniz, :math:`ds_o/ds_i = s_i/(b s_o)`)."""
+    L, b = mp.mpf(lz), (1 + mp.mpf(tb)) ** 2
+
+    def outer(si):
+        return mp.sqrt((1 + (L * si**2 - 1) / b) / L)
+
+    def law(si):
+        so = outer(si)
+        pts = sorted([so, si] + [k for k in [getattr(dW, "kink", None)] if k is not None and min(so, si) < k < max(so, si)])
+        return mp.quad(lambda s: dW(s) / (L * s**2 - 1), pts) * (1 if si >= so else -1)
+
+    def slope(si):
+        so = outer(si)
+        return dW(si) / (L * si**2 - 1) - dW(so) / (L * so**2 - 1) * si / (b * so)
+
+    return law, slope
+
+
+ISOTROPIC = {"gent": dict(shear_modulus=2e3, locking_parameter=3.0), "fung": dict(shear_modulus=2e3, stiffening=0.7),
+             "yeoh": dict(c1=1e3, c2=-120.0, c3=8.0), "ogden": dict(moduli=(2008.5, 14.75, 49.05), exponents=(1.3, 5.0, -2.0))}
+
+
+@pytest.mark.parametrize("name", sorted(ISOTROPIC))
+@pytest.mark.parametrize("lz", [0.8, 1.6])
+def test_axial_stretch_of_plugin_materials_matches_mpmath(name, lz):
+    """Gent, Fung, Yeoh, Ogden installed at lz: the thick law against the s-integral of the 3-D
+    energy (mpmath), including a collapsing stretch; the thin laws against the membrane forms
+    tb W'(s_i)/sqrt(lz) and tb W'(s_i)/(lz s_i), s_i = lam/sqrt(lz) (the installed rest lumen
+    a/sqrt(lz), as for every isotropic material)."""
+    pytest.importorskip("tubefsi_hyperelastic")
+    dW = axial_dW_of(name, ISOTROPIC[name], lz)
+    thick = walls[f"thick-{name}"](axial_stretch=lz, **ISOTROPIC[name])
+    thin = {c: walls[f"thin-{name}"](axial_stretch=lz, thickness_convention=c, **ISOTROPIC[name])
+            for c in ("reference", "current")}
+    with mp.workdps(20):
+        for tb in (0.05, 1.2):
+            law, _ = s_integral(dW, lz, tb)
+            top = min(thick.max_stretch(tb), thin["current"].max_stretch(tb))
+            for lam in (1.0 + 0.5 * (thick.min_stretch(tb) - 1.0), 1.01, min(2.0, 1 + 0.9 * (top - 1))):
+                s_i = mp.mpf(lam) / mp.sqrt(lz)
+                assert thick.pressure(lam, tb) == pytest.approx(float(law(s_i)), rel=1e-12)
+                assert thin["reference"].pressure(lam, tb) == pytest.approx(float(tb * dW(s_i) / mp.sqrt(lz)), rel=1e-12)
+                assert thin["current"].pressure(lam, tb) == pytest.approx(float(tb * dW(s_i) / (lz * s_i)), rel=1e-12)
+
+
+def test_axial_stretch_of_plugin_materials_validates_and_locks():
+    """Gent's lock and Fung's maximum stretch in the installed variables (where I1 - 3 = J_m and
+    b (I1 - 3) = 600, solved in mpmath from the stretches); typed errors where the installed tube
+    at rest is beyond them, or has no positive small-strain modulus (Yeoh, Ogden)."""
+    pytest.importorskip("tubefsi_hyperelastic")
+    lz = mp.mpf(1.5)
+
+    def installed_i1(sig):          # I1 - 3 at the installed stretch sigma = s sqrt(lz)
+        s = sig / mp.sqrt(lz)
+        return (s * lz) ** -2 + s**2 + lz**2 - 3
+
+    gent = walls["thick-gent"](shear_modulus=1.0, locking_parameter=3.0, axial_stretch=1.5)
+    assert gent.max_stretch(0.3) == pytest.approx(float(mp.findroot(lambda x: installed_i1(x) - 3, 2)), rel=1e-14)
+    fung = walls["thin-fung"](shear_modulus=1.0, stiffening=20.0, axial_stretch=1.5)
+    assert fung.max_stretch(0.3) == pytest.approx(float(mp.findroot(lambda x: 20 * installed_i1(x) - 600, 2)), rel=1e-14)
+    for name, kw in [("thick-gent", dict(shear_modulus=1.0, locking_parameter=0.5, axial_stretch=2.0)),
+                     ("thin-fung", dict(shear_modulus=1.0, stiffening=300.0, axial_stretch=2.5)),
+                     ("thick-yeoh", dict(c1=1.0, c2=-2.0, c3=0.0, axial_stretch=2.0)),
+                     ("thick-ogden", dict(moduli=(1.0, -0.9), exponents=(8.0, -2.0), axial_stretch=2.0)),
+                     ("thick-gent", dict(shear_modulus=1.0, locking_parameter=3.0, axial_stretch=0.0))]:
+        with pytest.raises(tubefsi.InvalidParameterError, match="axial_stretch"):
+            walls[name](**kw)
+    names = [p.name for p in tubefsi.fields.parameters(walls["thin-ogden"])]
+    assert "axial_stretch" in names
+
+
+@settings(deadline=None, max_examples=6)
+@given(delta=st.floats(-1e-6, 1e-6), name=st.sampled_from(["thick-gent", "thin-fung", "thick-ogden", "thin-yeoh",
+                                                           "thick-hgo", "thin-hgo"]),
+       lam=st.floats(1.001, 1.5))
+def test_axial_stretch_near_one_gives_todays_walls(delta, name, lam):
+    """lz -> 1: the tube law moves by O(delta) from the plane-strain wall (the fibre walls too)."""
+    pytest.importorskip("tubefsi_hyperelastic")
+    base = examples_of(name)
+    near = attrs_evolve(base, axial_stretch=1.0 + delta)
+    tb = 0.3
+    assert abs(near.pressure(lam, tb) / base.pressure(lam, tb) - 1) <= 50 * abs(delta) + 1e-13
+
+
+@settings(deadline=None, max_examples=4)
+@given(lz=st.lists(st.floats(0.85, 1.8), min_size=2, max_size=3), name=st.sampled_from(["thick-hgo", "thin-hgo",
+                                                                                        "thick-fung", "thin-gent"]))
+def test_axial_stretch_broadcasts_like_a_loop(lz, name):
+    """An array of axial stretches gives the scalar walls' values, entry by entry."""
+    pytest.importorskip("tubefsi_hyperelastic")
+    base = examples_of(name)
+    lam, tb = np.array([1.02, 1.3])[:, None], np.array([0.1, 0.4])[:, None]
+    wall = attrs_evolve(base, axial_stretch=np.array(lz))
+    got = wall.pressure(lam, tb)
+    assert got.shape == (2, len(lz))
+    for j, value in enumerate(lz):
+        one = attrs_evolve(base, axial_stretch=value)
+        np.testing.assert_allclose(got[:, j], one.pressure(lam[:, 0], tb[:, 0]), rtol=1e-13)
+        np.testing.assert_allclose(wall.stiffness(lam, tb)[:, j], one.stiffness(lam[:, 0], tb[:, 0]), rtol=1e-12)
+
+
+# ------------------------------------------------------------------ 7. HGO in situ
+HGO_CASES = [("rabbit-carotid-media", 1.7), ("rabbit-carotid-media", 1.3), ("rabbit-carotid-adventitia", 0.8),
+             ("stiff", 1.3)]
+STIFF_HGO = dict(shear_modulus=1e3, fibre_stiffness=1e4, fibre_exponent=20.0, fibre_angle=0.7)
+
+
+def hgo_params(preset):
+    from tubefsi.walls.hgo import PRESETS
+
+    return STIFF_HGO if preset == "stiff" else PRESETS[preset]
+
+
+@pytest.mark.parametrize("preset, lz", HGO_CASES)
+def test_hgo_in_situ_matches_mpmath(preset, lz):
+    r"""The pre-stretched HGO tube against the s-integral of its 3-D energy (mpmath): the rest
+    lumen (the root of the law at zero pressure, stress-free geometry), the installed thickness
+    (incompressibility), the thick law and its slope in the installed stretch
+    :math:`\lambda = s_i/s_{i0}` (a collapsing stretch, a tiny strain, inflation past the point where
+    slack fibres engage inside the wall at lz = 1.3), and the membrane (thin) laws with the
+    membrane rest lumen :math:`\hat W'(s_0) = 0`."""
+    params = hgo_params(preset)
+    dW = axial_dW_of("hgo", params, lz)
+    thick = walls["thick-hgo"](axial_stretch=lz, **params)
+    thin = {c: walls["thin-hgo"](axial_stretch=lz, thickness_convention=c, **params) for c in ("reference", "current")}
+    L = mp.mpf(lz)
+    with mp.workdps(20):
+        s0 = mp_root(dW, mp.mpf("0.2"), mp.mpf(3)) if dW(1 / mp.sqrt(L)) > 0 else 1 / mp.sqrt(L)   # membrane rest
+        for tb in (0.1, 0.5):
+            tube = tubefsi.Tube(radius=1.0, thickness=tb, length=1.0)
+            law, slope = s_integral(dW, lz, tb)
+            rest = mp_root(law, mp.mpf("0.3") * s0, s0 * (1 + mp.mpf(10) ** -25)) if law(s0) > 0 else s0
+            installed = thick._installed_tube(tube)
+            assert installed.radius == pytest.approx(float(rest), rel=1e-13)
+            outer = mp.sqrt(rest**2 + (2 * tb + tb**2) / L)                  # R_o^2 = R_i^2 + (B^2 - A^2)/lz
+            assert installed.thickness == pytest.approx(float(outer - rest), rel=1e-13)
+            assert installed.length == lz
+            tbi = installed.reduced_thickness
+            top = thick.max_stretch(tbi)
+            for lam in (1.0 + 0.5 * (thick.min_stretch(tbi) - 1.0), 1.0 + 1e-6, 1.05, min(1.5, 1 + 0.9 * (top - 1))):
+                s_i = rest * lam
+                assert thick.pressure(lam, tbi) == pytest.approx(float(law(s_i)), rel=1e-12), lam
+                assert thick.stiffness(lam, tbi) == pytest.approx(float(slope(s_i) * rest), rel=1e-11), lam
+            membrane = thin["current"]._installed_tube(tube)
+            assert membrane.radius == pytest.approx(float(s0), rel=1e-13)
+            assert membrane.thickness == pytest.approx(float(tb / (s0 * L)), rel=1e-13)
+            tbm = membrane.reduced_thickness
+            for lam in (1.0 + 0.5 * (thin["current"].min_stretch(tbm) - 1.0), 1.0 + 1e-6, 1.3):
+                w = dW(s0 * lam)
+                assert thin["reference"].pressure(lam, tbm) == pytest.approx(float(tbm * s0 * w), rel=1e-12)
+                assert thin["current"].pressure(lam, tbm) == pytest.approx(float(tbm * s0 * w / lam), rel=1e-12)
+
+
+def test_hgo_rest_state_against_an_ode_in_the_deformed_tube():
+    r"""An independent check of the in-situ rest lumen: :math:`d\sigma_r/dR = (\sigma_\theta - \sigma_r)/R`
+    integrated over the deformed wall by DOP853 (SciPy, rtol 1e-13), with the stresses from the
+    3-D energy's principal stretches at each R (:math:`\rho^2 = A^2 + \lambda_z(R^2 - R_i^2)`); from
+    :math:`\sigma_r(R_i) = 0` at the library's rest lumen it ends at :math:`\sigma_r(R_o) = 0`."""
+    from scipy.integrate import solve_ivp
+
+    params, lz, tb = hgo_params("rabbit-carotid-media"), 1.7, 0.4
+    wall = walls["thick-hgo"](axial_stretch=lz, **params)
+    installed = wall._installed_tube(tubefsi.Tube(radius=1.0, thickness=tb, length=1.0))
+    mu, k1, k2 = params["shear_modulus"], params["fibre_stiffness"], params["fibre_exponent"]
+    c2, s2 = math.cos(params["fibre_angle"]) ** 2, math.sin(params["fibre_angle"]) ** 2
+    r_i = installed.radius
+    r_o = r_i + installed.thickness
+
+    def radial_stress_at_outer(lumen, p):
+        """sigma_r at the outer surface from sigma_r(lumen) = -p; the material point of R has
+        rho^2 = 1 + lz (R^2 - lumen^2) in the stress-free tube (its lumen at rho = 1)."""
+        def difference(R):      # sigma_theta - sigma_r = lam_t W_t - lam_r W_r at the stretches of R
+            lt = R / math.sqrt(1.0 + lz * (R * R - lumen * lumen))
+            lr = 1.0 / (lt * lz)
+            x = lt * lt * c2 + lz * lz * s2 - 1.0
+            fibre = 4.0 * k1 * x * math.exp(k2 * x * x) * lt * lt * c2 if x > 0 else 0.0
+            return mu * (lt * lt - lr * lr) + fibre
+
+        outer = math.sqrt(lumen * lumen + (r_o * r_o - r_i * r_i))
+        end = solve_ivp(lambda R, y: [difference(R) / R], (lumen, outer), [-p], method="DOP853", rtol=1e-13,
+                        atol=1e-16).y[0, -1]
+        scale = solve_ivp(lambda R, y: [abs(difference(R)) / R], (lumen, outer), [0.0], method="DOP853",
+                          rtol=1e-10).y[0, -1]
+        return end, scale
+
+    end, scale = radial_stress_at_outer(r_i, 0.0)
+    assert abs(end) < 1e-12 * scale
+    # and the lumen 5 % wider: the same ODE from sigma_r = -P(1.05) ends at 0
+    end, scale = radial_stress_at_outer(1.05 * r_i, wall.pressure(1.05, installed.reduced_thickness))
+    assert abs(end) < 1e-12 * scale
+
+
+@pytest.mark.parametrize("lz", [1.7, 1.3])
+def test_artery_in_situ_solve_matches_mpmath(lz):
+    """solve() through the pre-stretched HGO media (thick), Newtonian, under an external pressure
+    that puts the outlet below rest: pressure drop and inlet radius against the mpmath solution
+    of the installed tube (rest lumen from the s-integral, length lz L) to 1e-11."""
+    params = hgo_params("rabbit-carotid-media")
+    wall = walls["thick-hgo"](axial_stretch=lz, **params)
+    tube = tubefsi.Tube(radius=1e-3, thickness=3e-4, length=2e-2)
+    dW = axial_dW_of("hgo", params, lz)
+    q, p_out, p_e = 2e-7, 20.0, 25.0
+    sol = tubefsi.solve(NEWTONIAN, wall, tube, flow_rate=q, outlet_pressure=p_out, external_pressure=p_e)
+    with mp.workdps(20):
+        law_s, slope_s = s_integral(dW, lz, tube.reduced_thickness)
+        s0 = mp_root(dW, mp.mpf("0.2"), mp.mpf(3))
+        rest = mp_root(law_s, mp.mpf("0.3") * s0, s0 * (1 + mp.mpf(10) ** -25))
+        installed = tubefsi.Tube(radius=float(rest) * tube.radius, thickness=1.0, length=tube.length * lz)
+        dp, e_in, _ = mp_reference(lambda lam: law_s(rest * lam), lambda lam: slope_s(rest * lam) * rest, NEWTONIAN,
+                                   installed, q, mp.mpf(p_out - p_e))
+    assert sol.tube.radius == pytest.approx(float(rest) * tube.radius, rel=1e-13)
+    assert sol.pressure_drop == pytest.approx(float(dp), rel=1e-11)
+    assert sol.radius(0.0) == pytest.approx(float((1 + e_in) * rest) * tube.radius, rel=1e-11)
+
+
+def test_hgo_in_situ_validates():
+    params = hgo_params("rabbit-carotid-media")
+    with pytest.raises(tubefsi.InvalidParameterError, match="axial_stretch"):     # k2 x0^2 >= 600 at rest
+        walls["thick-hgo"](**{**params, "fibre_exponent": 500.0}, axial_stretch=3.0)
+    with pytest.raises(tubefsi.InvalidParameterError, match="axial_stretch"):
+        walls["thin-hgo"](**params, axial_stretch=-1.0)
+    names = [p.name for p in tubefsi.fields.parameters(walls["thick-hgo"])]
+    assert "axial_stretch" in names
+    wall = walls["thick-hgo"].preset("rabbit-carotid-media", axial_stretch=1.7)
+    top = wall.max_stretch(0.3)
+    with pytest.raises(tubefsi.InvalidParameterError, match="stretch"):
+        wall.pressure(top * 1.0001, 0.3)
+    assert wall.min_pressure(0.3) == pytest.approx(-params["shear_modulus"] / 1.7 * (0.3 / 1.3) ** 3)
+
+
+class TestStiffHGOInSitu(tubefsi.testing.AccuracyContract):
+    """A stiff thin fibre law (k2 = 20) at lz = 1.3, whose fibres are slack at rest and engage at
+    the stretch 1.10, inside the flow (the quadratures split there), and a stiff thick Fung
+    (b = 20) at lz = 1.3, against the brute force."""
+
+    @pytest.fixture(params=tubefsi.testing.accuracy_cases(
+        [walls["thin-hgo"](shear_modulus=1e3, fibre_stiffness=1e4, fibre_exponent=20.0, fibre_angle=0.3,
+                           thickness_convention="current", axial_stretch=1.3)]
+        + ([walls["thick-fung"](shear_modulus=1e3, stiffening=20.0, axial_stretch=1.3)] if "thick-fung" in walls else []),
+        [POWER_LAW]))
+    def case(self, request):
+        return request.param
+
+
+def test_docs_artery_in_situ_example():
+    """The numbers docs/walls_beyond.md quotes for its artery in situ (section "Examples")."""
+    blood = tubefsi.registry.rheologies["power-law"](consistency=0.017, index=0.7)
+    artery = walls["thick-hgo"].preset("rabbit-carotid-media", axial_stretch=1.7)
+    tube = tubefsi.Tube(radius=1.5e-3, thickness=4e-4, length=5e-2)
+    rest = tubefsi.solve(blood, artery, tube, flow_rate=0.0).tube
+    assert (round(rest.radius, 7), round(rest.thickness, 7), rest.length) == (1.0821e-3, 3.218e-4, 0.085)
+    assert round(artery.min_pressure(rest.reduced_thickness), 2) == -21.25
+    sol = tubefsi.solve(blood, artery, tube, flow_rate=2e-6, outlet_pressure=1e3, external_pressure=1.01e3)
+    assert round(sol.pressure_drop, 1) == 427.4
+    ratios = sol.radius(np.linspace(0, sol.tube.length, 5)) / rest.radius
+    np.testing.assert_array_equal(np.round(ratios, 3), [1.226, 1.176, 1.120, 1.060, 0.996])

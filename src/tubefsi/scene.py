@@ -415,6 +415,9 @@ def _graded_scene(rheology, wall, tube, outlet_pressure, external_pressure):
     lz = getattr(wall, "axial_stretch", 1.0)
     if np.ndim(lz) != 0:
         raise InvalidParameterError("axial_stretch", "a number for a tube or wall that varies along z", lz)
+    if lz != 1.0 and not getattr(wall, "_homogeneous_rest", lambda: True)():
+        raise InvalidParameterError("axial_stretch", "1 for a pre-stretched fibre wall on a tube or wall that varies "
+                                    "along z", lz, "its installed rest state depends on the local geometry")
     if lz != 1.0:
         shrink = 1.0 / math.sqrt(lz)
         fields = {n: (v.scaled(shrink, 1.0 / lz) if isinstance(v, Profile) else v * shrink)

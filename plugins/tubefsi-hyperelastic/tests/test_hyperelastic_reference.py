@@ -39,12 +39,15 @@ def material(wall):
     """The reference material of a tubefsi wall, from its parameters."""
     name = type(wall).__name__.replace("Thin", "").replace("Thick", "")
     if name == "Gent":
-        return ref.Gent(wall.shear_modulus, wall.locking_parameter)
-    if name == "Fung":
-        return ref.Fung(wall.shear_modulus, wall.stiffening)
-    if name == "Yeoh":
-        return ref.Yeoh(wall.c1, wall.c2, wall.c3)
-    return ref.Ogden(wall.moduli, wall.exponents)
+        mat = ref.Gent(wall.shear_modulus, wall.locking_parameter)
+    elif name == "Fung":
+        mat = ref.Fung(wall.shear_modulus, wall.stiffening)
+    elif name == "Yeoh":
+        mat = ref.Yeoh(wall.c1, wall.c2, wall.c3)
+    else:
+        mat = ref.Ogden(wall.moduli, wall.exponents)
+    # under an axial stretch: the installed law from the 3-D energy (hand-derived dW_axial)
+    return mat if wall.axial_stretch == 1 else ref.Installed(mat, wall.axial_stretch)
 
 
 def theory(wall):

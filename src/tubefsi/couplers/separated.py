@@ -43,7 +43,7 @@ import numpy as np
 
 from .._lazy import lazy_module
 from .._numerics import EPS, integrate_graded, solve_increasing
-from .._quadrature import adaptive_to_pole, quiet, recording, solve_integral, warn_unconverged
+from .._quadrature import Integral, adaptive_to_pole, quiet, recording, solve_integral, warn_unconverged
 from ..errors import ConvergenceError, InvalidParameterError, NoSteadyStateError, StretchRangeError
 from ..scene import Points, Scene, State
 from ._tables import SeparatedTable, fit_chebyshev
@@ -81,6 +81,22 @@ def _at_rest(pts, state, z, strain, rise):
         p = np.asarray(pts.outlet_pressure) + rise + 0.0 * dp
         strain = np.where(rest, pts.wall._strain(p, pts.tb), strain)
     return strain, rise
+
+
+def _split_at_kinks(pts, upper):
+    """``[0, k..., upper]`` per point: the log-stretches in ``(0, upper)`` where the wall's slope
+    kinks (``WallModel._slope_kinks``, e.g. where a fibre wall's fibres engage), ``upper`` where
+    there is none; just ``[0, upper]`` when no point has one."""
+    upper = np.asarray(upper, dtype=float)
+    kinks = pts.wall._slope_kinks(pts.tb)
+    if not kinks:
+        return [np.zeros(upper.shape), upper]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        u = [np.log(np.asarray(k, dtype=float) / pts.outlet_stretch) + 0.0 * upper for k in kinks]
+    inside = [np.where((x > 0) & (x < upper), x, upper) for x in u]
+    if not any(np.any(x < upper) for x in inside):
+        return [np.zeros(upper.shape), upper]
+    return [np.zeros(upper.shape), *np.sort(np.stack(inside), axis=0), upper]
 
 
 def _pick(value, index):
@@ -136,8 +152,14 @@ class SeparatedVariables(Coupler):
         pole = np.where(locks, v_max, np.inf)
         if order is not None:
             return integrate_graded(f, upper, pole, order=order, panel_width=panel_width)
-        result = adaptive_to_pole(f, 0.0, upper, pole, rtol=self._RTOL if rtol is None else rtol,
-                                  panel_width=panel_width)
+        rtol = self._RTOL if rtol is None else rtol
+        edges = _split_at_kinks(pts, upper)
+        result = adaptive_to_pole(f, edges[0], edges[1], pole, rtol=rtol, panel_width=panel_width)
+        for lo, hi in zip(edges[1:-1], edges[2:]):     # a tube law whose slope kinks: each piece on its own
+            more = adaptive_to_pole(f, lo, hi, pole, rtol=rtol, panel_width=panel_width)
+            value, error = result.value + more.value, result.error + more.error
+            result = Integral(value=value, error=error, panels=result.panels + more.panels,
+                              converged=(result.converged & more.converged) | (error <= rtol * np.abs(value)))
         if not np.all(result.converged):
             warn_unconverged("the separated-variables integral", result)
         return result.value

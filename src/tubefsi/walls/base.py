@@ -74,6 +74,9 @@ class WallModel(abc.ABC, metaclass=KeywordCheckedABC):
                                                             ``-inf``, else the tube law's inverse)
     ``_installed_tube(tube)``                               the tube itself; the installed tube of a wall
                                                             under axial pre-stretch
+    ``_slope_kinks(tb)``                                    ``()``; stretches where :math:`P'` or
+                                                            :math:`P''` jumps (fibres engaging): the
+                                                            couplers' quadratures split there
     ``_stiffness_decay_exponent(tb)``                       :math:`\kappa` in :math:`P' \sim \lambda^{-\kappa}`,
                                                             estimated (only used with a limit pressure)
     ``_power_law_integral(log_ratio, stretch, k, tb)``      None; a closed form of the separated integral
@@ -273,6 +276,11 @@ class WallModel(abc.ABC, metaclass=KeywordCheckedABC):
         """The tube the flow sees, from the stress-free one (an axial pre-stretch changes it); the
         tube law's stretch is relative to its lumen."""
         return tube
+
+    def _slope_kinks(self, tb):
+        """Stretches (arrays aligned with ``tb``, NaN for none) where the tube law's slope or its
+        derivative jumps; ``()`` for a smooth law."""
+        return ()
 
     def _collapse_stretch(self, tb):
         """The stretch the law is never evaluated at or below (0; a material that also locks in

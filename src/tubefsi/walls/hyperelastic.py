@@ -4,7 +4,9 @@ The tube is clamped (axial stretch 1), so a material point at radius :math:`r`
 moves to :math:`R` with stretches :math:`(r/R, R/r, 1)`. The reduced strain
 energy is :math:`\hat W(\lambda) = W(1/\lambda, \lambda, 1)` and a material
 subclass gives only its derivative ``_dW(stretch)`` (or ``_energy(stretch)``,
-differentiated numerically). The wall theory is chosen by composition:
+differentiated numerically, or, for an isotropic :math:`W(I_1, I_2)`, ``_W1`` and ``_W2``,
+which also serve an axial pre-stretch: ``docs/walls_beyond.md``, section "Axial pre-stretch").
+The wall theory is chosen by composition:
 
 ================================  ==========================================================
 theory                            tube law :math:`P(\lambda; \bar t)`
@@ -63,6 +65,11 @@ __all__ = ["HyperelasticWall", "ThinWall", "ThickWall", "THICKNESS_CONVENTIONS",
 THICKNESS_CONVENTIONS = ("reference", "current")
 
 
+def _quartic(s):
+    r""":math:`s - s^{-3} = (s-1)(s+1)(s^2+1)/s^3`, free of cancellation near 1."""
+    return (s - 1.0) * (s + 1.0) * (s * s + 1.0) / s**3
+
+
 def axial_stretch():
     """The ``axial_stretch`` parameter of a material that supports an axial pre-stretch
     (``docs/walls_beyond.md``, section "Axial pre-stretch"): positive, default 1."""
@@ -72,20 +79,34 @@ def axial_stretch():
 class HyperelasticWall(WallModel):
     r"""Abstract base of plane-strain incompressible hyperelastic walls (a material; pick a theory).
 
-    Hooks of a material (arrays of stretches; implement ``_dW`` or ``_energy``, override the
-    others for speed or accuracy):
+    Hooks of a material (arrays of stretches; implement ``_dW``, ``_W1`` or ``_energy``, override
+    the others for speed or accuracy). With an ``axial_stretch`` :math:`\lambda_z` field (the
+    ``axial_stretch()`` parameter) the stretch is the installed tube's and ``_dW`` is its law
+    :math:`D(\lambda) = \hat W'(\lambda/\sqrt{\lambda_z};\lambda_z)/\sqrt{\lambda_z}`
+    (``docs/walls_beyond.md``, section "Axial pre-stretch"; :math:`\hat W'` at :math:`\lambda_z = 1`):
 
-    ===========================  ============================================================
-    hook                         default
-    ===========================  ============================================================
-    ``_dW(stretch)``             natural hook: :math:`\hat W'(\lambda)`, or ``_energy``
-                                 differentiated numerically
-    ``_energy(stretch)``         :math:`\hat W(\lambda)` (optional natural hook)
-    ``_d2W(stretch)``            :math:`\hat W''(\lambda)` by ``scipy.differentiate``
-    ``_locking_stretch()``       ``inf``; the stretch where :math:`\hat W'` blows up (Gent)
-    ``_thick_integrand(s)``      :math:`\hat W'(s)/(s^2-1)`, with the removable singularity at
-                                 :math:`s = 1` taken from ``_d2W``; override with a form free of it
-    ===========================  ============================================================
+    ================================  ================================================================
+    hook                              default
+    ================================  ================================================================
+    ``_dW(stretch)``                  natural hook: :math:`D(\lambda)`, or from ``_W1``/``_W2``, or
+                                      ``_energy`` differentiated numerically
+    ``_W1(i1, i2)``                   natural hook of an isotropic material :math:`W(I_1, I_2)`:
+                                      :math:`\partial W/\partial I_1` at :math:`I_1 - 3 =` ``i1``, :math:`I_2 - 3 =` ``i2``;
+                                      the base derives :math:`D = F(\lambda - \lambda^{-3})`,
+                                      :math:`F = 2(W_1 + \lambda_z^2W_2)/\lambda_z`, its slope and the thick
+                                      integrand :math:`F(\lambda^2+1)/\lambda^3` at every :math:`\lambda_z`
+    ``_W2(i1, i2)``                   0; :math:`\partial W/\partial I_2`
+    ``_W_second(i1, i2)``             None (then :math:`D'` numerically); ``(W11, W12, W22)``
+    ``_energy(stretch)``              :math:`\hat W(\lambda)` (optional natural hook, plane strain)
+    ``_d2W(stretch)``                 :math:`D'(\lambda)`: from the invariants, else by ``scipy.differentiate``
+    ``_current_slope(stretch)``       :math:`d(D/\lambda)/d\lambda` (thin wall, current thickness)
+    ``_locking_stretch()``            ``inf``; the stretch where :math:`D` blows up (Gent)
+    ``_thick_integrand(s)``           :math:`D(s)/(s^2-1)`, with the removable singularity at
+                                      :math:`s = 1` taken from ``_d2W``; override with a form free of it
+    ``_installed_cross_section``      ``(radius, thickness)`` of the installed tube at rest: the
+                                      stress-free ones over :math:`\sqrt{\lambda_z}` (a homogeneous rest state)
+    ``_homogeneous_rest()``           True; False where the rest state is solved for (fibres)
+    ================================  ================================================================
 
     The theory (:class:`ThinWall` with a ``thickness_convention``, or :class:`ThickWall`) gives
     ``_pressure_at_strain`` and ``_stiffness``; the :class:`~tubefsi.walls.WallModel` hooks
@@ -103,8 +124,10 @@ class HyperelasticWall(WallModel):
         return evaluate(self, lambda wall, lam: wall._dW(lam), np.asarray(stretch, dtype=float))
 
     def _dW(self, stretch):
+        if self._uses_invariants():
+            return self._invariant_factor(stretch)[0] * _quartic(stretch)
         if type(self)._energy is HyperelasticWall._energy:
-            raise TypeError(f"{type(self).__name__} must implement _dW or _energy")
+            raise TypeError(f"{type(self).__name__} must implement _dW, _W1 or _energy")
         shape, wall, (lam,) = flat_points(self, stretch)
         res = differentiate.derivative(lambda x, i: model_at(wall, i)._energy(x), lam, args=(np.arange(lam.size),),
                                        initial_step=0.1 * lam, tolerances=_DIFF_TOL)
@@ -116,12 +139,94 @@ class HyperelasticWall(WallModel):
 
     def _d2W(self, stretch):
         r""":math:`\hat W''(\lambda)`, numerically unless overridden (steps clear of a locking stretch)."""
+        if self._uses_invariants():
+            second = self._invariant_second(stretch)
+            if second is not None:
+                return second
         shape, wall, (lam,) = flat_points(self, stretch)
         room = wall._locking_stretch() - lam
         step = 0.1 * np.minimum(lam, np.where(np.isfinite(room), 0.2 * room, np.inf))
         res = differentiate.derivative(lambda x, i: model_at(wall, i)._dW(x), lam, args=(np.arange(lam.size),),
                                        initial_step=step, tolerances=_DIFF_TOL)
         return res.df.reshape(shape)
+
+    # -- isotropic materials W(I1, I2): the installed law from the invariant derivatives
+    def _W1(self, i1, i2):
+        r""":math:`W_1 = \partial W/\partial I_1` at :math:`I_1 - 3 =` ``i1``, :math:`I_2 - 3 =` ``i2``
+        (optional natural hook of an isotropic material; then every :math:`\lambda_z` is served)."""
+        raise NotImplementedError
+
+    def _W2(self, i1, i2):
+        r""":math:`W_2 = \partial W/\partial I_2` (0 unless overridden)."""
+        return 0.0
+
+    def _W_second(self, i1, i2):
+        r"""``(W11, W12, W22)``, the second derivatives, or None (then :math:`D'` numerically)."""
+        return None
+
+    def _uses_invariants(self) -> bool:
+        return type(self)._W1 is not HyperelasticWall._W1
+
+    def _installed_invariants(self, s):
+        r""":math:`(I_1 - 3, I_2 - 3)` at the installed stretch :math:`s` (stretches
+        :math:`(1/(s\sqrt{\lambda_z}), s/\sqrt{\lambda_z}, \lambda_z)` from the stress-free tube):
+        :math:`h/\lambda_z + (\lambda_z-1)^2(\lambda_z+2)/\lambda_z` and
+        :math:`\lambda_z h + (\lambda_z-1)^2(2\lambda_z+1)/\lambda_z^2`, :math:`h = (s - 1/s)^2`,
+        free of cancellation (exactly :math:`h, h` at :math:`\lambda_z = 1`)."""
+        lz = self._axial()
+        h = ((s - 1.0) * (s + 1.0) / s) ** 2
+        if type(lz) is float and lz == 1.0:
+            return h, h
+        d = (lz - 1.0) ** 2
+        return h / lz + d * (lz + 2.0) / lz, lz * h + d * (2.0 * lz + 1.0) / (lz * lz)
+
+    def _axial(self):
+        return getattr(self, "axial_stretch", 1.0)
+
+    def _invariant_factor(self, s):
+        r"""``(F, i1, i2)``: :math:`F = 2(W_1 + \lambda_z^2 W_2)/\lambda_z`, so that
+        :math:`D(s) = F\,(s - s^{-3})` (``docs/walls_beyond.md``, section "Axial pre-stretch")."""
+        lz = self._axial()
+        i1, i2 = self._installed_invariants(s)
+        with np.errstate(over="ignore", invalid="ignore"):
+            w = self._W1(i1, i2)
+            if type(self)._W2 is not HyperelasticWall._W2:
+                w = w + lz * lz * self._W2(i1, i2)
+            return (2.0 / lz) * w, i1, i2
+
+    def _invariant_second(self, s):
+        r""":math:`D'(s) = F(1 + 3s^{-4}) + (4/\lambda_z)(s - s^{-3})^2 K`,
+        :math:`K = (W_{11} + \lambda_z^2W_{12})/\lambda_z + \lambda_z(W_{12} + \lambda_z^2W_{22})`; None without
+        ``_W_second``."""
+        factor, i1, i2 = self._invariant_factor(s)
+        k = self._invariant_curvature(i1, i2)
+        if k is None:
+            return None
+        q = _quartic(s)
+        with np.errstate(over="ignore", invalid="ignore"):
+            return factor * (1.0 + 3.0 * s**-4) + (4.0 / self._axial()) * k * q * q
+
+    def _invariant_curvature(self, i1, i2):
+        second = self._W_second(i1, i2)
+        if second is None:
+            return None
+        lz = self._axial()
+        w11, w12, w22 = second
+        with np.errstate(over="ignore", invalid="ignore"):
+            return (w11 + lz * lz * w12) / lz + lz * (w12 + lz * lz * w22)
+
+    def _current_slope(self, s):
+        r""":math:`d(D/s)/ds`, the slope of the thin current-thickness law per :math:`\bar t`: from the
+        invariants as :math:`[4Fs^{-4} + (4/\lambda_z)(s - s^{-3})^2K]/s` (no cancellation at large
+        stretch), else :math:`(D' - D/s)/s`."""
+        if self._uses_invariants():
+            factor, i1, i2 = self._invariant_factor(s)
+            k = self._invariant_curvature(i1, i2)
+            if k is not None:
+                q = _quartic(s)
+                with np.errstate(over="ignore", invalid="ignore"):
+                    return (4.0 * factor * s**-4 + (4.0 / self._axial()) * k * q * q) / s
+        return (self._d2W(s) - self._dW(s) / s) / s
 
     def _locking_stretch(self) -> float:
         r"""The stretch at which the material locks (:math:`\hat W' \to \infty`, e.g. Gent); ``inf``.
@@ -146,9 +251,20 @@ class HyperelasticWall(WallModel):
                 return tube
             raise InvalidParameterError("tube", "a stress-free Tube", tube,
                                         f"it is installed at the axial stretch {tube.axial_stretch}, not {lz}")
-        shrink = 1.0 / np.sqrt(lz)
-        return InstalledTube(radius=tube.radius * shrink, thickness=tube.thickness * shrink,
-                             length=tube.length * lz, axial_stretch=lz)
+        radius, thickness = self._installed_cross_section(tube)
+        return InstalledTube(radius=radius, thickness=thickness, length=tube.length * lz, axial_stretch=lz)
+
+    def _homogeneous_rest(self) -> bool:
+        """Whether the installed tube at rest is the stress-free one scaled (True: :math:`D(1) = 0`,
+        and the plane Lamé integral of :math:`D` is the thick law); False for pre-stretched fibres."""
+        return True
+
+    def _installed_cross_section(self, tube):
+        r"""``(radius, thickness)`` of the installed tube at rest: the stress-free ones over
+        :math:`\sqrt{\lambda_z}` (a homogeneous state, where :math:`D(1) = 0`, as for every isotropic
+        material); a material whose rest state is not homogeneous (fibres) solves for it."""
+        shrink = 1.0 / np.sqrt(self.axial_stretch)
+        return tube.radius * shrink, tube.thickness * shrink
 
 
     def _collapse_stretch(self, tb):
@@ -163,6 +279,8 @@ class HyperelasticWall(WallModel):
     def _thick_integrand(self, s):
         r""":math:`\hat W'(s)/(s^2-1)`; override with a form free of the removable singularity."""
         s = np.asarray(s, dtype=float)
+        if self._uses_invariants():               # D(s)/(s^2 - 1) = F(s) (s^2 + 1)/s^3: no singularity
+            return self._invariant_factor(s)[0] * (s * s + 1.0) / s**3
         near = np.abs(s - 1.0) < 1e-7
         with np.errstate(invalid="ignore", divide="ignore"):
             g = self._dW(s) / ((s - 1.0) * (s + 1.0))
@@ -239,7 +357,7 @@ class ThinWall(HyperelasticWall):
     def _stiffness(self, stretch, tb):
         if self.thickness_convention == "reference":
             return tb * self._d2W(stretch)
-        return tb * (self._d2W(stretch) - self._dW(stretch) / stretch) / stretch
+        return tb * self._current_slope(stretch)
 
 
 class ThickWall(HyperelasticWall):

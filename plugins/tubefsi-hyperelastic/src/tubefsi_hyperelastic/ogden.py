@@ -12,6 +12,13 @@ saturates, and below it rises to a peak and falls. Terms of different signs can 
 it non-monotone at moderate stretch (Treloar-type fits do, for thin current-thickness and
 thick tubes): the first peak is then the wall's maximum stretch and limit pressure
 (see :mod:`tubefsi_hyperelastic._limit_point`).
+
+Installed at an axial stretch :math:`\lambda_z` (``docs/walls_beyond.md``, section "Axial
+pre-stretch"), the principal stretches from the stress-free tube are
+:math:`(1/(\lambda\sqrt{\lambda_z}), \lambda/\sqrt{\lambda_z}, \lambda_z)` and
+:math:`D(\lambda) = \sum_p \frac{2\mu_p\lambda_z^{-\alpha_p/2}}{\alpha_p}(\lambda^{\alpha_p - 1} -
+\lambda^{-\alpha_p - 1})`: the plane-strain law with the moduli :math:`\mu_p\lambda_z^{-\alpha_p/2}`
+(whose sum, the installed small-strain modulus, must be positive).
 """
 
 from __future__ import annotations
@@ -22,6 +29,7 @@ import attrs
 import numpy as np
 from tubefsi import InvalidParameterError
 from tubefsi.walls import HyperelasticWall, ThickWall, ThinWall
+from tubefsi.walls.hyperelastic import axial_stretch
 
 from ._limit_point import LimitPoint
 
@@ -63,6 +71,7 @@ class Ogden(LimitPoint, HyperelasticWall):
                                 metadata={"unit": "Pa", "doc": "moduli mu_p (sum = shear modulus)"})
     exponents: tuple = attrs.field(converter=_floats, validator=_check_terms,
                                    metadata={"unit": "", "doc": "exponents alpha_p (nonzero)"})
+    axial_stretch: float = axial_stretch()
 
     def __attrs_post_init__(self):
         if len(self.moduli) != len(self.exponents):
@@ -71,16 +80,25 @@ class Ogden(LimitPoint, HyperelasticWall):
         if not sum(self.moduli) > 0:
             raise InvalidParameterError("moduli", "sum(moduli) > 0", self.moduli,
                                         "the small-strain shear modulus must be positive")
+        if not sum(self._installed_moduli()) > 0:
+            raise InvalidParameterError("axial_stretch", "values where sum(moduli_p lz^(-exponents_p/2)) > 0",
+                                        self.axial_stretch, "the installed tube's small-strain modulus must be positive")
+
+    def _installed_moduli(self):
+        r""":math:`\mu_p\lambda_z^{-\alpha_p/2}` (the moduli themselves at :math:`\lambda_z = 1`)."""
+        lz = float(self.axial_stretch)
+        return self.moduli if lz == 1.0 else tuple(m * lz ** (-0.5 * a) for m, a in zip(self.moduli, self.exponents))
 
     def _pressure_scale(self):                  # P is linear in the moduli
         return sum(self.moduli)
 
     def _shape_key(self):
         total = sum(self.moduli)
-        return (tuple(m / total for m in self.moduli), self.exponents, getattr(self, "thickness_convention", "thick"))
+        return (tuple(m / total for m in self.moduli), self.exponents, self.axial_stretch,
+                getattr(self, "thickness_convention", "thick"))
 
     def _terms(self):
-        return zip((2.0 * m / a for m, a in zip(self.moduli, self.exponents)), self.exponents)
+        return zip((2.0 * m / a for m, a in zip(self._installed_moduli(), self.exponents)), self.exponents)
 
     def _dW(self, s):
         # s^(a-1) - s^(-a-1) = s^(-a-1) expm1(2 a ln s): no cancellation near s = 1
@@ -105,7 +123,7 @@ class Ogden(LimitPoint, HyperelasticWall):
         crit, top = self._critical(theory), max(abs(a) for a in self.exponents)
         if top > crit:
             return math.inf
-        lead = sum(m for m, a in zip(self.moduli, self.exponents) if abs(a) == crit) * 2.0 / crit
+        lead = sum(m for m, a in zip(self._installed_moduli(), self.exponents) if abs(a) == crit) * 2.0 / crit
         if top < crit or not lead > 0:
             return 0.0  # the law falls back to zero: its peak is the limit (found by the scan)
         return tb * lead if theory != "thick" else np.log1p(tb) * lead
@@ -138,4 +156,5 @@ class ThickOgden(ThickWall, Ogden):
 
     _examples = ({"moduli": (2e3,), "exponents": (3.0,)},
                  {"moduli": (2008.5, 14.75, 49.05), "exponents": (1.3, 5.0, -2.0)},
-                 {"moduli": (1e3, 1e3), "exponents": (2.0, -1.0)})
+                 {"moduli": (1e3, 1e3), "exponents": (2.0, -1.0)},
+                 {"moduli": (2e3,), "exponents": (3.0,), "axial_stretch": 0.8})

@@ -6,6 +6,13 @@ shear modulus is :math:`2c_1`. With :math:`c_2, c_3 \ge 0` the tube law increase
 (or saturates, when :math:`c_2 = c_3 = 0`: neo-Hookean). A negative :math:`c_2` (common in
 fits to rubber) can make it rise to a peak first: the peak is then the wall's maximum stretch
 and limit pressure (see :mod:`tubefsi_hyperelastic._limit_point`).
+
+The material gives only :math:`W_1 = c_1 + 2c_2 y + 3c_3 y^2` and :math:`W_{11}` (the invariant
+hooks of :class:`~tubefsi.walls.HyperelasticWall`), which serve every axial stretch
+:math:`\lambda_z`: installed at :math:`\lambda_z`, :math:`y = (\lambda - 1/\lambda)^2/\lambda_z + c`,
+:math:`c = (\lambda_z-1)^2(\lambda_z+2)/\lambda_z` (``docs/walls_beyond.md``, section "Axial
+pre-stretch"); the installed tube's small-strain modulus :math:`2W_1(c)/\lambda_z` must be
+positive (``InvalidParameterError`` otherwise).
 """
 
 from __future__ import annotations
@@ -14,10 +21,11 @@ import math
 
 import attrs
 import numpy as np
+from tubefsi import InvalidParameterError
 from tubefsi.fields import nonnegative, positive, real
 from tubefsi.walls import HyperelasticWall, ThickWall, ThinWall
+from tubefsi.walls.hyperelastic import axial_stretch
 
-from ._forms import hoop, quartic
 from ._limit_point import LimitPoint
 
 __all__ = ["Yeoh", "ThinYeoh", "ThickYeoh"]
@@ -30,28 +38,26 @@ class Yeoh(LimitPoint, HyperelasticWall):
     c1: float = positive(unit="Pa", doc="c1 = half the small-strain shear modulus")
     c2: float = real(unit="Pa", doc="c2 (may be negative)")
     c3: float = nonnegative(unit="Pa", doc="c3 >= 0")
+    axial_stretch: float = axial_stretch()
 
-    def _pressure_scale(self):                  # P is linear in (c1, c2, c3): c1 * P_hat(c2/c1, c3/c1)
+    def __attrs_post_init__(self):
+        rest = self._W1(self._installed_invariants(1.0)[0], None)
+        if not np.all(rest > 0):
+            raise InvalidParameterError("axial_stretch", "values where c1 + 2 c2 y + 3 c3 y^2 > 0 at rest, "
+                                        "y = (lz - 1)^2 (lz + 2)/lz", self.axial_stretch,
+                                        "the installed tube's small-strain modulus must be positive")
+
+    def _pressure_scale(self):                  # P is linear in (c1, c2, c3): c1 * P_hat(c2/c1, c3/c1, lz)
         return self.c1
 
     def _shape_key(self):
-        return (self.c2 / self.c1, self.c3 / self.c1, getattr(self, "thickness_convention", "thick"))
+        return (self.c2 / self.c1, self.c3 / self.c1, self.axial_stretch, getattr(self, "thickness_convention", "thick"))
 
-    def _f(self, y):  # dW/d lam = f(y) (lam - lam^-3), f = 2 dW/dI1
-        return 2.0 * (self.c1 + y * (2.0 * self.c2 + 3.0 * self.c3 * y))
+    def _W1(self, i1, i2):       # dW/dI1 at y = I1 - 3
+        return self.c1 + i1 * (2.0 * self.c2 + 3.0 * self.c3 * i1)
 
-    def _df(self, y):
-        return 4.0 * self.c2 + 12.0 * self.c3 * y
-
-    def _dW(self, s):
-        return self._f(hoop(s) ** 2) * quartic(s)
-
-    def _d2W(self, s):
-        g = quartic(s)
-        return self._f(hoop(s) ** 2) * (1.0 + 3.0 * s**-4) + 2.0 * self._df(hoop(s) ** 2) * g * g
-
-    def _thick_integrand(self, s):
-        return self._f(hoop(s) ** 2) * (s * s + 1.0) / s**3
+    def _W_second(self, i1, i2):
+        return 2.0 * self.c2 + 6.0 * self.c3 * i1, 0.0, 0.0
 
     def _max_stretch(self, tb):
         return math.inf if self.c2 >= 0 else super()._max_stretch(tb)   # c2, c3 >= 0: increasing
@@ -62,7 +68,7 @@ class Yeoh(LimitPoint, HyperelasticWall):
     def _asymptote(self, tb, theory):
         if self.c2 != 0 or self.c3 != 0 or theory == "reference":
             return math.inf
-        return 2.0 * self.c1 * (tb if theory == "current" else np.log1p(tb))
+        return 2.0 * self.c1 / self.axial_stretch * (tb if theory == "current" else np.log1p(tb))
 
     def _asymptotic_decay(self, tb, theory):
         return 5.0
@@ -74,15 +80,8 @@ class ThinYeoh(ThinWall, Yeoh):
 
     _examples = ({"c1": 1e3, "c2": 50.0, "c3": 2.0},
                  {"c1": 1e3, "c2": -120.0, "c3": 8.0, "thickness_convention": "current"},
-                 {"c1": 1e3, "c2": 0.0, "c3": 0.0, "thickness_convention": "current"})
-
-    def _stiffness(self, stretch, tb):
-        if self.thickness_convention == "reference":
-            return tb * self._d2W(stretch)
-        # d/dlam (dW/lam) = [4 f s^-4 + 2 f'(y) (s - s^-3)^2] / s: no cancellation at large stretch
-        s = stretch
-        y, g = hoop(s) ** 2, quartic(s)
-        return tb * (4.0 * self._f(y) * s**-4 + 2.0 * self._df(y) * g * g) / s
+                 {"c1": 1e3, "c2": 0.0, "c3": 0.0, "thickness_convention": "current"},
+                 {"c1": 1e3, "c2": 50.0, "c3": 2.0, "axial_stretch": 1.25})
 
 
 @attrs.frozen(kw_only=True)

@@ -54,7 +54,7 @@ from collections.abc import Mapping
 from mpmath import mp, mpf
 
 __all__ = [
-    "Material", "NeoHookean", "MooneyRivlin", "Gent", "Fung", "HoopFibre", "Yeoh", "Ogden", "Linear",
+    "Material", "NeoHookean", "MooneyRivlin", "Gent", "Fung", "HoopFibre", "Yeoh", "Ogden", "Linear", "Installed",
     "material_from_params", "RefWall", "KINDS", "LIMIT_KINDS", "WALLS", "stretch_at_pressure",
 ]
 
@@ -83,8 +83,34 @@ class Material:
         """dW(s) / (s^2 - 1), the integrand of the thick-wall (Lamé) law."""
         return self.dW(s) / (s * s - 1)
 
+    def dW_axial(self, s, lz):
+        """d/ds W(1/(s lz), s, lz): the reduced energy under the axial stretch lz, by
+        ``mpmath.diff`` unless a material writes it by hand."""
+        lz = mpf(lz)
+        return mp.diff(lambda x: self.W(1 / (x * lz), x, lz), s)
+
     def __repr__(self):
         return self._repr
+
+
+class Installed(Material):
+    r"""``material`` installed at the axial stretch ``lz`` (``docs/walls_beyond.md``, section "Axial
+    pre-stretch"), in the installed tube's stretch :math:`\sigma = s\sqrt{\lambda_z}`:
+    ``dW(sigma)`` is :math:`D(\sigma) = \hat W'(\sigma/\sqrt{\lambda_z};\lambda_z)/\sqrt{\lambda_z}`
+    from the material's ``dW_axial``, so that :class:`RefWall` gives the installed tube's laws; its
+    ``lock`` is the installed one (``lock_axial``, where the material has one)."""
+
+    def __init__(self, material, lz):
+        self.material, self.lz = material, mpf(lz)
+        self.root = mp.sqrt(self.lz)
+        self.lock = material.lock_axial(self.lz) if hasattr(material, "lock_axial") else mp.inf
+        self._repr = f"Installed({material!r}, {lz!r})"
+
+    def W(self, l1, l2, l3):
+        raise NotImplementedError("the installed material is given by its reduced law")
+
+    def dW(self, sigma):
+        return self.material.dW_axial(sigma / self.root, self.lz) / self.root
 
 
 class NeoHookean(Material):
@@ -131,6 +157,16 @@ class Gent(Material):
     def dW(self, s):   # I1 - 3 = (s - 1/s)^2, d(I1)/ds = 2 (s - s^-3)
         return self.mu * (s - s**-3) / (1 - (s - 1 / s) ** 2 / self.jm)
 
+    def dW_axial(self, s, lz):   # I1 = s^2 + lz^2 + 1/(s lz)^2, dI1/ds = 2 (s - s^-3 lz^-2)
+        i1 = s * s + lz * lz + 1 / (s * lz) ** 2 - 3
+        return self.mu * (s - s**-3 / lz**2) / (1 - i1 / self.jm)
+
+    def lock_axial(self, lz):
+        """The installed stretch sigma = s sqrt(lz) where I1 - 3 = jm on the inflation side:
+        y = sigma^2 solves y/lz + 1/(y lz) = jm + 3 - lz^2, a quadratic."""
+        B = lz * (self.jm + 3 - lz * lz)
+        return mp.sqrt((B + mp.sqrt(B * B - 4)) / 2)
+
 
 class Fung(Material):
     """W = (mu / 2b)(exp(b (I1 - 3)) - 1)."""
@@ -144,6 +180,10 @@ class Fung(Material):
 
     def dW(self, s):
         return self.mu * (s - s**-3) * mp.exp(self.b * (s - 1 / s) ** 2)
+
+    def dW_axial(self, s, lz):
+        i1 = s * s + lz * lz + 1 / (s * lz) ** 2 - 3
+        return self.mu * (s - s**-3 / lz**2) * mp.exp(self.b * i1)
 
 
 class HoopFibre(Material):
@@ -186,6 +226,10 @@ class Yeoh(Material):
         i = (s - 1 / s) ** 2
         return 2 * (self.c[0] + 2 * self.c[1] * i + 3 * self.c[2] * i**2) * (s - s**-3)
 
+    def dW_axial(self, s, lz):
+        i = s * s + lz * lz + 1 / (s * lz) ** 2 - 3
+        return 2 * (self.c[0] + 2 * self.c[1] * i + 3 * self.c[2] * i**2) * (s - s**-3 / lz**2)
+
 
 class Ogden(Material):
     """W = sum 2 mu_p / alpha_p^2 (l1^a + l2^a + l3^a - 3)."""
@@ -199,6 +243,9 @@ class Ogden(Material):
 
     def dW(self, s):
         return mp.fsum(2 * m / a * (s ** (a - 1) - s ** (-a - 1)) for m, a in self.terms)
+
+    def dW_axial(self, s, lz):   # d/ds [(s lz)^-a + s^a + lz^a]
+        return mp.fsum(2 * m / a * (s ** (a - 1) - s ** (-a - 1) * lz ** (-a)) for m, a in self.terms)
 
 
 class Linear:
