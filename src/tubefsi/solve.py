@@ -35,7 +35,8 @@ from .walls.base import WallModel
 __all__ = ["solve", "max_flow_rate", "select_coupler"]
 
 
-#: (registry generation, rheology class, wall class) -> the coupler "auto" picks and its name.
+#: (rheology class, wall class, coupler registry generation) -> the coupler "auto" picks and its
+#: name, or False where the classes are not models (the scalar path's one lookup)
 _AUTO: dict = {}
 
 
@@ -57,11 +58,15 @@ def _contract_couplers():
 
 
 def _auto(rheology, wall):
-    key = (registry.couplers.generation, type(rheology), type(wall))
+    """``(coupler, name)`` of ``"auto"`` for the pair's classes, or False if they are not models."""
+    key = (type(rheology), type(wall), registry.couplers.generation)
     found = _AUTO.get(key)
     if found is None:
-        chosen = select_coupler(rheology, wall)
-        found = _AUTO[key] = (chosen, registry.couplers.name_of(chosen) or type(chosen).__name__)
+        found = False
+        if _is(type(rheology), Rheology) and _is(type(wall), WallModel):
+            chosen = select_coupler(rheology, wall)
+            found = (chosen, registry.couplers.name_of(chosen) or type(chosen).__name__)
+        _AUTO[key] = found
     return found
 
 
@@ -292,9 +297,6 @@ def _beyond_range(controlled, values, why):
 
 
 _SUBCLASS: dict = {}
-#: (rheology class, wall class, coupler registry generation) -> (coupler, name), or False where
-#: the classes are not models (the scalar path's one lookup)
-_SCALAR_PAIRS: dict = {}
 
 
 def _is(cls, base) -> bool:
@@ -312,11 +314,9 @@ def _scalar_flow(rheology, wall, tube, q):
     does not apply; the general path then answers (and builds the table for the next call)."""
     if type(tube) is not Tube:
         return None
-    chosen = _SCALAR_PAIRS.get((type(rheology), type(wall), registry.couplers.generation))
-    if chosen is None:                         # first time for this pair of classes: models, and the coupler
-        ok = _is(type(rheology), Rheology) and _is(type(wall), WallModel)
-        chosen = _SCALAR_PAIRS[(type(rheology), type(wall), registry.couplers.generation)] = \
-            _auto(rheology, wall) if ok else False
+    chosen = _AUTO.get((type(rheology), type(wall), registry.couplers.generation))
+    if chosen is None:                         # first time for this pair of classes
+        chosen = _auto(rheology, wall)
     if chosen is False:
         return None
     if not (q > 0.0 and q < math.inf) or wall.is_rigid or wall._installed_tube(tube) is not tube:

@@ -198,19 +198,19 @@ class SeparatedVariables(Coupler):
                     scale = (a * points.outlet_stretch) ** k
                 reach = np.max(np.abs(k)) * max(np.max(u), -np.min(u)) if np.size(u) else 0.0
                 near = np.abs(np.log(scale)) < _LOG_RANGE
-                if reach < _LOG_RANGE and np.all(near):
-                    ku = k * u
-                    if type(ku) is not np.ndarray or ku.shape != np.shape(slope):
-                        return slope * (scale * np.exp(ku))
+                within = reach < _LOG_RANGE and np.all(near)
+                ku = k * u
+                if within and type(ku) is np.ndarray and ku.shape == np.shape(slope):
                     np.exp(ku, out=ku)               # in place: one array for the product
                     ku *= scale
                     return np.multiply(slope, ku, out=ku)
+                with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+                    fast = slope * (scale * np.exp(ku))
+                if within:
+                    return fast
                 # some factor beyond half the exponent range: the power where the exponential
                 # form could leave the doubles, decided node by node (a point's answer must not
                 # depend on the batch it came in); the power raises where psi itself leaves them
-                ku = k * u
-                with np.errstate(over="ignore", under="ignore", invalid="ignore"):
-                    fast = slope * (scale * np.exp(ku))
                 return np.where(near & (np.abs(ku) < _LOG_RANGE), fast, slope / rheo._radius_factor(a * s))
             return slope / rheo._radius_factor(a * s)
         qq = np.broadcast_to(q, np.shape(u))
@@ -499,7 +499,8 @@ class SeparatedVariables(Coupler):
         ``bound``. Returns ``(v, solved)`` shaped like ``target``."""
         v = np.zeros(target.shape)
         solved = np.zeros(target.shape, dtype=bool)
-        top = np.minimum(1.5 * guess, bound) + np.zeros(target.shape)
+        bound = np.broadcast_to(bound, target.shape).ravel()
+        top = np.minimum(1.5 * guess, bound.reshape(target.shape)) + np.zeros(target.shape)
         live = np.flatnonzero((target.ravel() > 0) & (top.ravel() > 0))
         for _ in range(2):
             if live.size == 0:
@@ -517,7 +518,7 @@ class SeparatedVariables(Coupler):
                 x, good, short = solve_integral(f, target.ravel()[live], top.ravel()[live], rtol=self._RTOL)
             v.ravel()[live[good]] = x[good]
             solved.ravel()[live[good]] = True
-            wider = np.minimum(3.0 * top.ravel()[live], (np.asarray(bound) + np.zeros(target.shape)).ravel()[live])
+            wider = np.minimum(3.0 * top.ravel()[live], bound[live])
             short &= wider > top.ravel()[live]
             top.ravel()[live] = wider
             live = live[short]
