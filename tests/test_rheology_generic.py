@@ -17,6 +17,8 @@ import warnings
 import attrs
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from mpmath import mp, mpf
 
 import tubefsi
@@ -400,3 +402,93 @@ def test_solve_with_a_kinked_law():
     a = tubefsi.solve(law, wall, tube, flow_rate=q)
     back = tubefsi.solve(law, wall, tube, pressure_drop=a.pressure_drop)
     np.testing.assert_allclose(back.flow_rate, q, rtol=1e-11)
+
+
+# ---------------------------------------------------------------- a panel's nodes from one cumulative integral
+def _panel_nodes(a, b):
+    """The 29 parameters of a table panel on [a, b] (its Lobatto nodes and check points)."""
+    from tubefsi.rheology._flow_table import _N, _XC, _XF
+    p = 0.5 * (a + b) + 0.5 * (b - a) * np.concatenate([_XF, _XC])
+    p[0], p[_N] = a, b
+    return p
+
+
+@pytest.mark.parametrize("a, b", [(-6.0, -4.0), (-1.0, 1.0), (3.0, 5.0), (-4.0, 4.0), (12.0, 20.0)])
+def test_cumulative_panel_rate_against_mpmath(a, b):
+    """Gamma at a panel's nodes from the cumulative integral K (one rule for the whole panel)
+    against 30-digit mpmath quadrature of 4/3 rate int_0^1 (1 - (tau(rate t)/tau_w)^3) dt for
+    the Carreau law written afresh: every accepted node within 3e-15 and within its estimate
+    plus 1e-15; at least 80 % of the nodes accepted on a smooth law."""
+    from tubefsi.rheology._flow_table import stress_natural_rate_panels
+    law = CarreauLike()
+    p = _panel_nodes(a, b)[None]
+    rate = np.exp(p)
+    tw = law._stress(rate)     # the reference takes these as given: their rounding, amplified 3q/(1-q), is the law's
+    gamma, estimate, ok = stress_natural_rate_panels(law, p, tw)
+    assert ok.mean() >= 0.8
+    with mp.workdps(30):
+        e0, lam, n = mpf(law.eta0), mpf(law.lam), mpf(law.index)
+
+        def tau(g):
+            return g * e0 * (1 + (lam * g) ** 2) ** ((n - 1) / 2)
+
+        for j in range(0, p.shape[1], 4):
+            g_w = mpf(float(rate[0, j]))
+            t_w = mpf(float(tw[0, j]))           # the given wall stress (see above)
+            corner = 1 / (lam * g_w)             # the transition, where tanh-sinh needs a breakpoint
+            points = [0] + sorted(c for c in (corner / 1000, corner / 10, corner, 10 * corner, 1000 * corner) if c < 1) + [1]
+            ref = 4 * g_w / 3 * mp.quad(lambda t: 1 - (tau(g_w * t) / t_w) ** 3, points)
+            err = float(abs(gamma[0, j] - ref) / ref)
+            if ok[0, j]:
+                assert err < 3e-15 and err < estimate[0, j] + 1e-15, (j, err, estimate[0, j])
+
+
+@pytest.mark.parametrize("a, b", [(3.0, 5.0), (3.9, 4.0), (3.0, 3.912)])
+def test_cumulative_panel_rate_across_a_kink(a, b):
+    """A stress-natural law with a kink inside the panel (ln g_c = 3.912): the accepted nodes
+    against the elementary closed form within 2e-14, and the table's exact values (accepted or
+    integrated one by one) too."""
+    from tubefsi.rheology._flow_table import FlowTable, stress_natural_rate_panels
+    law = KinkedPowerLaw()
+    p = _panel_nodes(a, b)[None]
+    rate = np.exp(p)
+    tw = law._stress(rate)
+    gamma, _, ok = stress_natural_rate_panels(law, p, tw)
+    exact = law.exact_rate(tw)
+    assert np.all(rel(gamma[ok], exact[ok]) < 2e-14)
+    s, y, _ = FlowTable(law)._exact(p)
+    assert np.all(rel(np.exp(y), exact) < 2e-14)
+
+
+def test_cumulative_panel_rate_refuses_a_stress_plateau():
+    """Near a yield stress 1 - q cancels (q -> 1): those nodes are refused, and the table's
+    exact values there are the point-wise integrals."""
+    from tubefsi.rheology._flow_table import FlowTable, stress_natural_rate, stress_natural_rate_panels
+    law, twin = StressOnlyHerschelBulkley(), RateOnlyHerschelBulkley()
+    p = _panel_nodes(-20.0, -14.0)[None]            # tau - tau_y ~ 1e-5 .. 1e-3 tau_y
+    rate = np.exp(p)
+    tw = law._stress(rate)
+    _, _, ok = stress_natural_rate_panels(law, p, tw)
+    assert not np.any(ok)
+    _, y, _ = FlowTable(law)._exact(p)
+    assert np.array_equal(np.exp(y), np.exp(np.log(stress_natural_rate(law, rate, tw)[0])))
+    # (their own accuracy there is the law's: 1 - (tau / tau_w)^3 carries eps tau_y / (tau - tau_y))
+    excess = law.consistency * rate**law.index
+    assert np.all(rel(np.exp(y), twin.exact_rate(tw, excess)) < 4 * EPS * law.yield_stress / excess)
+
+
+@settings(max_examples=25, deadline=None)
+@given(eta0=st.floats(1e-3, 10.0), lam=st.floats(1e-3, 1e3), index=st.floats(0.05, 1.8),
+       centre=st.floats(-25.0, 25.0), width=st.floats(0.05, 12.0))
+def test_cumulative_panel_rate_equals_the_pointwise_integrals(eta0, lam, index, centre, width):
+    """Property: wherever the cumulative rule accepts a node, it agrees with the point-wise
+    error-controlled integral of the other formulation (1 - ratio^3 over t in (0, 1]) within
+    4e-15 (the rounding it may keep is a quarter of the table's 1e-14)."""
+    from tubefsi.rheology._flow_table import stress_natural_rate, stress_natural_rate_panels
+    law = CarreauLike(eta0=eta0, lam=lam, index=index)
+    p = _panel_nodes(centre - width / 2, centre + width / 2)[None]
+    rate = np.exp(p)
+    tw = law._stress(rate)
+    gamma, _, ok = stress_natural_rate_panels(law, p, tw)
+    pointwise = stress_natural_rate(law, rate[ok], tw[ok])[0]
+    assert np.all(rel(gamma[ok], pointwise) < 4e-15)

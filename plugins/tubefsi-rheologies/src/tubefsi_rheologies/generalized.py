@@ -25,7 +25,8 @@ def _log1p_power(x, a):
     :math:`x^a > 1` (so the stress keeps increasing up to the largest representable shear rate)."""
     with np.errstate(divide="ignore"):
         la = a * np.log(x)
-    return np.where(la > 0, la + np.log1p(np.exp(-np.abs(la))), np.log1p(np.exp(np.minimum(la, 0.0))))
+    # max(la, 0) + ln(1 + e^-|la|): one exponential and one log1p per point, either branch
+    return np.log1p(np.exp(-np.abs(la))) + np.maximum(la, 0.0)
 
 
 def _require(ok, name, admissible, value, detail=None):
