@@ -365,12 +365,14 @@ def stress_natural_rate_panels(rheology, p, wall_stress, *, rtol: float = RTOL):
     over steps in :math:`u`: 20 of width 2 below the panel's lowest node (as :func:`unit_integral`'s
     initial panels; the rest, below :math:`e^{-40}` of the lowest rate, is bounded by the integrand
     at the first step's start, for :math:`\tau` increases), then node to node (in parts of at most 2).
-    Each step is taken by the Kronrod rule on the step and on its two halves: the halves' estimates,
-    at least the change on bisection (which bounds the error where the law has a kink, as in :func:`unit_integral`). A point
-    is accepted when the summed truncation estimates are within ``rtol`` of :math:`\Gamma` (or twice
-    the rounding, which they cannot fall below) and the rounding (the rules' floors and that of :math:`1 - q`, both amplified by :math:`q/(1-q)`: large
-    only where the stress is nearly constant, as near a yield stress) within a quarter of
-    :data:`TOL`; the caller integrates the others one by one (:func:`stress_natural_rate`). One
+    Each step is taken by the Kronrod rule on the step and on its two halves: the halves'
+    estimates, at least the change on bisection (which bounds the error where the law has a kink,
+    as in :func:`unit_integral`). A point is accepted when the summed truncation estimates are
+    within ``rtol`` of :math:`\Gamma` (or twice the rounding, which they cannot fall below), and
+    they and the rounding together (the rules' floors, and :math:`6\epsilon q` for the sum, the
+    scale factors and :math:`1 - q`, all amplified by :math:`q/(1-q)`: large where the stress is
+    nearly constant, as near a yield stress or for a power-law index below ~0.3) within a quarter
+    of :data:`TOL`; the caller integrates the others one by one (:func:`stress_natural_rate`). One
     vectorized rule for the whole panel: a fourth of the law evaluations of the point-wise
     integrals of a 29-node panel, and none of their refinement rounds."""
     p = np.asarray(p, dtype=float)
@@ -433,7 +435,7 @@ def stress_natural_rate_panels(rheology, p, wall_stress, *, rtol: float = RTOL):
         rel = truncation + rounding
         # (the truncation estimate of a step is at least its rounding noise: as unit_integral's
         # points, a node is also done when that estimate is within twice the rounding)
-        good = (rest > 0) & (truncation <= np.maximum(rtol, 2.0 * rounding)) & (rounding <= 0.25 * TOL) \
+        good = (rest > 0) & (truncation <= np.maximum(rtol, 2.0 * rounding)) & (rel <= 0.25 * TOL) \
             & np.isfinite(gamma) & np.isfinite(rel)
     out = np.empty_like(gamma), np.empty_like(rel), np.empty(good.shape, dtype=bool)
     for dest, src in zip(out, (gamma, rel, good)):
@@ -1209,12 +1211,11 @@ def _eval_subs(subs, y, s0=0.0):
     """Evaluate the lookup panels ``subs`` [(lo, hi, cheb)] (offsets from ``s0``) at ``y`` (1-D)."""
     lo = np.array([t[0] for t in subs])
     j = np.clip(np.searchsorted(lo, y, side="right") - 1, 0, len(subs) - 1)
-    out = np.empty(y.shape)
-    for k in np.unique(j):
-        a, b, c = subs[k]
-        x = (y[j == k] - 0.5 * (a + b)) / (0.5 * (b - a))
-        out[j == k] = np.polynomial.chebyshev.chebval(x, c)
-    return out + s0
+    a = lo[j]
+    b = np.array([subs[k][1] for k in j])
+    x = (y - 0.5 * (a + b)) / (0.5 * (b - a))
+    coef = np.array([subs[k][2] for k in j]).T              # one column per point
+    return np.polynomial.chebyshev.chebval(x, coef, tensor=False) + s0
 
 
 def _linear_subs(panel):
