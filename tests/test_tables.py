@@ -227,3 +227,22 @@ def test_chebyshev_lookup_against_numpy_chebval(decay):
     bound = 4e-16 if decay < 1 else 1e-14
     assert np.max(np.abs(table(x) - ref) / scale) < bound
     assert max(abs(table.scalar(float(xi)) - ri) / si for xi, ri, si in zip(x[:50], ref, scale)) < bound
+
+
+def test_chebyshev_lookup_at_the_ends_and_breaks_and_in_place():
+    """At the ends of the range and on either side of every breakpoint (where the bucket lookup
+    may pick the neighbouring panel, or one past the last, whose gathers clip) an interpolant of
+    sin is still within its tolerance; evaluating into the argument's own array (``out=x``, the
+    curve path) gives the same values, for both evaluation rules."""
+    from tubefsi.couplers._tables import Chebyshev
+    cheb, _ = fit_chebyshev(np.sin, -1.0, 7.0)
+    b = cheb.breaks
+    x = np.concatenate([b, np.nextafter(b, np.inf)[:-1], np.nextafter(b, -np.inf)[1:], np.linspace(-1.0, 7.0, 101)])
+    got = cheb(x)
+    assert np.max(np.abs(got - np.sin(x))) < 1e-14
+    rough = Chebyshev(b, np.random.default_rng(7).standard_normal(cheb.coef.shape))     # Clenshaw
+    assert cheb._horner and not rough._horner
+    for table in (cheb, rough):
+        inplace = x.copy()
+        assert table(inplace, out=inplace) is inplace
+        np.testing.assert_array_equal(inplace, table(x))

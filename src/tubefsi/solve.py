@@ -222,7 +222,9 @@ class _Results(dict):
         self.n = n
 
     def store(self, idx, state):
-        whole = not self and idx.size == self.n
+        """Store ``state`` at the points ``idx`` (indices, or a slice of consecutive points)."""
+        size = idx.stop - idx.start if type(idx) is slice else idx.size
+        whole = not self and size == self.n
         for f in _STATE_FIELDS:
             value = np.asarray(getattr(state, f), dtype=float)
             if whole and value.shape == (self.n,) and value.flags.writeable:   # not a broadcast view
@@ -230,7 +232,7 @@ class _Results(dict):
                 continue
             if f not in self:
                 self[f] = np.full(self.n, np.nan)
-            self[f][idx] = np.broadcast_to(value, idx.shape)
+            self[f][idx] = np.broadcast_to(value, (size,))
 
     def __missing__(self, name):          # no chunk answered (every point beyond a limit)
         value = self[name] = np.full(self.n, np.nan)
@@ -244,38 +246,44 @@ def _solve_chunks(flat, values, method, runner, controlled, optimistic, on_infea
     """Solve every point of ``flat`` in chunks of at most ``CHUNK`` points (one parameter set per
     chunk where a model needs it), storing into ``out`` and ``feasible``."""
     n = values.size
-    for index, part in flat.split(np.arange(n)):
-        for start in range(0, index.size, CHUNK):
-            idx = index[start:start + CHUNK]
-            chunk = part if part.size == 1 or idx.size == index.size else part.take(np.arange(start, start + idx.size))
+    # a scene of scalars (a curve) is one part, its points in order: chunks are slices
+    parts = [(None, flat)] if flat.size == 1 else flat.split(np.arange(n))
+    for index, part in parts:
+        size = n if index is None else index.size
+        for start in range(0, size, CHUNK):
+            stop = min(start + CHUNK, size)
+            idx = np.arange(start, stop) if index is None and size > CHUNK else (
+                slice(start, stop) if index is None else index[start:stop])
+            chunk = part if part.size == 1 or stop - start == size else part.take(np.arange(start, stop))
+            load = values[idx].copy() if index is None else values[idx]   # (a copy: the state keeps it)
             if optimistic:
                 # the engine detects a point beyond the limit itself (its inlet stretch runs away):
                 # solve first, and look for the limit (a quadrature to infinity) only if one did
                 try:
-                    state = method(chunk, values[idx])
+                    state = method(chunk, load)
                 except OverflowError:         # a scene beyond double precision: a typed error
-                    raise _beyond_range(controlled, values[idx], "an intermediate quantity overflows") from None
+                    raise _beyond_range(controlled, load, "an intermediate quantity overflows") from None
                 except (NoSteadyStateError, StretchRangeError) as error:   # the limit decides which
-                    if _feasible(runner, chunk, values[idx], controlled, raise_=on_infeasible == "raise") is None:
+                    if _feasible(runner, chunk, load, controlled, raise_=on_infeasible == "raise") is None:
                         raise error
                 else:
                     out.store(idx, state)
-                    shown.update(idx.size)
+                    shown.update(stop - start)
                     continue
-            ok = _feasible(runner, chunk, values[idx], controlled, raise_=on_infeasible == "raise")
-            go = np.arange(idx.size) if ok is None else np.flatnonzero(ok)
+            ok = _feasible(runner, chunk, load, controlled, raise_=on_infeasible == "raise")
+            go = np.arange(stop - start) if ok is None else np.flatnonzero(ok)
             if ok is not None:
                 feasible[idx] = ok
             if go.size == 0:
-                shown.update(idx.size)
+                shown.update(stop - start)
                 continue
-            sub = chunk if go.size == idx.size else (chunk.take(go) if chunk.size > 1 else chunk)
+            sub = chunk if go.size == stop - start else (chunk.take(go) if chunk.size > 1 else chunk)
             try:
-                state = method(sub, values[idx][go])
+                state = method(sub, load[go])
             except OverflowError:             # a scene beyond double precision: a typed error
-                raise _beyond_range(controlled, values[idx][go], "an intermediate quantity overflows") from None
-            out.store(idx[go], state)
-            shown.update(idx.size)
+                raise _beyond_range(controlled, load[go], "an intermediate quantity overflows") from None
+            out.store(np.arange(start, stop)[go] if type(idx) is slice else idx[go], state)
+            shown.update(stop - start)
 
 
 def _graded(scene, coupler):

@@ -82,54 +82,64 @@ class Chebyshev:
         self._buckets = count
 
     def _panel(self, x):
-        """The panel index of each ``x``."""
+        """The panel index of each ``x``, possibly one past the last panel at its upper end: every
+        gather by it clips (``mode="clip"``) to the panels."""
         if self._search:
             return np.clip(np.searchsorted(self.breaks, x, side="right") - 1, 0, len(self.breaks) - 2)
-        b = ((x - self.lo) * self._bucket_scale).astype(np.intp)
-        # (two ufuncs, not np.clip: its Python wrapper costs more than the work at a few points)
+        b = np.subtract(x, self.lo)
+        b *= self._bucket_scale
+        # clipped while still floats (two ufuncs, not np.clip: its Python wrapper costs more than
+        # the work at a few points; and the integer ufuncs are not vectorized)
         np.minimum(b, self._buckets - 1, out=b)
-        np.maximum(b, 0, out=b)
-        j = self._bucket_panel[b]
-        j += x >= self._bucket_break[b]           # the second panel of a bucket that holds two
-        np.minimum(j, len(self.breaks) - 2, out=j)
+        np.maximum(b, 0.0, out=b)
+        b = b.astype(np.intp)
+        j = self._bucket_panel.take(b, mode="clip")
+        j += x >= self._bucket_break.take(b, mode="clip")     # the second panel of a bucket holding two
         return j
 
-    def __call__(self, x):
-        """Values at ``x`` (an array inside ``[lo, hi]``): a panel lookup and one Clenshaw sweep."""
+    def __call__(self, x, out=None):
+        """Values at ``x`` (an array inside ``[lo, hi]``): a panel lookup and one Clenshaw sweep (or
+        Horner, below). ``out``: a float array of ``x``'s shape for the values (it may be ``x``
+        itself: ``x`` is read only before the first value is written)."""
         x = np.asarray(x, dtype=float)
         if x.ndim != 1:                                        # the lookups work on flat arrays
             return self(x.ravel()).reshape(x.shape)
         j = self._panel(x)
+        # (per-panel factors gathered first and scaled in place: no pass allocates what it does not
+        # keep; and every gather with mode="clip", the indices being in range: with the default
+        # mode, "raise", a gather into ``out`` is buffered and costs twice as much)
         if self._horner:
-            t = x * self._t_scale[j]                           # t in [-1, 1] on the panel
-            t += self._t_offset[j]
+            t = self._t_scale.take(j, mode="clip")              # t in [-1, 1] on the panel
+            t *= x
+            ak = self._t_offset.take(j, mode="clip")
+            t += ak
             mono = self._monoT
-            value = mono[_DEGREE].take(j)
-            ak = np.empty_like(value)
+            value = mono[_DEGREE].take(j, out=out, mode="clip")
             for k in range(_DEGREE - 1, -1, -1):               # b = b t + a_k
                 value *= t
-                mono[k].take(j, out=ak)
+                mono[k].take(j, out=ak, mode="clip")
                 value += ak
             return value
-        t2 = x * self._t2_scale[j]                             # 2 t, t in [-1, 1] on the panel
-        t2 += self._t2_offset[j]
+        t2 = self._t2_scale.take(j, mode="clip")               # 2 t, t in [-1, 1] on the panel
+        t2 *= x
+        t2 += self._t2_offset.take(j, mode="clip")
         # Clenshaw with the coefficients gathered one degree at a time into contiguous vectors (a
         # 2-D gather coef[:, j] has strided rows: every pass over them was three times slower)
         coef = self._coefT
-        b2 = coef[_DEGREE].take(j)
+        b2 = coef[_DEGREE].take(j, mode="clip")
         b1 = np.multiply(t2, b2)
-        b1 += coef[_DEGREE - 1].take(j)
+        b1 += coef[_DEGREE - 1].take(j, mode="clip")
         ck, tmp = np.empty_like(b1), np.empty_like(b1)
         for k in range(_DEGREE - 2, 0, -1):                    # b_k = 2t b_{k+1} - b_{k+2} + c_k
-            coef[k].take(j, out=ck)
+            coef[k].take(j, out=ck, mode="clip")
             ck -= b2
             np.multiply(t2, b1, out=tmp)
             tmp += ck
             b1, b2, tmp = tmp, b1, b2
-        value = np.multiply(t2, b1)
+        value = np.multiply(t2, b1, out=out)
         value *= 0.5
         value -= b2
-        value += coef[0].take(j)
+        value += coef[0].take(j, out=ck, mode="clip")
         return value
 
     def scalar(self, x: float) -> float:

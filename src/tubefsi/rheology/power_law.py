@@ -73,7 +73,13 @@ class _PowerLawForms(Rheology):
         # q > 0, even where phi itself would leave double range
         n = self.index
         with np.errstate(divide="ignore"):
-            return np.log(flow_rate) * n + (np.log(2.0 * self.consistency) + n * np.log((3.0 * n + 1.0) / (math.pi * n)))
+            shift = np.log(2.0 * self.consistency) + n * np.log((3.0 * n + 1.0) / (math.pi * n))
+            out = np.log(flow_rate)
+            if type(n) is float and type(out) is np.ndarray:     # a curve: in place, one array
+                out *= n
+                out += shift
+                return out
+            return out * n + shift
 
     def _flow_factor_inverse(self, factor):
         n = self.index

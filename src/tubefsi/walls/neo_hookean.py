@@ -58,11 +58,25 @@ class _NeoHookeanLaw:
 def _beyond(out, strain, stretch, direct):
     """``out`` with ``direct(stretch)`` where the strain is past 1e70 (its polynomial form would
     overflow); the rare case only costs its own points."""
-    far = strain > 1e70
     if out.ndim == 0:
-        return direct(stretch) if far else out
-    if far.any():
+        return direct(stretch) if strain > 1e70 else out
+    if out.size and not strain.max() <= 1e70:        # (one reduction where nothing is that far)
+        far = strain > 1e70
         out[far] = direct(stretch[far])
+    return out
+
+
+def _quartic_rise(e):
+    r""":math:`\lambda^4 - 1 = \varepsilon(4 + \varepsilon(6 + \varepsilon(4 + \varepsilon)))` at
+    :math:`\lambda = 1 + \varepsilon`, in one array for an array (Horner in place)."""
+    if e.ndim == 0:
+        return e * (4.0 + e * (6.0 + e * (4.0 + e)))
+    out = e + 4.0
+    out *= e
+    out += 6.0
+    out *= e
+    out += 4.0
+    out *= e
     return out
 
 
@@ -73,7 +87,10 @@ def _reference_unit(strain):
     e = np.asarray(strain, dtype=float)
     with np.errstate(over="ignore", invalid="ignore"):
         lam = 1.0 + e
-        out = e * (4.0 + e * (6.0 + e * (4.0 + e))) / (lam * lam * lam)
+        cube = lam * lam
+        cube *= lam
+        out = _quartic_rise(e)
+        out /= cube
         return _beyond(out, e, lam, lambda big: big - big**-3)
 
 
@@ -84,7 +101,9 @@ def _current_unit(strain):
     with np.errstate(over="ignore", invalid="ignore"):
         lam = 1.0 + e
         lam2 = lam * lam
-        out = e * (4.0 + e * (6.0 + e * (4.0 + e))) / (lam2 * lam2)
+        lam2 *= lam2
+        out = _quartic_rise(e)
+        out /= lam2
         return _beyond(out, e, lam, lambda big: 1.0 - big**-4)
 
 
@@ -94,9 +113,12 @@ class _ThinForms(_NeoHookeanLaw):
     closed_form_integral = True
 
     def _pressure_at_strain(self, strain, tb):
-        if self.thickness_convention == "reference":
-            return self._installed_modulus() * tb * _reference_unit(strain)
-        return self._installed_modulus() * tb * _current_unit(strain)
+        unit = _reference_unit(strain) if self.thickness_convention == "reference" else _current_unit(strain)
+        scale = self._installed_modulus() * tb
+        if type(scale) is float and unit.ndim:      # (a curve: scaled in place)
+            unit *= scale
+            return unit
+        return scale * unit
 
     def _stiffness(self, stretch, tb):
         if self.thickness_convention == "reference":
