@@ -246,3 +246,20 @@ def test_chebyshev_lookup_at_the_ends_and_breaks_and_in_place():
         inplace = x.copy()
         assert table(inplace, out=inplace) is inplace
         np.testing.assert_array_equal(inplace, table(x))
+
+
+def test_the_scalar_rule_is_the_array_rule_bit_for_bit():
+    """The scalar path's unrolled Horner rule per panel does the array rule's operations in its
+    order: the same bits at every point (and a second call, from the cached rule, too)."""
+    cheb, _ = fit_chebyshev(np.log1p, 0.0, 100.0)
+    assert cheb._horner
+    x = np.concatenate([cheb.breaks, np.random.default_rng(2).uniform(0.0, 100.0, 300)])
+    array = cheb(x)
+    for _ in range(2):
+        assert [cheb.scalar(float(v)) for v in x] == array.tolist()
+
+
+def test_the_scalar_state_is_a_state():
+    from tubefsi.scene import State, _scalar_state
+    made = _scalar_state(1e-9, 2.5e3, 0.25, np.log1p(0.25))
+    assert made == State(1e-9, 2.5e3, 0.25, np.log1p(0.25)) and type(made) is State

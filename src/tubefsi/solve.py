@@ -27,7 +27,7 @@ from .couplers.separated import _TABLES, SeparatedVariables, curve_span
 from .geometry import Tube
 from .rheology.base import Rheology
 from .rheology.power_law import FactorRangeError
-from .scene import Scene, State, _resolve, make_scene
+from .scene import Scene, State, _resolve, make_scene, _scalar_state
 from .solution import Solution
 from .validity import SLENDERNESS, check, warn
 from .walls.base import WallModel
@@ -361,7 +361,7 @@ def _scalar_flow(rheology, wall, tube, q):
                            float(np.log(lam_max)))
     if a * (1.0 + strain) > SLENDERNESS * L or strain > wall.calibrated_strain:
         warn(check(scene, q, strain))
-    return Solution._scalar_flow_controlled(scene, chosen, State(q, drop, strain, v), name)
+    return Solution._scalar_flow_controlled(scene, chosen, _scalar_state(q, drop, strain, v), name)
 
 
 #: Points per coupler call: bounds the working memory (a few tens of MB) of any sweep.

@@ -66,6 +66,7 @@ class Chebyshev:
         self._horner = bool(np.all(np.abs(mono).sum(axis=1) <= 2.0 * np.abs(self.coef).sum(axis=1)))
         self._monoT = np.ascontiguousarray(mono.T)
         self._mono_parts = [tuple(row[::-1]) for row in mono.tolist()]     # a_D, ..., a_0
+        self._scalar_panels = [None] * len(self._mono_parts)
         self._t_scale, self._t_offset = 0.5 * self._t2_scale, 0.5 * self._t2_offset
         self._t_scale_list, self._t_offset_list = self._t_scale.tolist(), self._t_offset.tolist()
         # panel lookup by equal buckets as narrow as the narrowest panel (the panels come from
@@ -147,11 +148,11 @@ class Chebyshev:
         j = bisect.bisect_right(self._breaks, x) - 1
         j = 0 if j < 0 else (self._last if j > self._last else j)
         if self._horner:
-            t = x * self._t_scale_list[j] + self._t_offset_list[j]
-            value = 0.0
-            for a in self._mono_parts[j]:
-                value = value * t + a
-            return value
+            panel = self._scalar_panels[j]
+            if panel is None:                          # the panel's Horner rule, made on first use
+                panel = self._scalar_panels[j] = _horner_rule(self._mono_parts[j], self._t_scale_list[j],
+                                                              self._t_offset_list[j])
+            return panel(x)
         t2 = x * self._t2_scale_list[j] + self._t2_offset_list[j]
         top, inner, c0 = self._coef_parts[j]       # c_D; c_{D-1}, ..., c_1; c_0
         b1, b2 = top, 0.0
@@ -164,6 +165,19 @@ class Chebyshev:
         scale = 2.0 / np.diff(self.breaks)
         d = np.polynomial.chebyshev.chebder(self.coef.T, axis=0).T * scale[:, None]
         return Chebyshev(self.breaks, np.pad(d, ((0, 0), (0, 1))))
+
+
+def _horner_rule(parts, scale, offset):
+    """``x -> sum_k a_k t^k``, ``t = x scale + offset``, for one float: Horner's rule unrolled into
+    one expression with the panel's numbers as constants (``parts``: a_D, ..., a_0). The same
+    operations in the same order as the loop ``value = value t + a`` from ``a_D``, so the same
+    bits, at a third of its cost (the scalar path evaluates two tables per solve)."""
+    expr = repr(parts[0])
+    for a in parts[1:]:
+        expr = f"({expr}) * t + {a!r}"
+    namespace: dict = {}
+    exec(f"def rule(x):\n    t = x * {scale!r} + {offset!r}\n    return {expr}\n", namespace)   # noqa: S102
+    return namespace["rule"]
 
 
 def fit_chebyshev(f, lo, hi, *, panels=4, tol=1e-14, max_panels=256):
