@@ -177,3 +177,25 @@ def test_a_scalar_argument_with_array_parameters_in_the_generic_wall_paths():
             assert abs(strain[i] / one.strain(50.0, 0.3) - 1) <= 1e-15     # a root: to its last bits
         limit = wall.limit_pressure(0.3)
         assert np.shape(limit) == (3,)
+
+
+def test_points_of_every_point_are_read_only_views_with_the_gathered_values():
+    """Scene.at of all the points of a flat scene in order takes read-only views (no gather); any
+    other index of the same size gathers; both give each point its own values."""
+    from tubefsi.scene import make_scene
+    mu = np.array([1e3, 2e3, 3e3, 4e3])
+    scene = make_scene(rheologies["power-law"](consistency=np.array([0.01, 0.02, 0.03, 0.04]), index=0.7),
+                       walls["thick-neo-hookean"](shear_modulus=mu),
+                       tubefsi.Tube(radius=1e-4, thickness=np.array([1e-5, 2e-5, 3e-5, 4e-5]), length=1e-2))
+    for column in (False, True):
+        every = scene.at(np.arange(4), column=column)
+        backwards = scene.at(np.arange(4)[::-1].copy(), column=column)
+        shape = (4, 1) if column else (4,)
+        for got, flipped, ref in ((every.wall.shear_modulus, backwards.wall.shear_modulus, mu),
+                                  (every.tb, backwards.tb, np.array([0.1, 0.2, 0.3, 0.4])),
+                                  (every.rheology.consistency, backwards.rheology.consistency,
+                                   np.array([0.01, 0.02, 0.03, 0.04]))):
+            assert got.shape == shape and not got.flags.writeable
+            np.testing.assert_array_equal(got.ravel(), ref)
+            np.testing.assert_array_equal(flipped.ravel(), ref[::-1])
+    assert not np.shares_memory(backwards.wall.shear_modulus, scene.wall.shear_modulus)

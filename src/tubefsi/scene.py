@@ -11,6 +11,7 @@ validates every argument. A coupler returns a :class:`State`: arrays of one shap
 
 from __future__ import annotations
 
+import functools
 import math
 
 import attrs
@@ -323,14 +324,23 @@ class Points:
             self.outlet_pressure, self.log_stretch_max = scene.outlet_pressure, scene.log_stretch_max
             return
 
-        def pick(value):
-            if np.ndim(value) == 0:
-                return value
-            v = value[index]
-            return v[:, None] if column else v
+        if _every_point(index, scene.size):
+            # the identity (a whole flat scene, the common case): read-only views, not copies
+            def pick(value):
+                if np.ndim(value) == 0:
+                    return value
+                return _read_only(value[:, None] if column else value[:])
 
-        self.wall = model_at(scene.wall, index, column=column)
-        self.rheology = model_at(scene.rheology, index, column=column)
+            self.wall, self.rheology = _viewed(scene.wall, column), _viewed(scene.rheology, column)
+        else:
+            def pick(value):
+                if np.ndim(value) == 0:
+                    return value
+                v = value[index]
+                return v[:, None] if column else v
+
+            self.wall = model_at(scene.wall, index, column=column)
+            self.rheology = model_at(scene.rheology, index, column=column)
         self.radius = pick(scene.tube.radius)
         self.length = pick(scene.tube.length)
         self.tb = pick(scene.tb)
@@ -338,6 +348,33 @@ class Points:
         self.outlet_strain = pick(scene.outlet_strain)
         self.outlet_pressure = pick(scene.outlet_pressure)
         self.log_stretch_max = pick(scene.log_stretch_max)
+
+
+@functools.lru_cache(maxsize=8)
+def _positions(n):
+    out = np.arange(n)
+    out.flags.writeable = False
+    return out
+
+
+def _every_point(index, n) -> bool:
+    """Whether ``index`` is ``0, 1, ..., n - 1`` (one comparison pass instead of a gather per
+    quantity: a flat scene's points are most often asked for all at once)."""
+    return (type(index) is np.ndarray and index.ndim == 1 and index.size == n and n > 1
+            and index.dtype.kind in "iu" and index[0] == 0 and index[-1] == n - 1
+            and bool(np.array_equal(index, _positions(n))))
+
+
+def _read_only(view):
+    view.flags.writeable = False          # a view of the scene's own array: never written through
+    return view
+
+
+def _viewed(model, column):
+    """``model_at(model, every point)``: its array parameters as read-only views (columns if ``column``)."""
+    arrays = {name: _read_only(v[:, None] if column else v[:]) for name in _array_fields(type(model))
+              if isinstance(v := getattr(model, name), np.ndarray)}
+    return _replace(model, arrays) if arrays else model
 
 
 _KINDS = {"rheology": (Rheology, _rheologies), "wall": (WallModel, _walls)}
