@@ -43,7 +43,7 @@ _CHEB_TO_MONO = np.array([np.pad(np.polynomial.chebyshev.cheb2poly(np.eye(_DEGRE
 
 
 class Chebyshev:
-    """A piecewise Chebyshev interpolant: degree-20 series on the panels ``breaks[j] .. breaks[j+1]``."""
+    """A piecewise Chebyshev interpolant: degree-10 series on the panels ``breaks[j] .. breaks[j+1]``."""
 
     def __init__(self, breaks, coef):
         self.breaks = np.asarray(breaks, dtype=float)
