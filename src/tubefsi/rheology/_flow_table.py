@@ -1125,7 +1125,7 @@ class _Segment:
         np.clip(work, 0.0, self.ncell - 1, out=work)
         cell = work.astype(np.intp)
         j = self.first.take(cell)
-        np.take(self.threshold, cell, out=work)
+        np.take(self.threshold, cell, out=work, mode="clip")   # in range: clip skips the buffering
         np.add(j, y >= work, out=j, casting="unsafe")
         if self.any_multi:
             sub = np.flatnonzero(self.multi.take(cell))
@@ -1134,13 +1134,13 @@ class _Segment:
         del cell
         np.minimum(j, self.k - 1, out=j)
         x = np.subtract(y, self.center.take(j))
-        np.take(self.inv, j, out=work)
+        np.take(self.inv, j, out=work, mode="clip")
         x *= work
         coef = self.coef
         acc = coef[_P].take(j)
         for d in range(_P - 1, -1, -1):
             acc *= x
-            np.take(coef[d], j, out=work)
+            np.take(coef[d], j, out=work, mode="clip")
             acc += work
         if self.flagged:
             worst = float(np.max(self.error.take(j)))
