@@ -406,11 +406,9 @@ def test_solve_with_a_kinked_law():
 
 # ---------------------------------------------------------------- a panel's nodes from one cumulative integral
 def _panel_nodes(a, b):
-    """The 29 parameters of a table panel on [a, b] (its Lobatto nodes and check points)."""
-    from tubefsi.rheology._flow_table import _N, _XC, _XF
-    p = 0.5 * (a + b) + 0.5 * (b - a) * np.concatenate([_XF, _XC])
-    p[0], p[_N] = a, b
-    return p
+    """The 29 parameters of the table panel on [a, b] (its Lobatto nodes and check points), (1, 29)."""
+    from tubefsi.rheology._flow_table import _panel_nodes as nodes
+    return nodes(np.array([a]), np.array([b]))
 
 
 @pytest.mark.parametrize("a, b", [(-6.0, -4.0), (-1.0, 1.0), (3.0, 5.0), (-4.0, 4.0), (12.0, 20.0)])
@@ -421,7 +419,7 @@ def test_cumulative_panel_rate_against_mpmath(a, b):
     plus 1e-15; at least 80 % of the nodes accepted on a smooth law."""
     from tubefsi.rheology._flow_table import stress_natural_rate_panels
     law = CarreauLike()
-    p = _panel_nodes(a, b)[None]
+    p = _panel_nodes(a, b)
     rate = np.exp(p)
     tw = law._stress(rate)     # the reference takes these as given: their rounding, amplified 3q/(1-q), is the law's
     gamma, estimate, ok = stress_natural_rate_panels(law, p, tw)
@@ -450,7 +448,7 @@ def test_cumulative_panel_rate_across_a_kink(a, b):
     integrated one by one) too."""
     from tubefsi.rheology._flow_table import FlowTable, stress_natural_rate_panels
     law = KinkedPowerLaw()
-    p = _panel_nodes(a, b)[None]
+    p = _panel_nodes(a, b)
     rate = np.exp(p)
     tw = law._stress(rate)
     gamma, _, ok = stress_natural_rate_panels(law, p, tw)
@@ -465,7 +463,7 @@ def test_cumulative_panel_rate_refuses_a_stress_plateau():
     exact values there are the point-wise integrals."""
     from tubefsi.rheology._flow_table import FlowTable, stress_natural_rate, stress_natural_rate_panels
     law, twin = StressOnlyHerschelBulkley(), RateOnlyHerschelBulkley()
-    p = _panel_nodes(-20.0, -14.0)[None]            # tau - tau_y ~ 1e-5 .. 1e-3 tau_y
+    p = _panel_nodes(-20.0, -14.0)            # tau - tau_y ~ 1e-5 .. 1e-3 tau_y
     rate = np.exp(p)
     tw = law._stress(rate)
     _, _, ok = stress_natural_rate_panels(law, p, tw)
@@ -487,7 +485,7 @@ def test_cumulative_panel_rate_equals_the_pointwise_integrals(eta0, lam, index, 
     table's 1e-14."""
     from tubefsi.rheology._flow_table import stress_natural_rate, stress_natural_rate_panels
     law = CarreauLike(eta0=eta0, lam=lam, index=index)
-    p = _panel_nodes(centre - width / 2, centre + width / 2)[None]
+    p = _panel_nodes(centre - width / 2, centre + width / 2)
     rate = np.exp(p)
     tw = law._stress(rate)
     gamma, estimate, ok = stress_natural_rate_panels(law, p, tw)

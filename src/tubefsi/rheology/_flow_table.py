@@ -519,6 +519,17 @@ _SLOPE_F = _FIT_F @ _cheb_and_slope(_XF, _N)[1].T              # values at nodes
 _SLOPE_F[:, 0] = _FIT_F @ np.array([(-1.0) ** (k + 1) * k * k for k in range(_N + 1)])
 _SLOPE_F[:, -1] = _FIT_F @ np.array([k * k for k in range(_N + 1)], dtype=float)
 
+_XS = np.concatenate([_XF, _XC])                              # a panel's nodes, then its check points
+
+
+def _panel_nodes(pa, pb):
+    """The parameters of the panels ``[pa, pb]`` (1-D arrays): their Lobatto nodes (exact at the
+    ends), then their check points; shape (panels, 29)."""
+    p = (0.5 * (pa + pb))[:, None] + (0.5 * (pb - pa))[:, None] * _XS
+    p[:, 0], p[:, _N] = pa, pb
+    return p
+
+
 _P = 7                                                        # lookup degree
 _XL = -np.cos(np.pi * (np.arange(_P + 1) + 0.5) / (_P + 1))   # Chebyshev points (first kind)
 _FIT_L = np.linalg.inv(np.polynomial.chebyshev.chebvander(_XL, _P)).T
@@ -635,11 +646,8 @@ class FlowTable:
                                        "panels: is the constitutive law continuous and increasing?")
             pa = np.array([a for a, _ in pending])
             pb = np.array([b for _, b in pending])
-            mid, half = 0.5 * (pa + pb), 0.5 * (pb - pa)
-            xs = np.concatenate([_XF, _XC])
-            p = mid[:, None] + half[:, None] * xs
-            p[:, 0], p[:, _N] = pa, pb
-            s, y, err = self._exact(p)          # whole panels: see stress_natural_rate_panels
+            mid = 0.5 * (pa + pb)
+            s, y, err = self._exact(_panel_nodes(pa, pb))   # whole panels: see stress_natural_rate_panels
             nxt = []
             for i in range(len(pending)):
                 verdict = self._accept(pa[i], pb[i], s[i], y[i], err[i])
