@@ -263,3 +263,50 @@ def test_the_scalar_state_is_a_state():
     from tubefsi.scene import State, _scalar_state
     made = _scalar_state(1e-9, 2.5e3, 0.25, np.log1p(0.25))
     assert made == State(1e-9, 2.5e3, 0.25, np.log1p(0.25)) and type(made) is State
+
+
+@pytest.mark.parametrize("fn, lo, hi", [(np.sin, -1.0, 7.0), (np.log1p, 0.0, 100.0), (np.arctan, 0.0, 30.0)])
+def test_uniform_fit_meets_its_tolerance_everywhere(fn, lo, hi):
+    """The low-degree uniform interpolant (the array path of a table's inverse) against the
+    function itself (numpy's, to an ulp) at 2e5 points it was not fitted or checked at, at both
+    ends, and evaluated into its argument's own array."""
+    from tubefsi.couplers._tables import fit_uniform
+    fast, err = fit_uniform(fn, lo, hi)
+    assert fast is not None and err <= 2e-15
+    x = np.concatenate([[lo, hi, np.nextafter(hi, -np.inf)], np.random.default_rng(7).uniform(lo, hi, 200_000)])
+    want = fn(x)
+    assert np.max(np.abs(fast(x) - want) / np.maximum(1.0, np.abs(want))) <= 4e-15
+    same = x.copy()
+    assert np.array_equal(fast(same, out=same), fast(x))
+
+
+def test_uniform_fit_gives_up_honestly():
+    """A function no rule of the budget resolves (a square-root singularity at the end) gets
+    None, and the table keeps its degree-10 inverse; so does one whose panel coordinate's rounding
+    (an absolute eps (hi - lo) in x: arctan's slope 1 at 0, 30 from the lower end) exceeds the
+    tolerance."""
+    from tubefsi.couplers._tables import fit_uniform
+    fast, err = fit_uniform(lambda x: np.sqrt(np.maximum(1.0 - x, 0.0)), 0.0, 1.0)
+    assert fast is None and err == np.inf
+    assert fit_uniform(np.arctan, -30.0, 30.0)[0] is None
+
+
+def test_thin_reference_pressure_from_the_log_stretch_against_mpmath():
+    r"""The thin reference-thickness law from :math:`v = \ln\lambda` (:math:`-e^v\,\mathrm{expm1}(-4v)`,
+    the curve path) against :math:`\lambda - \lambda^{-3}` in 40-digit mpmath, from
+    :math:`v = 10^{-12}` to 650, within 4 ulp; the current-thickness law and other arguments fall
+    back to the strain form exactly."""
+    import mpmath
+    mpmath.mp.dps = 40
+    wall = walls["thin-neo-hookean"](shear_modulus=2e3, thickness_convention="reference")
+    v = np.concatenate([np.geomspace(1e-12, 650.0, 400), [3e-9, 0.5, 2.0]])
+    got = wall._pressure_at_log_stretch(v, np.expm1(v), 0.3)
+    lam = [mpmath.exp(mpmath.mpf(float(x))) for x in v]
+    want = np.array([float(2e3 * mpmath.mpf(0.3) * (s - s**-3)) for s in lam])
+    assert np.max(np.abs(got / want - 1)) <= 4 * 2.2e-16
+    current = walls["thin-neo-hookean"](shear_modulus=2e3, thickness_convention="current")
+    assert np.array_equal(current._pressure_at_log_stretch(v[:50], np.expm1(v[:50]), 0.3),
+                          current._pressure_at_strain(np.expm1(v[:50]), 0.3))
+    far = np.array([1.0, 701.0])                         # past v = 700: the strain form
+    assert np.array_equal(wall._pressure_at_log_stretch(far, np.expm1(far), 0.3),
+                          wall._pressure_at_strain(np.expm1(far), 0.3))

@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 
+from ._products import rows_dot
 from .errors import ConvergenceError
 
 EPS = np.finfo(float).eps
@@ -79,7 +80,7 @@ def integrate_panels(f, upper, *, order=16, panel_width=2.0):
         t = ((np.arange(count)[:, None] + x[None, :]) / count).ravel()
         wt = np.tile(w, count) / count
         u = flat[idx, None] * t
-        out[idx] = flat[idx] * (f(u, idx) @ wt)
+        out[idx] = flat[idx] * rows_dot(f(u, idx), wt)
     return out.reshape(upper.shape)
 
 
@@ -99,7 +100,7 @@ def _panels_and_slope(f, upper, width, idx, order):
         wt = np.tile(w, count) / count
         u = upper[sel, None] * t
         values = f(u, idx[sel])
-        out[sel] = upper[sel] * (values @ wt)
+        out[sel] = upper[sel] * rows_dot(values, wt)
         # log-slope across each panel from its first and last nodes (exact for an exponential):
         # e^(kappa u) on a panel of width h is integrated to full precision for kappa h <= m
         # (m >= 12; 0.6 m below), i.e. for |ln(last / first)| <= c = (x_m - x_1) m

@@ -27,10 +27,12 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import threading
 
 import attrs
 import numpy as np
 
+from ._products import fixed_width_product, rows_dot
 from .errors import AccuracyWarning, warn_user
 
 __all__ = ["Integral", "adaptive", "adaptive_to_pole", "solve_integral", "warn_unconverged", "quiet", "KRONROD_NODES",
@@ -63,6 +65,10 @@ KRONROD_WEIGHTS = 0.5 * np.concatenate([_WK[:-1], _WK[::-1]])
 #: The 10-point Gauss weights on [0, 1], for the nodes ``KRONROD_NODES[1::2]``.
 GAUSS_WEIGHTS = 0.5 * np.concatenate([_WG, _WG[::-1]])
 
+#: The Kronrod weights and the embedded Gauss weights (zero at the Kronrod-only nodes), as columns.
+_KRONROD_AND_GAUSS = np.stack([KRONROD_WEIGHTS, np.zeros(21)], axis=1)
+_KRONROD_AND_GAUSS[1::2, 1] = GAUSS_WEIGHTS
+
 _EPS = np.finfo(float).eps
 
 
@@ -81,16 +87,17 @@ def _rule(f, lo, hi, idx, noise=None):
     h = hi - lo
     x = lo[:, None] + h[:, None] * KRONROD_NODES
     y = np.asarray(f(x, idx), dtype=float)
-    kron = y @ KRONROD_WEIGHTS                       # mean value of f on the panel (weights sum to 1)
-    gauss = y[:, 1::2] @ GAUSS_WEIGHTS
+    # (every product row by row, whatever the batch: tubefsi._products)
     with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
-        spread = np.abs(y - kron[:, None]) @ KRONROD_WEIGHTS
+        rules = rows_dot(y, _KRONROD_AND_GAUSS)
+        kron, gauss = rules[:, 0], rules[:, 1]          # mean values of f on the panel (weights sum to 1)
+        spread = rows_dot(np.abs(y - kron[:, None]), KRONROD_WEIGHTS)
         raw = np.abs(kron - gauss)
         scaled = np.where((spread > 0) & (raw > 0), spread * np.minimum(1.0, (200.0 * raw / spread) ** 1.5), raw)
-        magnitude = np.abs(y) @ KRONROD_WEIGHTS
+        magnitude = rows_dot(np.abs(y), KRONROD_WEIGHTS)
         floor = 2.0 * _EPS * magnitude                            # the rule's own rounding
         if noise is not None:                                     # and the integrand's, if known
-            floor = np.maximum(floor, (np.abs(y) * noise(x, idx)) @ KRONROD_WEIGHTS)
+            floor = np.maximum(floor, rows_dot(np.abs(y) * noise(x, idx), KRONROD_WEIGHTS))
         error = np.maximum(scaled, floor)
     return kron * h, error * np.abs(h), floor * np.abs(h)
 
@@ -326,20 +333,30 @@ _COEF, _ANTI, _CUMULATIVE = slice(0, 17), slice(17, 35), slice(35, 52)
 _BLOCK = 256
 
 
+_SCRATCH = threading.local()
+
+
+def _workspace(name, shape):
+    """An uninitialized float array of ``shape`` from this thread's scratch buffer ``name``, reused
+    by every call (valid until the next call asks for the same name). Why: the arrays of a batch
+    of 10^4 points are megabytes, which glibc allocates with mmap and unmaps on free, so that a
+    fresh one costs a page fault per 4 KiB written (~1000 per batch, a quarter of a broadcast
+    solve's time). A buffer grows to the largest batch seen (at most ``CHUNK`` points of a solve:
+    7 MB)."""
+    size = shape[0] * shape[1]
+    buffer = getattr(_SCRATCH, name, None)
+    if buffer is None or buffer.size < size:
+        buffer = np.empty(size)
+        setattr(_SCRATCH, name, buffer)
+    return buffer[:size].reshape(shape)
+
+
 def _apply_map(y):
-    """``_MAP @ y.T`` (shape (52, P), rows contiguous), in blocks of ``_BLOCK`` points. A block of
-    one point is computed as two: a matrix-vector product sums in another order than the
-    matrix-matrix one, and a point's answer must not depend on the batch it came in (a
-    broadcast solve equals its scalar solves)."""
-    out = np.empty((_MAP.shape[0], y.shape[0]))
-    y_t = y.T
-    for start in range(0, y.shape[0], _BLOCK):
-        block = y_t[:, start:start + _BLOCK]
-        if block.shape[1] == 1:
-            out[:, start:start + 1] = (_MAP @ np.repeat(block, 2, axis=1))[:, :1]
-        else:
-            out[:, start:start + _BLOCK] = _MAP @ block
-    return out
+    """``_MAP @ y.T`` (shape (52, P), rows contiguous), in blocks of ``_BLOCK`` points of one
+    shape (:func:`~tubefsi._products.fixed_width_product`: a point's answer must not depend on the
+    batch it came in: a broadcast solve equals its scalar solves), into this thread's scratch
+    buffer (valid until the next call)."""
+    return fixed_width_product(_MAP, y.T, out=_workspace("maps", (_MAP.shape[0], y.shape[0])), width=_BLOCK)
 
 
 def _clenshaw(coef, t):

@@ -435,6 +435,11 @@ def make_scene(rheology, wall, tube, *, outlet_pressure=0.0, external_pressure=0
     tube = wall._installed_tube(tube)        # an axial pre-stretch installs the tube longer and narrower
     if (type(outlet_pressure) is float and outlet_pressure == 0.0 and type(external_pressure) is float
             and external_pressure == 0.0):   # the common case: an unloaded outlet is below every limit
+        if parameter_shape(rheology) == () and parameter_shape(wall) == () and parameter_shape(tube) == ():
+            # every parameter a float (a curve): the fields __attrs_post_init__ would derive, directly
+            lam_max = wall._max_stretch(tube.reduced_thickness)
+            return Scene._trusted(rheology, wall, tube, math.log(lam_max) if type(lam_max) is float
+                                  else float(np.log(lam_max)))
         return Scene(rheology=rheology, wall=wall, tube=tube, outlet_pressure=0.0)
     p_out = as_array("outlet_pressure", outlet_pressure, "[0, inf)", lambda a: a >= 0)
     p_out = float(p_out) if p_out.ndim == 0 else p_out

@@ -29,7 +29,7 @@ import math
 
 import numpy as np
 
-__all__ = ["Chebyshev", "SeparatedTable", "fit_chebyshev"]
+__all__ = ["Chebyshev", "SeparatedTable", "UniformPolynomial", "fit_chebyshev", "fit_uniform"]
 
 _DEGREE = 10
 _NODES = np.cos(np.pi * (np.arange(_DEGREE + 1) + 0.5) / (_DEGREE + 1))[::-1]     # ascending, in (-1, 1)
@@ -218,18 +218,106 @@ def fit_chebyshev(f, lo, hi, *, panels=4, tol=1e-14, max_panels=256):
     return Chebyshev(breaks, np.array([p[2] for p in done])), worst
 
 
+def _shift_to_unit(degree):
+    r"""The matrix ``S`` with ``a_u = a_t S``: monomial coefficients in :math:`t \in [-1, 1]` to
+    those in :math:`u = (t + 1)/2 \in [0, 1]` (:math:`t^k = (2u - 1)^k`, binomially)."""
+    out = np.zeros((degree + 1, degree + 1))
+    for k in range(degree + 1):
+        for m in range(k + 1):
+            out[k, m] = math.comb(k, m) * 2.0**m * (-1.0) ** (k - m)
+    return out
+
+
+class UniformPolynomial:
+    r"""A piecewise polynomial of low degree :math:`D` on :math:`P` equal panels of ``[lo, hi]``,
+    in the monomial basis of each panel's own coordinate :math:`u \in [0, 1)`: the array path of
+    a table where a low degree meets the tolerance (:func:`fit_uniform`).
+
+    Next to :class:`Chebyshev` (degree 10 on bisected panels) it costs per point a multiply-add
+    and a truncation for the panel (no bucket gathers) and :math:`D + 1` gathers and :math:`2D`
+    passes for Horner's rule: about half, at :math:`D = 6`. Its panel coordinate carries an
+    absolute rounding of about :math:`\epsilon P`: ``x`` is in effect rounded to
+    :math:`\epsilon\,(hi - lo)` (where the Chebyshev form rounds it to :math:`\epsilon|x|`); the
+    check of :func:`fit_uniform` measures the values as evaluated, rounding included. It has no
+    scalar path: the scalar path keeps the :class:`Chebyshev` it was fitted to.
+    """
+
+    def __init__(self, lo, hi, coef):
+        self.lo, self.hi = float(lo), float(hi)
+        self.coef = np.asarray(coef, dtype=float)          # (P, D + 1), ascending powers of u
+        self.panels, self.degree = self.coef.shape[0], self.coef.shape[1] - 1
+        # b = (x - lo) P / (hi - lo), shrunk by 2^-40 so that x = hi, with the rounding of the
+        # multiply-add, stays inside the last panel (the panels are fitted on this same map)
+        self._scale = self.panels / (self.hi - self.lo) * (1.0 - 2.0**-40)
+        self._offset = -self.lo * self._scale
+        self._coefT = np.ascontiguousarray(self.coef.T)
+
+    def panel_nodes(self, u):
+        """``x`` at the panel coordinates ``u`` (shape ``(m,)``) of every panel: shape ``(P, m)``."""
+        return (np.arange(self.panels)[:, None] + np.asarray(u)[None, :] - self._offset) / self._scale
+
+    def __call__(self, x, out=None):
+        """Values at ``x`` (an array inside ``[lo, hi]``); ``out`` as in :meth:`Chebyshev.__call__`."""
+        x = np.asarray(x, dtype=float)
+        if x.ndim != 1:
+            return self(x.ravel()).reshape(x.shape)
+        u = np.multiply(x, self._scale)
+        u += self._offset
+        j = u.astype(np.intp)          # truncation = floor: u >= 0 up to a rounding (then j = 0)
+        u -= j                         # the panel coordinate, in [0, 1)
+        coef = self._coefT
+        value = coef[self.degree].take(j, out=out, mode="clip")
+        ak = np.empty_like(u)
+        for k in range(self.degree - 1, -1, -1):        # b = b u + a_k
+            value *= u
+            coef[k].take(j, out=ak, mode="clip")
+            value += ak
+        return value
+
+
+#: (degree, panels) tried in turn by :func:`fit_uniform`, cheapest first
+_UNIFORM_RULES = ((6, 1024), (6, 2048), (8, 2048))
+#: panel coordinates of the check points (the ends, for continuity, and two between nodes)
+_UNIFORM_CHECK = np.array([0.0, 0.2887, 0.6931, 1.0])
+
+
+def fit_uniform(f, lo, hi, *, tol=2e-15, rules=_UNIFORM_RULES):
+    """``(UniformPolynomial, error)``: ``f`` (vectorized) interpolated at the Chebyshev nodes of
+    equal panels, for the first ``(degree, panels)`` of ``rules`` whose error at check points
+    (the panel ends and two points between nodes, per panel) is within ``tol`` relative to
+    ``max(1, |f|)``; ``(None, inf)`` if none is. The check is of the polynomial as it is
+    evaluated, after the change of basis."""
+    for degree, panels in rules:
+        nodes = 0.5 * (1.0 + np.cos(np.pi * (np.arange(degree + 1) + 0.5) / (degree + 1))[::-1])   # in (0, 1)
+        probe = UniformPolynomial(lo, hi, np.zeros((panels, degree + 1)))
+        values = np.asarray(f(probe.panel_nodes(nodes).ravel()), dtype=float).reshape(panels, degree + 1)
+        t = 2.0 * nodes - 1.0
+        cheb = np.linalg.solve(np.polynomial.chebyshev.chebvander(t, degree), values.T).T
+        to_mono = np.array([np.pad(np.polynomial.chebyshev.cheb2poly(np.eye(degree + 1)[k]), (0, degree - k))
+                            for k in range(degree + 1)])
+        fitted = UniformPolynomial(lo, hi, cheb @ to_mono @ _shift_to_unit(degree))
+        x_check = np.clip(fitted.panel_nodes(_UNIFORM_CHECK).ravel(), lo, hi)
+        want = np.asarray(f(x_check), dtype=float)
+        miss = float(np.max(np.abs(fitted(x_check) - want) / np.maximum(1.0, np.abs(want))))
+        if miss <= tol:
+            return fitted, miss
+    return None, math.inf
+
+
 class SeparatedTable:
     r"""The tables of one (wall shape, t/a, n) key; see the module docstring.
 
-    ``forward(y)`` is :math:`\ln\hat J(e^y)`, ``inverse(x)`` its inverse, ``pressure(y)`` the log of
+    ``forward(y)`` is :math:`\ln\hat J(e^y)`, ``inverse(x)`` its inverse (``inverse_fast``: the
+    same, of low degree on equal panels, for arrays, where it was accepted), ``pressure(y)`` the log of
     the pressure per unit modulus (None where the wall's pressure is cheap to evaluate directly).
     ``x_lo .. x_hi`` is the range of targets served; ``j_inf`` is :math:`\hat J(\infty)` (or ``inf``);
     ``error`` the a-posteriori estimate of the error of :math:`\ln v` (and of the log pressure).
     """
 
     def __init__(self, forward, inverse, pressure, *, x_lo, x_hi, y_lo, y_hi, j_inf, error, k, wall_type,
-                 tabulate_pressure, pressure_inverse=None):
+                 tabulate_pressure, pressure_inverse=None, inverse_fast=None):
         self.forward, self.inverse, self.pressure = forward, inverse, pressure
+        self.inverse_fast = inverse_fast
         self.pressure_inverse = pressure_inverse
         self.x_lo, self.x_hi, self.y_lo, self.y_hi = x_lo, x_hi, y_lo, y_hi
         self.j_inf, self.error, self.k, self.wall_type = j_inf, error, k, wall_type
@@ -250,7 +338,9 @@ class _Bound:
         self.wall, self.tb = scene.wall, scene.tb
         self.scale = float(scene.wall._pressure_scale())
         self.norm = float(scene.tube.radius) ** table.k * self.scale
-        self.x_lo, self.x_hi, self.inverse = table.x_lo, table.x_hi, table.inverse
+        # the array path: the low-degree uniform inverse where it was accepted
+        self.x_lo, self.x_hi = table.x_lo, table.x_hi
+        self.inverse = table.inverse if table.inverse_fast is None else table.inverse_fast
 
     def rise(self, y, v, strain=None):
         """The pressure rise (Pa) at ``y = ln v`` (arrays; ``strain``: :math:`e^v - 1` if the caller has it)."""
@@ -259,4 +349,4 @@ class _Bound:
             np.exp(out, out=out)
             out *= self.scale
             return out
-        return self.wall._pressure_at_strain(np.expm1(v) if strain is None else strain, self.tb)
+        return self.wall._pressure_at_log_stretch(v, np.expm1(v) if strain is None else strain, self.tb)

@@ -84,6 +84,7 @@ import weakref
 
 import numpy as np
 
+from .._products import rows_dot
 from .._quadrature import GAUSS_WEIGHTS, KRONROD_NODES, KRONROD_WEIGHTS, Integral, warn_unconverged
 from ..errors import ConvergenceError, InvalidParameterError
 
@@ -143,14 +144,14 @@ def _panels(g, lo, hi, idx, noise, x=None):
         x = lo[:, None] + h[:, None] * _NODES_23
         x[:, 0], x[:, -1] = lo, hi
     y = np.asarray(g(x, idx), dtype=float)
-    rules = y @ _RULES
+    rules = rows_dot(y, _RULES)              # (row by row, whatever the batch: tubefsi._products)
     kron = rules[:, 0]
     with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
         ay = np.abs(y)
-        magnitude = ay @ _KRONROD_23
+        magnitude = rows_dot(ay, _KRONROD_23)
         y -= kron[:, None]                      # y is g's fresh array: reused for the spread
         np.abs(y, out=y)
-        spread = y @ _KRONROD_23
+        spread = rows_dot(y, _KRONROD_23)
         raw = np.abs(kron - rules[:, 1])
         scaled = np.where((spread > 0) & (raw > 0), spread * np.minimum(1.0, (200.0 * raw / spread) ** 1.5), raw)
         # the nodes' interpolant against the integrand at the panel's ends: a kink (or any
@@ -159,7 +160,7 @@ def _panels(g, lo, hi, idx, noise, x=None):
         ends *= _END_GAP
         floor = 2.0 * _EPS * magnitude
         if noise is not None:
-            floor = np.maximum(floor, (ay[:, 1:-1] * noise(x[:, 1:-1], idx)) @ KRONROD_WEIGHTS)
+            floor = np.maximum(floor, rows_dot(ay[:, 1:-1] * noise(x[:, 1:-1], idx), KRONROD_WEIGHTS))
         # QUADPACK's scaled estimate presumes a smooth integrand: never below |K21 - G10| itself
         error = np.maximum(np.maximum(scaled, raw) + ends, floor)
     return kron * h, error * h, floor * h
@@ -765,7 +766,7 @@ class FlowTable:
             sm, sh = 0.5 * (lo + hi), 0.5 * (hi - lo)
             u = ((sm - 0.5 * (ya + yb))[:, None] + sh[:, None] * _XL) / hw
             vals = _barycentric(u.ravel(), _XI, _WI, st)[0].reshape(u.shape)
-            b = vals @ _FIT_L
+            b = rows_dot(vals, _FIT_L)
             ok = np.max(np.abs(b[:, -2:]), axis=1) <= allowed
             out += [(lo[k], hi[k], b[k]) for k in np.flatnonzero(ok)]
             if np.all(ok):
@@ -1097,7 +1098,7 @@ class _Segment:
         hi = np.array([t[1] for t, _, _ in subs])
         # breakpoints (adjacent forward panels share their end's exact value; guard the rounding)
         self.brk = np.maximum.accumulate(np.concatenate([lo, hi[-1:]]))
-        mono = np.array([t[2] for t, _, _ in subs]) @ _TO_MONO
+        mono = rows_dot(np.array([t[2] for t, _, _ in subs]), _TO_MONO)
         mono[:, 0] += np.array([s0 for _, _, s0 in subs])        # the panels' centres, added last
         self.coef = np.ascontiguousarray(mono.T)
         self.error = np.array([e for _, e, _ in subs])
@@ -1180,7 +1181,7 @@ def _barycentric(x, nodes, weights, values, slope=False):
         c[rows] = 0.0
         c[rows, cols] = 1.0
     den = c.sum(axis=1)
-    p = (c @ values) / den
+    p = rows_dot(c, values) / den
     if not slope:
         return p, None
     # p'(x) = sum_j c_j (p - v_j) / (x - x_j) / sum_j c_j (Schneider & Werner 1986)

@@ -60,6 +60,10 @@ class WallModel(abc.ABC, metaclass=KeywordCheckedABC):
     ``_stretch(pressure, tb)``                              natural hook, or ``1 + _strain``
     ``_pressure_at_strain(strain, tb)``                     ``_pressure(1 + strain)``; override to keep
                                                             full accuracy at tiny strain
+    ``_pressure_at_log_stretch(v, strain, tb)``             ``_pressure_at_strain(strain)``: the same at
+                                                            :math:`v = \ln\lambda` with
+                                                            :math:`e^v - 1` given; override where
+                                                            :math:`v` is the cheaper variable
     ``_strain(pressure, tb)``                               ``_stretch - 1``, or the inverse of
                                                             ``_pressure_at_strain`` (Newton, then bracketing)
     ``_stiffness(stretch, tb)``                             :math:`dP/d\lambda` by ``scipy.differentiate``
@@ -195,6 +199,12 @@ class WallModel(abc.ABC, metaclass=KeywordCheckedABC):
         """Natural hook: pressure at ``stretch`` (array, >= 1) for thickness ratio ``tb``."""
         self._natural()
         return self._pressure_at_strain(stretch - 1.0, tb)
+
+    def _pressure_at_log_stretch(self, log_stretch, strain, tb):
+        """Pressure at log-stretch ``log_stretch`` whose strain ``expm1(log_stretch)`` is ``strain``
+        (both arrays, given by a caller that has both); override where the log-stretch makes a
+        cheaper exact form."""
+        return self._pressure_at_strain(strain, tb)
 
     def _pressure_at_strain(self, strain, tb):
         """Pressure at hoop strain; override for accuracy at tiny strain."""

@@ -120,6 +120,21 @@ class _ThinForms(_NeoHookeanLaw):
             return unit
         return scale * unit
 
+    def _pressure_at_log_stretch(self, log_stretch, strain, tb):
+        # reference thickness: lam - lam^-3 = e^v (1 - e^{-4v}) = -e^v expm1(-4v): two exponentials
+        # of exact arguments (4v is) and a product, to a few ulp at any v (no cancellation at small
+        # v; e^{-3v} would round 3v: a relative 3v eps) where the strain form takes ten passes
+        v = log_stretch
+        if (self.thickness_convention != "reference" or type(v) is not np.ndarray or type(tb) is not float
+                or type(self._installed_modulus()) is not float or v.shape != np.shape(strain)
+                or not (v.size and v.max() <= 700.0)):
+            return self._pressure_at_strain(strain, tb)
+        out = np.multiply(v, -4.0)
+        np.expm1(out, out=out)
+        out *= np.exp(v)
+        out *= -self._installed_modulus() * tb
+        return out
+
     def _stiffness(self, stretch, tb):
         if self.thickness_convention == "reference":
             return self._installed_modulus() * tb * (1.0 + 3.0 * stretch**-4)
