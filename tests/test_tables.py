@@ -310,3 +310,33 @@ def test_thin_reference_pressure_from_the_log_stretch_against_mpmath():
     far = np.array([1.0, 701.0])                         # past v = 700: the strain form
     assert np.array_equal(wall._pressure_at_log_stretch(far, np.expm1(far), 0.3),
                           wall._pressure_at_strain(np.expm1(far), 0.3))
+
+
+def test_the_lean_curve_path_is_the_general_path_bit_for_bit():
+    """A 1-D curve through a scene of scalars whose table is built takes the lean curve path of
+    ``solve``; its answers are the general path's to the last bit (the general path forced by an
+    option that changes nothing here, ``on_infeasible="nan"``), as are its validity warnings.
+    It declines, and the general path answers, where the table does not serve every point (a
+    zero flow rate), where the wall has an explicit inverse (thin, current thickness), and for
+    arrays of more than one dimension."""
+    solve_module = importlib.import_module("tubefsi.solve")
+    wall = walls["thin-neo-hookean"](shear_modulus=2e3, thickness_convention="reference")
+    q = np.geomspace(1e-12, 3e-8, 500)
+    tubefsi.solve(FLUID, wall, TUBE, flow_rate=q)                     # builds the table
+    lean = solve_module._curve_flow(FLUID, wall, TUBE, q)
+    assert lean is not None
+    general = tubefsi.solve(FLUID, wall, TUBE, flow_rate=q, on_infeasible="nan")
+    for name in ("pressure_drop", "inlet_displacement", "flow_rate"):
+        assert np.array_equal(getattr(lean, name), getattr(general, name))
+    z = np.array([0.0, 0.4, 1.0])[:, None] * TUBE.length
+    assert np.array_equal(lean.pressure(z), general.pressure(z))
+    assert lean.coupler_name == general.coupler_name and lean.feasible is None and not lean.scalar
+    assert lean.flow_rate is not q                                    # the solution keeps a copy
+    with pytest.warns(tubefsi.ModelValidityWarning, match="not slender"):
+        assert solve_module._curve_flow(FLUID, wall, TUBE, np.geomspace(1e-9, 1e-2, 100)) is not None
+    assert solve_module._curve_flow(FLUID, wall, TUBE, np.r_[0.0, q]) is None
+    current = walls["thin-neo-hookean"](shear_modulus=2e3, thickness_convention="current")
+    assert solve_module._curve_flow(FLUID, current, TUBE, q[:10]) is None
+    assert solve_module._curve_flow(FLUID, wall, TUBE, q.reshape(20, 25)) is None
+    np.testing.assert_array_equal(tubefsi.solve(FLUID, wall, TUBE, flow_rate=q.reshape(20, 25)).pressure_drop,
+                                  general.pressure_drop.reshape(20, 25))

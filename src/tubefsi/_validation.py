@@ -37,7 +37,8 @@ def real_array(name, value, admissible):
 def as_load(name, value, *, allow_zero=True):
     """Convert a flow rate / pressure to a float array; reject negative, NaN, inf."""
     a = real_array(name, value, "[0, inf)")
-    if a.size and (a.min() > 0 or (allow_zero and a.min() == 0)) and a.max() < math.inf:
+    low = a.min() if a.size else None
+    if a.size and (low > 0 or (allow_zero and low == 0)) and a.max() < math.inf:
         return a                             # two reductions (a NaN fails both) instead of four passes
     bad = ~np.isfinite(a) | (a < 0) | ((a == 0) if not allow_zero else False)
     if np.any(bad):

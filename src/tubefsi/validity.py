@@ -90,7 +90,9 @@ def check(scene, flow_rate, inlet_strain, *, density=None) -> Validity:
     """Check a result: ``scene`` a flat scene (:meth:`~tubefsi.scene.Scene.flat`) and the flat
     arrays ``flow_rate``, ``inlet_strain`` of its points (NaN where infeasible)."""
     q = np.ravel(np.asarray(flow_rate, dtype=float))
-    strain = np.broadcast_to(np.asarray(inlet_strain, dtype=float), q.shape)
+    strain = np.asarray(inlet_strain, dtype=float)
+    if strain.shape != q.shape:
+        strain = np.broadcast_to(strain, q.shape)
     a, length = scene.tube.radius, scene.tube.length
     limit = getattr(scene.wall, "calibrated_strain", math.inf)
     if density is None and q.size and np.ndim(a) == 0 and np.ndim(length) == 0 and np.ndim(limit) == 0:

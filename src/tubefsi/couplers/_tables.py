@@ -276,7 +276,7 @@ class UniformPolynomial:
 
 
 #: (degree, panels) tried in turn by :func:`fit_uniform`, cheapest first
-_UNIFORM_RULES = ((6, 1024), (6, 2048), (8, 2048))
+_UNIFORM_RULES = ((5, 2048), (6, 1024), (6, 2048), (8, 2048))
 #: panel coordinates of the check points (the ends, for continuity, and two between nodes)
 _UNIFORM_CHECK = np.array([0.0, 0.2887, 0.6931, 1.0])
 

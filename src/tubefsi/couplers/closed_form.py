@@ -46,16 +46,20 @@ class ClosedForm(SeparatedVariables):
         index = np.asarray(index)
         return self._J(scene, np.full(index.shape, np.inf), index) + np.zeros(index.shape)
 
+    def curve_from_table(self, scene, q):
+        # a wall with an explicit inverse is served by it, not by a table (flow_controlled)
+        return None if scene.wall._has_power_law_integral_inverse() else super().curve_from_table(scene, q)
+
     def flow_controlled(self, scene, flow_rate):
         """Explicit inverse where the wall has one (linear, thin current thickness), else Newton."""
         q = np.asarray(flow_rate, dtype=float)
         if scene.wall.is_rigid:
             return super().flow_controlled(scene, q)
+        if not scene.wall._has_power_law_integral_inverse():   # (a property of the wall's class and options)
+            return super().flow_controlled(scene, q)    # no explicit inverse: the tables or Newton (in logs)
         index = np.arange(q.size)
         pts = scene.at(index)
         k = pts.rheology.radius_exponent
-        if not pts.wall._has_power_law_integral_inverse():
-            return super().flow_controlled(scene, q)    # no explicit inverse: the tables or Newton (in logs)
         target = self.target(pts, q)
         v = pts.wall._power_law_integral_inverse(target / pts.radius**k, pts.outlet_stretch, k, pts.tb)
         v = np.where(q == 0, 0.0, v)

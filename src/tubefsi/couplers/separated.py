@@ -319,6 +319,13 @@ class SeparatedVariables(Coupler):
         dp[target == 0] = 0.0
         return State(q, dp, self.strain_at(pts, v) + 0.0 * v, v)
 
+    def curve_from_table(self, scene: Scene, q):
+        """The state of every flow rate ``q`` (a flat array of positive ones) of a scene of
+        scalars from its table if the table is built and serves every point, else None (what
+        :meth:`flow_controlled` does first; the lean curve path of :func:`tubefsi.solve`)."""
+        table = self._table(scene, build=False)
+        return None if table is None else _curve_from_table(scene, table, q)
+
     def _curve_by_interpolation(self, scene: Scene, q):
         r"""The inlet log-stretches of a long curve through one scene that has no table (a
         non-separable fluid, a loaded outlet): :math:`\ln v` as a function of :math:`\ln q` is
