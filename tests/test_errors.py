@@ -4,6 +4,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import tubefsi
 from tubefsi import InvalidParameterError, NoSteadyStateError
@@ -155,3 +157,29 @@ def test_no_nan_over_a_wide_load_range(wall):
         assert np.all(value > 0) or (wall.is_rigid and np.all(value >= 0))
     back = tubefsi.solve(FLUID, wall, TUBE, pressure_drop=sol.pressure_drop)
     assert np.all(np.isfinite(back.flow_rate))
+
+
+@settings(deadline=None, max_examples=300)
+@given(low=st.sampled_from([-math.inf, -1.0, 0.0, 1.0]), width=st.sampled_from([0.0, 1.0, math.inf]),
+       low_open=st.booleans(), high_open=st.booleans(),
+       value=st.one_of(st.floats(allow_nan=True, allow_infinity=True),
+                       st.sampled_from([-math.inf, -1.0, -0.0, 0.0, 1.0, 2.0, math.inf, math.nan])))
+def test_interval_validator_against_its_definition(low, width, low_open, high_open, value):
+    """A float parameter passes exactly when it is a finite number (or +inf under a closed infinite
+    upper end) within the interval, open or closed at each end, as an array entry does."""
+    from tubefsi.fields import _interval_validator
+    high = low + width
+
+    class Field:
+        name = "x"
+
+    inside = ((value > low) if low_open else (value >= low)) and ((value < high) if high_open else (value <= high))
+    admitted = inside and (math.isfinite(value) or (value == math.inf and high == math.inf and not high_open))
+    check = _interval_validator(low, high, low_open, high_open, "the interval")
+    for given_value in (value, np.array([value])):
+        try:
+            check(None, Field, given_value)
+            passed = True
+        except InvalidParameterError:
+            passed = False
+        assert passed == admitted, (low, high, low_open, high_open, value)

@@ -340,3 +340,42 @@ def test_the_lean_curve_path_is_the_general_path_bit_for_bit():
     assert solve_module._curve_flow(FLUID, wall, TUBE, q.reshape(20, 25)) is None
     np.testing.assert_array_equal(tubefsi.solve(FLUID, wall, TUBE, flow_rate=q.reshape(20, 25)).pressure_drop,
                                   general.pressure_drop.reshape(20, 25))
+
+
+def test_the_scalar_pair_is_each_interpolant_bit_for_bit():
+    """One panel search and one generated rule give both values of a pair, each the bits of its
+    own scalar rule; a pair of interpolants on different panels is refused."""
+    from tubefsi.couplers._tables import ScalarPair, fit_on_breaks
+    first, _ = fit_chebyshev(np.log1p, 0.0, 100.0)
+    second, err = fit_on_breaks(lambda v: np.sqrt(1.0 + v), first.breaks)
+    assert second is not None and err <= 5e-14
+    pair = ScalarPair(first, second)
+    x = np.concatenate([first.breaks, np.random.default_rng(3).uniform(0.0, 100.0, 300)])
+    for _ in range(2):
+        assert [pair(float(v)) for v in x] == [(first.scalar(float(v)), second.scalar(float(v))) for v in x]
+    other, _ = fit_chebyshev(np.arctan, 0.0, 100.0)
+    with pytest.raises(ValueError):
+        ScalarPair(first, other)
+    # a function that no degree-10 series resolves on these panels: refused, not fitted
+    assert fit_on_breaks(lambda v: np.abs(v - 50.3), first.breaks) == (None, np.inf)
+
+
+def test_a_scalar_path_solution_is_a_whole_solution():
+    """The scalar path builds its scene on first use: the solution compares equal to the general
+    path's, pickles, copies, and reports its scene, tube and profiles."""
+    import copy
+    import pickle
+    solve_module = importlib.import_module("tubefsi.solve")
+    wall = walls["thick-neo-hookean"](shear_modulus=2e3)
+    tubefsi.solve(FLUID, wall, TUBE, flow_rate=np.geomspace(1e-12, 1e-9, 100))     # builds the table
+    fast = solve_module._scalar_flow(FLUID, wall, TUBE, 1e-9)
+    assert fast is not None and "scene" not in vars(fast)
+    general = tubefsi.solve(FLUID, wall, TUBE, flow_rate=1e-9, on_infeasible="nan")
+    assert fast.scene == general.scene and fast.tube is TUBE and fast.wall is wall
+    assert fast.pressure_drop == pytest.approx(general.pressure_drop, rel=1e-13)
+    back = pickle.loads(pickle.dumps(fast))
+    assert back.pressure_drop == fast.pressure_drop and back.scene == fast.scene
+    assert copy.deepcopy(fast).inlet_displacement == fast.inlet_displacement
+    assert fast.pressure(0.5 * TUBE.length) == pytest.approx(general.pressure(0.5 * TUBE.length), rel=1e-12)
+    with pytest.raises(AttributeError, match="no attribute 'scenery'"):
+        fast.scenery

@@ -116,10 +116,14 @@ def test_advise_takes_an_array_of_loads():
             dp = tubefsi.solve(c.rheology, c.wall, tube, flow_rate=q).pressure_drop
             np.testing.assert_allclose(c.pressure_drop, dp, rtol=1e-14)
             ref = tubefsi.solve(BLOOD, wall, tube, flow_rate=q[1:]).pressure_drop
-            assert c.relative_difference == pytest.approx(np.max(np.abs(dp[1:] / ref - 1)), rel=1e-12, abs=1e-16)
+            # (abs: the reference model as a candidate differs by rounding only, which depends on
+            # the path each call shape takes; every solve is accurate to ~1e-14)
+            assert c.relative_difference == pytest.approx(np.max(np.abs(dp[1:] / ref - 1)), rel=1e-12, abs=1e-13)
     single = tubefsi.advise(BLOOD, wall, tube, flow_rate=5e-10)
+    # (abs: a candidate that is the reference model differs by the two solves' rounding only,
+    # ~1e-15 on one path and 0 on another; each solve is accurate to ~1e-14)
     assert [c.relative_difference for c in single.candidates] == pytest.approx(
-        [c.relative_difference for c in advice.candidates], rel=1e-12)
+        [c.relative_difference for c in advice.candidates], rel=1e-12, abs=1e-13)
     assert "max rel. diff" in str(advice)
     with pytest.raises(tubefsi.InvalidParameterError, match="one scene"):
         tubefsi.advise(BLOOD, walls["thick-neo-hookean"](shear_modulus=[2e3, 3e3]), tube, flow_rate=1e-10)

@@ -100,12 +100,13 @@ def _fmt(x) -> str:
 
 
 def _interval_validator(low, high, low_open, high_open, admissible):
-    def check(instance, attribute, value):
-        if type(value) is float:                  # the common case, without numpy
-            if ((value > low if low_open else value >= low) and (value < high if high_open else value <= high)
-                    and (value == value) and (value != math.inf or (high == math.inf and not high_open))
-                    and value != -math.inf):
-                return
+    # a float (the common case) is tested by one chained comparison, without numpy: a NaN fails
+    # every comparison, inf passes only a closed infinite upper end, and -inf never passes (an
+    # infinite lower end is open)
+    low_open = low_open or low == -math.inf
+
+    def general(attribute, value):
+        if type(value) is float:
             raise InvalidParameterError(attribute.name, admissible, value)
         if isinstance(value, Profile):            # checked where it is evaluated
             return
@@ -121,6 +122,22 @@ def _interval_validator(low, high, low_open, high_open, admissible):
             raise InvalidParameterError(attribute.name, admissible, float(v[where]),
                                         f"entry {where} of an array of shape {v.shape}")
 
+    if low_open and high_open:
+        def check(instance, attribute, value):
+            if not (type(value) is float and low < value < high):
+                general(attribute, value)
+    elif low_open:
+        def check(instance, attribute, value):
+            if not (type(value) is float and low < value <= high):
+                general(attribute, value)
+    elif high_open:
+        def check(instance, attribute, value):
+            if not (type(value) is float and low <= value < high):
+                general(attribute, value)
+    else:
+        def check(instance, attribute, value):
+            if not (type(value) is float and low <= value <= high):
+                general(attribute, value)
     return check
 
 

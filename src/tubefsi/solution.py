@@ -48,14 +48,27 @@ class Solution:
     controlled: str = "flow_rate"
 
     @classmethod
-    def _scalar_flow_controlled(cls, scene, coupler, state, coupler_name) -> Solution:
+    def _scalar_flow_controlled(cls, scene_parts, coupler, state, coupler_name) -> Solution:
         """A flow-controlled scalar solution of validated parts, built without ``__init__`` (the
-        scalar fast path of :func:`tubefsi.solve`; the other fields take their defaults)."""
+        scalar fast path of :func:`tubefsi.solve`; the other fields take their defaults). Its
+        scene is built on first use from ``scene_parts``, the arguments of
+        :meth:`Scene._trusted <tubefsi.scene.Scene._trusted>` (a Monte Carlo loop that reads only
+        the pressure drop never needs it)."""
         new = object.__new__(cls)
         fields = new.__dict__
         fields.update(_SCALAR_DEFAULTS)
-        fields["scene"], fields["coupler"], fields["state"], fields["coupler_name"] = scene, coupler, state, coupler_name
+        fields["_scene_parts"], fields["coupler"], fields["state"], fields["coupler_name"] = (
+            scene_parts, coupler, state, coupler_name)
         return new
+
+    def __getattr__(self, name):
+        # only for an attribute not in the instance: the scene of a scalar-path solution
+        if name == "scene":
+            parts = self.__dict__.get("_scene_parts")
+            if parts is not None:
+                scene = self.__dict__["scene"] = Scene._trusted(*parts)
+                return scene
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
     # ------------------------------------------------------------------ loads
     @property

@@ -9,6 +9,7 @@ loads and returns a :class:`~tubefsi.Solution`.
 from __future__ import annotations
 
 import contextlib
+import functools
 import math
 
 import attrs
@@ -78,6 +79,29 @@ def _in_radius_units(function):
     return checked_keywords(function, recover=(FactorRangeError, lambda f, a, k: _radius_units(f, a, k)))
 
 
+def _solve_entry(function):
+    """:func:`_in_radius_units` for ``solve``, with the commonest call, ``solve(fluid, wall, tube,
+    flow_rate=q)`` for a float ``q``, tried on the lean scalar path before any argument binding
+    (a Monte Carlo loop's call: the binding and the general path's option checks were a tenth
+    of it). Anything else, or a miss, goes through the checked entry unchanged."""
+    entry = _in_radius_units(function)
+
+    @functools.wraps(function)
+    def solve(*args, **kwargs):
+        if len(args) == 3 and len(kwargs) == 1:
+            q = kwargs.get("flow_rate")
+            if type(q) is float:
+                try:
+                    fast = _scalar_flow(args[0], args[1], args[2], q)
+                except FactorRangeError:          # the general path recovers from it
+                    fast = None
+                if fast is not None:
+                    return fast
+        return entry(*args, **kwargs)
+
+    return solve
+
+
 @checked_keywords
 def select_coupler(rheology, wall, coupler="auto") -> Coupler:
     """The coupler ``solve`` would use: a name, an instance, or ``"auto"`` (cheapest accurate)."""
@@ -95,7 +119,7 @@ def select_coupler(rheology, wall, coupler="auto") -> Coupler:
     return inst
 
 
-@_in_radius_units
+@_solve_entry
 def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="auto",
           outlet_pressure=0.0, external_pressure=0.0, on_infeasible="raise", density=None, progress=False) -> Solution:
     r"""Solve steady flow of ``rheology`` through ``tube`` with wall ``wall``.
@@ -354,17 +378,24 @@ def _scalar_flow(rheology, wall, tube, q):
     x = math.log(L * phi / norm)
     if not table.x_lo <= x <= table.x_hi:
         return None
-    y = table.inverse.scalar(x)
+    pair = table.scalar_pair
+    if pair is not None:
+        y, log_rise = pair(x)
+    else:
+        y = table.inverse.scalar(x)
+        log_rise = table.pressure.scalar(y)
     v = math.exp(y)
     strain = math.expm1(v)
-    drop = scale * math.exp(table.pressure.scalar(y))
-    chosen, name = chosen
-    lam_max = wall._max_stretch(t / a)
-    scene = Scene._trusted(rheology, wall, tube, math.log(lam_max) if type(lam_max) is float else
-                           float(np.log(lam_max)))
+    drop = scale * math.exp(log_rise)
+    log_stretch_max = table.log_stretch_max
+    if log_stretch_max is None:                # the key's (wall shape, t/a): the same for every scene of it
+        lam_max = wall._max_stretch(t / a)
+        log_stretch_max = table.log_stretch_max = (math.log(lam_max) if type(lam_max) is float
+                                                   else float(np.log(lam_max)))
+    parts = (rheology, wall, tube, log_stretch_max)
     if a * (1.0 + strain) > SLENDERNESS * L or strain > wall.calibrated_strain:
-        warn(check(scene, q, strain))
-    return Solution._scalar_flow_controlled(scene, chosen, _scalar_state(q, drop, strain, v), name)
+        warn(check(Scene._trusted(*parts), q, strain))
+    return Solution._scalar_flow_controlled(parts, chosen[0], _scalar_state(q, drop, strain, v), chosen[1])
 
 
 def _curve_flow(rheology, wall, tube, flow_rate):

@@ -29,7 +29,8 @@ import math
 
 import numpy as np
 
-__all__ = ["Chebyshev", "SeparatedTable", "UniformPolynomial", "fit_chebyshev", "fit_uniform"]
+__all__ = ["Chebyshev", "ScalarPair", "SeparatedTable", "UniformPolynomial", "fit_chebyshev", "fit_on_breaks",
+           "fit_uniform"]
 
 _DEGREE = 10
 _NODES = np.cos(np.pi * (np.arange(_DEGREE + 1) + 0.5) / (_DEGREE + 1))[::-1]     # ascending, in (-1, 1)
@@ -167,16 +168,64 @@ class Chebyshev:
         return Chebyshev(self.breaks, np.pad(d, ((0, 0), (0, 1))))
 
 
-def _horner_rule(parts, scale, offset):
+def fit_on_breaks(f, breaks, *, tol=5e-14):
+    """``(Chebyshev, error)`` of ``f`` (vectorized) on the given panels ``breaks``, each panel's
+    tail and check points within ``tol`` (as in :func:`fit_chebyshev`); ``(None, inf)`` if a panel
+    misses (no splitting: the panels are another interpolant's, whose scalar path this one joins)."""
+    a, b = np.asarray(breaks[:-1], dtype=float), np.asarray(breaks[1:], dtype=float)
+    mid, half = 0.5 * (a + b), 0.5 * (b - a)
+    x = np.concatenate([mid[:, None] + half[:, None] * _NODES, mid[:, None] + half[:, None] * _CHECK], axis=1)
+    values = np.asarray(f(x.ravel()), dtype=float).reshape(x.shape)
+    y_nodes, y_check = values[:, :_DEGREE + 1], values[:, _DEGREE + 1:]
+    coef = y_nodes @ _FIT_INV.T
+    scale = np.maximum(1.0, np.max(np.abs(y_nodes), axis=1))
+    miss = np.max(np.abs(coef @ _AT_CHECK.T - y_check), axis=1) / scale
+    tail = np.max(np.abs(coef[:, -3:]), axis=1) / scale
+    if not np.all(np.isfinite(miss) & (miss <= tol) & (tail <= tol)):
+        return None, math.inf
+    return Chebyshev(breaks, coef), float(np.max(miss))
+
+
+class ScalarPair:
+    """Two interpolants on the same panels evaluated together at one float: one panel search and
+    one call of a generated rule that returns both values (the scalar path of a table: the inlet
+    log-stretch and the log pressure of a target). Each value is what its own
+    :meth:`Chebyshev.scalar` gives, to the bit, where both use Horner's rule."""
+
+    def __init__(self, first: Chebyshev, second: Chebyshev):
+        if not np.array_equal(first.breaks, second.breaks) or not (first._horner and second._horner):
+            raise ValueError("a ScalarPair needs two Horner-rule interpolants on the same panels")
+        self._first, self._second = first, second
+        self._breaks, self._last = first._breaks, first._last
+        self._rules = [None] * (self._last + 1)
+
+    def __call__(self, x: float):
+        """``(first(x), second(x))`` for one float ``x``."""
+        j = bisect.bisect_right(self._breaks, x) - 1
+        j = 0 if j < 0 else (self._last if j > self._last else j)
+        rule = self._rules[j]
+        if rule is None:                       # the panel's rule, made on first use
+            one, two = self._first, self._second
+            rule = self._rules[j] = _horner_rule(one._mono_parts[j], one._t_scale_list[j], one._t_offset_list[j],
+                                                 two._mono_parts[j])
+        return rule(x)
+
+
+def _horner_rule(parts, scale, offset, second=None):
     """``x -> sum_k a_k t^k``, ``t = x scale + offset``, for one float: Horner's rule unrolled into
     one expression with the panel's numbers as constants (``parts``: a_D, ..., a_0). The same
     operations in the same order as the loop ``value = value t + a`` from ``a_D``, so the same
-    bits, at a third of its cost (the scalar path evaluates two tables per solve)."""
-    expr = repr(parts[0])
-    for a in parts[1:]:
-        expr = f"({expr}) * t + {a!r}"
+    bits, at a third of its cost (the scalar path evaluates two tables per solve). ``second``: the
+    coefficients of a second polynomial in the same ``t``; the rule then returns both values."""
+    def horner(coefficients):
+        expr = repr(coefficients[0])
+        for a in coefficients[1:]:
+            expr = f"({expr}) * t + {a!r}"
+        return expr
+
+    body = horner(parts) if second is None else f"{horner(parts)}, {horner(second)}"
     namespace: dict = {}
-    exec(f"def rule(x):\n    t = x * {scale!r} + {offset!r}\n    return {expr}\n", namespace)   # noqa: S102
+    exec(f"def rule(x):\n    t = x * {scale!r} + {offset!r}\n    return {body}\n", namespace)   # noqa: S102
     return namespace["rule"]
 
 
@@ -308,20 +357,22 @@ class SeparatedTable:
     r"""The tables of one (wall shape, t/a, n) key; see the module docstring.
 
     ``forward(y)`` is :math:`\ln\hat J(e^y)`, ``inverse(x)`` its inverse (``inverse_fast``: the
-    same, of low degree on equal panels, for arrays, where it was accepted), ``pressure(y)`` the log of
+    same, of low degree on equal panels, for arrays, where it was accepted; ``scalar_pair(x)``: the
+    inverse and the log pressure of a target together, for one float), ``pressure(y)`` the log of
     the pressure per unit modulus (None where the wall's pressure is cheap to evaluate directly).
     ``x_lo .. x_hi`` is the range of targets served; ``j_inf`` is :math:`\hat J(\infty)` (or ``inf``);
     ``error`` the a-posteriori estimate of the error of :math:`\ln v` (and of the log pressure).
     """
 
     def __init__(self, forward, inverse, pressure, *, x_lo, x_hi, y_lo, y_hi, j_inf, error, k, wall_type,
-                 tabulate_pressure, pressure_inverse=None, inverse_fast=None):
+                 tabulate_pressure, pressure_inverse=None, inverse_fast=None, scalar_pair=None):
         self.forward, self.inverse, self.pressure = forward, inverse, pressure
-        self.inverse_fast = inverse_fast
+        self.inverse_fast, self.scalar_pair = inverse_fast, scalar_pair
         self.pressure_inverse = pressure_inverse
         self.x_lo, self.x_hi, self.y_lo, self.y_hi = x_lo, x_hi, y_lo, y_hi
         self.j_inf, self.error, self.k, self.wall_type = j_inf, error, k, wall_type
         self.tabulate_pressure = tabulate_pressure
+        self.log_stretch_max = None        # ln of the wall's maximum stretch, set by the scalar path
 
     def for_scene(self, scene):
         """The table bound to a scene of its key: the target normalization and the pressure (None

@@ -47,7 +47,7 @@ from .._products import rows_dot
 from .._quadrature import Integral, adaptive_to_pole, quiet, recording, solve_integral, warn_unconverged
 from ..errors import ConvergenceError, InvalidParameterError, NoSteadyStateError, StretchRangeError
 from ..scene import Points, Scene, State
-from ._tables import SeparatedTable, fit_chebyshev, fit_uniform
+from ._tables import ScalarPair, SeparatedTable, fit_chebyshev, fit_on_breaks, fit_uniform
 from .base import Coupler
 
 #: Half the exponent range of doubles: a product of two factors within it stays a normal double.
@@ -1083,6 +1083,14 @@ def _build_table(engine, scene):
     if pressure is None:
         return False
     error = max(error, err_p)
+    # the scalar path's pair: the log pressure as a function of the target on the inverse's own
+    # panels, so that one panel search and one generated rule give both (None where it misses)
+    scalar_pair = None
+    if inverse._horner:
+        of_target, err_t = fit_on_breaks(lambda x: pressure(inverse(x)), inverse.breaks, tol=5e-14)
+        if of_target is not None and of_target._horner:
+            scalar_pair = ScalarPair(inverse, of_target)
+            error = max(error, err_p + err_t)
     # its inverse (the inlet log-stretch of a pressure drop), by Newton on the pressure table
     p_slope = pressure.derivative()
     grid_w = pressure(grid_y)
@@ -1112,4 +1120,4 @@ def _build_table(engine, scene):
     return SeparatedTable(forward, inverse, pressure, x_lo=x_lo, x_hi=x_hi, y_lo=y_lo, y_hi=y_hi,
                           j_inf=j_inf, error=error, k=k, wall_type=type(wall),
                           tabulate_pressure=wall._pressure_needs_quadrature(), pressure_inverse=pressure_inverse,
-                          inverse_fast=inverse_fast)
+                          inverse_fast=inverse_fast, scalar_pair=scalar_pair)
