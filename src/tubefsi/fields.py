@@ -111,6 +111,12 @@ def _interval_validator(low, high, low_open, high_open, admissible):
         if isinstance(value, Profile):            # checked where it is evaluated
             return
         v = np.asarray(value)
+        if v.size and v.dtype.kind == "f":
+            # the extremes decide (two reductions; a NaN makes both fail): the elementwise test
+            # below only to name the offending entry
+            lo_v, hi_v = v.min(), v.max()
+            if (low < lo_v if low_open else low <= lo_v) and (hi_v < high if high_open else hi_v <= high):
+                return
         with np.errstate(invalid="ignore"):
             ok = np.isfinite(v) | ((v == math.inf) & (high == math.inf) & (not high_open))
             ok &= (v > low) if low_open else (v >= low)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import attrs
 import numpy as np
 
@@ -43,7 +45,7 @@ class Tube(metaclass=KeywordChecked):
                     getattr(self, name).check_span(self.length)
             return
         tb = np.asarray(self.thickness) / np.asarray(self.radius)
-        if not np.all((tb > 0) & np.isfinite(tb)):        # t/a beyond double range
+        if not (tb.min() > 0 and tb.max() < math.inf):    # t/a beyond double range (NaN fails both)
             raise InvalidParameterError("thickness", "values with a finite, nonzero t/a", self.thickness,
                                         f"t/a = {np.ravel(tb)[np.argmin(np.isfinite(tb) & (tb > 0))]!r} with radius "
                                         f"{self.radius!r}")

@@ -148,7 +148,18 @@ class Scene:
             strain = np.where(np.asarray(p_out) == 0, 0.0, self.wall.strain(p_out, tb))
         object.__setattr__(self, "outlet_strain", strain)
         object.__setattr__(self, "outlet_stretch", 1.0 + strain)
-        lam_max = self.wall._max_stretch(tb) if shape == () else self.wall.max_stretch(tb)
+        if shape == ():
+            lam_max = self.wall._max_stretch(tb)
+        else:
+            # the hook first: a wall that never locks says inf whatever its parameters (a tenth of
+            # the per-point evaluation's cost); any other answer, or a hook that takes no array
+            # parameters, gets the per-point, validated evaluation
+            try:
+                lam_max = self.wall._max_stretch(tb)
+            except Exception:                    # noqa: BLE001 (the evaluation below raises what is real)
+                lam_max = None
+            if not (type(lam_max) is float and lam_max == math.inf):
+                lam_max = self.wall.max_stretch(tb)
         with np.errstate(divide="ignore"):
             v_max = np.log(np.asarray(lam_max, dtype=float) / (1.0 + np.asarray(strain)))
         object.__setattr__(self, "log_stretch_max", float(v_max) if v_max.ndim == 0 else v_max)

@@ -24,6 +24,7 @@ from .couplers.checked import checked
 from .couplers.graded import Graded
 from .couplers.rescaled import Rescaled, in_units
 from .errors import InvalidParameterError, NoSteadyStateError, StretchRangeError
+from .fields import parameter_shape
 from .couplers.separated import _TABLES, SeparatedVariables, curve_span
 from .geometry import Tube
 from .rheology.base import Rheology
@@ -404,12 +405,15 @@ def _curve_flow(rheology, wall, tube, flow_rate):
     (:meth:`~tubefsi.couplers.separated.SeparatedVariables.curve_from_table`). The same answer as
     the general path, without its chunks, masks and index arrays (a third of a 10^4-point call's
     time at a table's speed). None where it does not apply; the general path then answers."""
-    if type(tube) is not Tube or flow_rate.ndim != 1 or not 0 < flow_rate.size <= CHUNK:
+    if (type(tube) is not Tube or flow_rate.ndim != 1 or not 0 < flow_rate.size <= CHUNK
+            or type(tube.radius) is not float or type(tube.thickness) is not float or type(tube.length) is not float):
         return None
     chosen = _AUTO.get((type(rheology), type(wall), registry.couplers.generation))
     if chosen is None:
         chosen = _auto(rheology, wall)
     if chosen is False or not _is(type(chosen[0]), SeparatedVariables) or chosen[0].refined() is not None:
+        return None
+    if parameter_shape(rheology) != () or parameter_shape(wall) != ():     # array parameters: a broadcast solve
         return None
     coupler, name = chosen
     scene = make_scene(rheology, wall, tube)

@@ -214,7 +214,9 @@ class _ThickForms(_NeoHookeanLaw):
         den = lam2 + d
         den *= den
         den *= lam2
-        num = lam2 * (d + 2.0)
+        # (in place where the shapes allow: one array of points x nodes fewer)
+        inplace = type(lam2) is np.ndarray and np.broadcast_shapes(lam2.shape, np.shape(d)) == lam2.shape
+        num = np.multiply(lam2, d + 2.0, out=lam2) if inplace else lam2 * (d + 2.0)
         num += d
         num *= self._installed_modulus() * d
         num /= den
