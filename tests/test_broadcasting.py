@@ -199,3 +199,16 @@ def test_points_of_every_point_are_read_only_views_with_the_gathered_values():
             np.testing.assert_array_equal(got.ravel(), ref)
             np.testing.assert_array_equal(flipped.ravel(), ref[::-1])
     assert not np.shares_memory(backwards.wall.shear_modulus, scene.wall.shear_modulus)
+
+
+def test_thick_neo_hookean_pressure_of_a_batch_is_its_entries():
+    """The thick neo-Hookean law decides its far-strain branch by one reduction over the batch:
+    an entry's value does not depend on what else is in the batch (strains past 1e154, where
+    lam^2 - 1 overflows, and a NaN among them included)."""
+    from tubefsi.registry import walls
+    wall = walls["thick-neo-hookean"](shear_modulus=2e3)
+    strain = np.concatenate([np.geomspace(1e-12, 1e200, 300), [np.nan]])
+    batch = wall._pressure_at_strain(strain, 0.3)
+    alone = np.array([wall._pressure_at_strain(np.array([e]), 0.3)[0] for e in strain])
+    np.testing.assert_array_equal(batch, alone)
+    assert np.all(np.isfinite(batch[:-1])) and batch[-2] == pytest.approx(2e3 * np.log1p(0.3), rel=1e-12)

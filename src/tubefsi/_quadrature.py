@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import math
 import threading
 
 import attrs
@@ -343,7 +344,7 @@ def _workspace(name, shape):
     fresh one costs a page fault per 4 KiB written (~1000 per batch, a quarter of a broadcast
     solve's time). A buffer grows to the largest batch seen (at most ``CHUNK`` points of a solve:
     7 MB)."""
-    size = shape[0] * shape[1]
+    size = math.prod(shape)
     buffer = getattr(_SCRATCH, name, None)
     if buffer is None or buffer.size < size:
         buffer = np.empty(size)
@@ -361,16 +362,20 @@ def _apply_map(y):
 
 def _clenshaw(coef, t):
     """:math:`\\sum_k c_{kp} T_k(t_p)` for each column ``p`` of ``coef`` (degree along axis 0)
-    at its own ``t_p``."""
+    at its own ``t_p``: three arrays rotated through the recurrence, none allocated in it."""
     b1 = np.zeros(t.shape)
     b2 = np.zeros(t.shape)
+    b0 = np.empty(t.shape)
     two_t = 2.0 * t
     for k in range(coef.shape[0] - 1, 0, -1):
-        b0 = two_t * b1
+        np.multiply(two_t, b1, out=b0)         # b_k = 2 t b_{k+1} - b_{k+2} + c_k
         b0 -= b2
         b0 += coef[k]
-        b1, b2 = b0, b1
-    return coef[0] + t * b1 - b2
+        b0, b1, b2 = b2, b0, b1
+    b1 *= t
+    b1 += coef[0]
+    b1 -= b2
+    return b1
 
 
 def solve_integral(f, target, upper, *, rtol=1e-14, values=None):
@@ -395,8 +400,10 @@ def solve_integral(f, target, upper, *, rtol=1e-14, values=None):
     """
     target = np.asarray(target, dtype=float).ravel()
     upper = np.broadcast_to(np.asarray(upper, dtype=float), target.shape)
-    y = np.asarray(f(upper[:, None] * LOBATTO_NODES, np.arange(target.size)) if values is None else values,
-                   dtype=float)
+    if values is None:          # (the nodes in a scratch buffer: f's temporaries are its own)
+        nodes = np.multiply(upper[:, None], LOBATTO_NODES, out=_workspace("nodes", (target.size, LOBATTO_NODES.size)))
+        values = f(nodes, np.arange(target.size))
+    y = np.asarray(values, dtype=float)
     half = 0.5 * upper
     with np.errstate(invalid="ignore", over="ignore"):
         maps = _apply_map(y)                             # (52, P): rows contiguous, for the recurrences

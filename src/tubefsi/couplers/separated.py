@@ -44,7 +44,7 @@ import numpy as np
 from .._lazy import lazy_module
 from .._numerics import EPS, integrate_graded, solve_increasing
 from .._products import rows_dot
-from .._quadrature import Integral, adaptive_to_pole, quiet, recording, solve_integral, warn_unconverged
+from .._quadrature import Integral, _workspace, adaptive_to_pole, quiet, recording, solve_integral, warn_unconverged
 from ..errors import ConvergenceError, InvalidParameterError, NoSteadyStateError, StretchRangeError
 from ..scene import Points, Scene, State
 from ._tables import ScalarPair, SeparatedTable, fit_chebyshev, fit_on_breaks, fit_uniform
@@ -185,7 +185,13 @@ class SeparatedVariables(Coupler):
 
     def integrand(self, points: Points, u, q=None):
         r""":math:`s P'(s)/\psi(a s)` (separable) or :math:`s P'(s)/G(q, a s)`."""
-        s = self.stretch_at(points, u)
+        if type(u) is np.ndarray and u.size >= _SCRATCH_SIZE and type(points.outlet_stretch) is float \
+                and points.outlet_stretch == 1.0:
+            # a large batch: the stretches in a scratch buffer (a fresh array of megabytes costs a
+            # page fault per 4 KiB); the wall reads them, and nothing returned refers to them
+            s = np.exp(u, out=_workspace("stretch", u.shape))
+        else:
+            s = self.stretch_at(points, u)
         a = points.radius
         slope = points.wall._log_slope(s, points.tb)
         rheo = points.rheology
@@ -959,6 +965,8 @@ _TABLE_MIN_POINTS = 64
 #: strain) costs its 17 values on top of the adaptive path. A non-separable fluid's integrand
 #: (an interpolated flow law) is left to the adaptive path, whose panels follow its smoothness.
 _ONE_BATCH_MIN_POINTS = 64
+#: Integrand batches of at least this many values put their stretches in a scratch buffer.
+_SCRATCH_SIZE = 1 << 14
 #: Start the direct Newton iteration from a Gauss estimate (SeparatedVariables._gauss_start).
 _GAUSS_START = True
 _START_NODES, _START_WEIGHTS = np.polynomial.legendre.leggauss(8)

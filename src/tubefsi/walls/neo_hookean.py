@@ -182,9 +182,13 @@ class _ThickForms(_NeoHookeanLaw):
         d = tb * (2.0 + tb)
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             x = e * (2.0 + e)                                  # lam^2 - 1 (inf past 1e154: fine below)
-            huge = x > 1e150
-            ratio = np.where(huge, 1.0 / (1.0 + b / x), x / (b + x))
-            last = np.where(huge, ratio * d / (1.0 + x), x * d / ((1.0 + x) * (b + x)))
+            if np.ndim(x) and x.size and x.max() <= 1e150:     # (one reduction, NaN failing it: the usual case, one branch)
+                ratio = x / (b + x)
+                last = x * d / ((1.0 + x) * (b + x))
+            else:
+                huge = x > 1e150
+                ratio = np.where(huge, 1.0 / (1.0 + b / x), x / (b + x))
+                last = np.where(huge, ratio * d / (1.0 + x), x * d / ((1.0 + x) * (b + x)))
         return 0.5 * self._installed_modulus() * (np.log1p(ratio * d) + last)
 
     def _stiffness(self, stretch, tb):
