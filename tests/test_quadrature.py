@@ -127,19 +127,26 @@ def test_newton_reports_where_its_answer_was_evaluated():
 
 
 # ------------------------------------------------------------------ solve_integral (one-shot Chebyshev)
-def test_interpolation_maps_against_numpy_chebyshev():
-    """The value -> coefficient map is the Chebyshev interpolant at the Lobatto nodes
-    (numpy's chebfit through the same 17 points), and its antiderivative vanishes at 0."""
-    from tubefsi._quadrature import _ANTI, _COEF, _MAP
+@pytest.mark.parametrize("degree", [12, 16])
+def test_interpolation_maps_against_numpy_chebyshev(degree):
+    """The value -> coefficient map is the Chebyshev interpolant at the Lobatto nodes (numpy's
+    chebfit through the same n + 1 points), its antiderivative vanishes at -1, and the
+    cumulative rows are that antiderivative at the nodes (numpy's chebval)."""
+    from tubefsi._quadrature import _lobatto_rule
+    rule = _lobatto_rule(degree)
     rng = np.random.default_rng(3)
-    y = rng.standard_normal((5, 17))
-    t = 2.0 * LOBATTO_NODES - 1.0
-    coef = (_MAP[_COEF] @ y.T).T
-    ref = np.array([np.polynomial.chebyshev.chebfit(t, row, 16) for row in y])
+    y = rng.standard_normal((5, degree + 1))
+    t = 2.0 * rule.nodes - 1.0
+    if degree == 16:
+        np.testing.assert_array_equal(rule.nodes, LOBATTO_NODES)
+    coef = (rule.matrix[rule.coef] @ y.T).T
+    ref = np.array([np.polynomial.chebyshev.chebfit(t, row, degree) for row in y])
     np.testing.assert_allclose(coef, ref, rtol=0, atol=1e-13)
-    anti = (_MAP[_ANTI] @ y.T).T
+    anti = (rule.matrix[rule.anti] @ y.T).T
     np.testing.assert_allclose(np.polynomial.chebyshev.chebval(-1.0, anti.T), 0.0, atol=1e-14)
     np.testing.assert_allclose(np.polynomial.chebyshev.chebder(anti.T).T, ref, rtol=0, atol=1e-13)
+    cumulative = (rule.matrix[rule.cumulative] @ y.T).T
+    np.testing.assert_allclose(cumulative, np.polynomial.chebyshev.chebval(t, anti.T), rtol=0, atol=1e-13)
 
 
 @settings(deadline=None, max_examples=30)

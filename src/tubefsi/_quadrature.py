@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import functools
 import math
 import threading
 
@@ -304,31 +305,46 @@ def warn_unconverged(what: str, result: Integral) -> None:
 # ------------------------------------------------------------ one-shot solve of an integral equation
 #: Degree of the Chebyshev interpolant of :func:`solve_integral` (17 Chebyshev–Lobatto nodes).
 CHEBYSHEV_DEGREE = 16
-_T = -np.cos(np.pi * np.arange(CHEBYSHEV_DEGREE + 1) / CHEBYSHEV_DEGREE)      # on [-1, 1], ascending
-#: The Chebyshev–Lobatto nodes of :func:`solve_integral` on [0, 1] (an end node is exactly 0, the other 1).
-LOBATTO_NODES = 0.5 * (1.0 + _T)
-LOBATTO_NODES[0], LOBATTO_NODES[-1] = 0.0, 1.0
 
 
-def _interpolation_matrix():
-    r"""One matrix for every linear map of :func:`solve_integral`, applied in one product (one
-    BLAS call): values at the Lobatto nodes -> the Chebyshev coefficients of the interpolant on
-    [-1, 1] (rows 0-16: the discrete cosine transform of type I), of its antiderivative that
-    vanishes at -1 (rows 17-34, :func:`numpy.polynomial.chebyshev.chebint`), and that
-    antiderivative at the nodes (rows 35-51: the integrals over [-1, t_j], to bracket the root)."""
-    n = CHEBYSHEV_DEGREE
+@attrs.frozen
+class _LobattoRule:
+    """What :func:`solve_integral` needs of one degree ``n``: the ``n + 1`` Chebyshev–Lobatto nodes
+    on [-1, 1] and [0, 1], and one matrix for every linear map, applied in one product (one
+    BLAS call): values at the nodes -> the Chebyshev coefficients of the interpolant on [-1, 1]
+    (rows ``coef``: the discrete cosine transform of type I), of its antiderivative that vanishes
+    at -1 (rows ``anti``, :func:`numpy.polynomial.chebyshev.chebint`), and that antiderivative at
+    the nodes (rows ``cumulative``: the integrals over [-1, t_j], to bracket the root)."""
+
+    degree: int
+    t: np.ndarray
+    nodes: np.ndarray
+    matrix: np.ndarray
+    coef: slice
+    anti: slice
+    cumulative: slice
+
+
+@functools.lru_cache(maxsize=None)
+def _lobatto_rule(n):
+    t = -np.cos(np.pi * np.arange(n + 1) / n)                       # on [-1, 1], ascending
+    nodes = 0.5 * (1.0 + t)
+    nodes[0], nodes[-1] = 0.0, 1.0                                 # (an end node exactly 0, the other 1)
     k = np.arange(n + 1)
     theta = np.pi * np.arange(n + 1) / n                 # t_j = -cos(theta_j)
     to_coef = np.cos(np.outer(k, theta)) * (-1.0) ** k[:, None] * (2.0 / n)
     to_coef[:, [0, -1]] *= 0.5                           # the end nodes count half (trapezoid on theta)
     to_coef[[0, -1], :] *= 0.5                           # and so do the first and last coefficients
     to_antiderivative = np.polynomial.chebyshev.chebint(to_coef, lbnd=-1.0, axis=0)
-    cumulative = np.polynomial.chebyshev.chebvander(_T, n + 1) @ to_antiderivative
-    return np.vstack([to_coef, to_antiderivative, cumulative])
+    cumulative = np.polynomial.chebyshev.chebvander(t, n + 1) @ to_antiderivative
+    matrix = np.vstack([to_coef, to_antiderivative, cumulative])
+    return _LobattoRule(n, t, nodes, matrix, slice(0, n + 1), slice(n + 1, 2 * n + 3), slice(2 * n + 3, 3 * n + 4))
 
 
-_MAP = _interpolation_matrix()
-_COEF, _ANTI, _CUMULATIVE = slice(0, 17), slice(17, 35), slice(35, 52)
+_RULE = _lobatto_rule(CHEBYSHEV_DEGREE)
+_T, _MAP = _RULE.t, _RULE.matrix
+#: The Chebyshev–Lobatto nodes of :func:`solve_integral` on [0, 1] (an end node is exactly 0, the other 1).
+LOBATTO_NODES = _RULE.nodes
 #: Points per matrix product: OpenBLAS runs a product above ~2.6e5 multiply-adds on several
 #: threads, which on a busy machine costs ten times the arithmetic; blocks stay below that.
 _BLOCK = 256
@@ -352,12 +368,12 @@ def _workspace(name, shape):
     return buffer[:size].reshape(shape)
 
 
-def _apply_map(y):
-    """``_MAP @ y.T`` (shape (52, P), rows contiguous), in blocks of ``_BLOCK`` points of one
-    shape (:func:`~tubefsi._products.fixed_width_product`: a point's answer must not depend on the
-    batch it came in: a broadcast solve equals its scalar solves), into this thread's scratch
-    buffer (valid until the next call)."""
-    return fixed_width_product(_MAP, y.T, out=_workspace("maps", (_MAP.shape[0], y.shape[0])), width=_BLOCK)
+def _apply_map(y, matrix=_MAP):
+    """``matrix @ y.T`` (shape (52, P) at degree 16, rows contiguous), in blocks of ``_BLOCK``
+    points of one shape (:func:`~tubefsi._products.fixed_width_product`: a point's answer must not
+    depend on the batch it came in: a broadcast solve equals its scalar solves), into this
+    thread's scratch buffer (valid until the next call)."""
+    return fixed_width_product(matrix, y.T, out=_workspace("maps", (matrix.shape[0], y.shape[0])), width=_BLOCK)
 
 
 def _clenshaw(coef, t):
@@ -378,18 +394,19 @@ def _clenshaw(coef, t):
     return b1
 
 
-def solve_integral(f, target, upper, *, rtol=1e-14, values=None):
+def solve_integral(f, target, upper, *, rtol=1e-14, values=None, degree=CHEBYSHEV_DEGREE):
     r"""Solve :math:`\int_0^{x} f(u)\,du = T` for :math:`x \in (0, X]`, per point, from one
     batch of integrand values: a Chebyshev interpolant on ``[0, X]``, integrated exactly.
 
-    ``f(u, index)`` takes ``u`` of shape ``(P, 17)`` (the Chebyshev–Lobatto nodes of ``P``
-    points' intervals) and the positions ``index`` of those points; ``f > 0``. The interpolant
-    of degree 16 is integrated in closed form, bracketed at the nodes and solved by Newton's
+    ``f(u, index)`` takes ``u`` of shape ``(P, n + 1)`` (the Chebyshev–Lobatto nodes of ``P``
+    points' intervals, ``n = degree``, 16 by default) and the positions ``index`` of those
+    points; ``f > 0``. The interpolant
+    of degree ``n`` is integrated in closed form, bracketed at the nodes and solved by Newton's
     method on the polynomial (no further integrand values). Its error is estimated a
     posteriori from the tail of its Chebyshev coefficients (for a function analytic near the
     interval they decay geometrically, and the last ones bound what was left off,
     L. N. Trefethen, *Approximation Theory and Approximation Practice*, ch. 8 and 19):
-    :math:`E = X\sum_{k=14}^{16}|c_k|`, and a point is solved only where
+    :math:`E = X\sum_{k=n-2}^{n}|c_k|`, and a point is solved only where
     :math:`E \le` ``rtol`` :math:`T`, its root lies in ``(0, X]`` and every value is positive
     and finite. The others are left to the caller (an adaptive method): nothing here is
     accepted unchecked.
@@ -398,16 +415,17 @@ def solve_integral(f, target, upper, *, rtol=1e-14, values=None):
     where ``solved``; ``short`` marks the points whose integral over ``[0, X]`` falls short of
     the target (the caller may try a longer interval).
     """
+    rule = _lobatto_rule(degree)
     target = np.asarray(target, dtype=float).ravel()
     upper = np.broadcast_to(np.asarray(upper, dtype=float), target.shape)
     if values is None:          # (the nodes in a scratch buffer: f's temporaries are its own)
-        nodes = np.multiply(upper[:, None], LOBATTO_NODES, out=_workspace("nodes", (target.size, LOBATTO_NODES.size)))
+        nodes = np.multiply(upper[:, None], rule.nodes, out=_workspace("nodes", (target.size, rule.nodes.size)))
         values = f(nodes, np.arange(target.size))
     y = np.asarray(values, dtype=float)
     half = 0.5 * upper
     with np.errstate(invalid="ignore", over="ignore"):
-        maps = _apply_map(y)                             # (52, P): rows contiguous, for the recurrences
-        coef, anti, cumulative = maps[_COEF], maps[_ANTI], maps[_CUMULATIVE]
+        maps = _apply_map(y, rule.matrix)                # (3n + 4, P): rows contiguous, for the recurrences
+        coef, anti, cumulative = maps[rule.coef], maps[rule.anti], maps[rule.cumulative]
         anti *= half                                     # dx = (X/2) dt
         cumulative *= half
         tail = np.abs(coef[-3:]).sum(axis=0) * upper
@@ -427,10 +445,10 @@ def solve_integral(f, target, upper, *, rtol=1e-14, values=None):
         h, t_goal = half[live], target[live]
     # the bracketing nodes, and the cubic Hermite interpolant of the integral between them (its
     # slopes are the integrand values themselves) as Newton's start: within ~1e-5 of the root
-    j = np.maximum(np.minimum(np.count_nonzero(cumulative < t_goal, axis=0), CHEBYSHEV_DEGREE), 1)
+    j = np.maximum(np.minimum(np.count_nonzero(cumulative < t_goal, axis=0), rule.degree), 1)
     cols = np.arange(live.size)
     c0, c1 = cumulative[j - 1, cols], cumulative[j, cols]
-    t0, t1 = _T[j - 1], _T[j]
+    t0, t1 = rule.t[j - 1], rule.t[j]
     scale = h * (t1 - t0)
     d0, d1 = y[cols, j - 1] * scale, y[cols, j] * scale      # dJ/ds at the ends, s in [0, 1]
     rise, goal = c1 - c0, t_goal - c0
