@@ -292,8 +292,8 @@ def test_uniform_fit_gives_up_honestly():
 
 
 def test_thin_reference_pressure_from_the_log_stretch_against_mpmath():
-    r"""The thin reference-thickness law from :math:`v = \ln\lambda` (:math:`-e^v\,\mathrm{expm1}(-4v)`,
-    the curve path) against :math:`\lambda - \lambda^{-3}` in 40-digit mpmath, from
+    r"""The thin reference-thickness law from :math:`v = \ln\lambda` (:math:`-\lambda\,\mathrm{expm1}(-4v)`
+    with :math:`\lambda = 1 + \mathrm{expm1}(v)`, the curve path) against :math:`\lambda - \lambda^{-3}` in 40-digit mpmath, from
     :math:`v = 10^{-12}` to 650, within 4 ulp; the current-thickness law and other arguments fall
     back to the strain form exactly."""
     import mpmath

@@ -252,7 +252,8 @@ class Scene:
             if not broadcasts and _array_values(model):
                 grouped.append(model)
         if not grouped:
-            return [(todo, self.take(todo))]
+            # (every point in order, the common case: the scene itself, not a gathered copy of it)
+            return [(todo, self if _every_point(todo, self.size) else self.take(todo))]
         keys = [np.broadcast_to(v, (self.size,))[todo] for m in grouped for v in _array_values(m).values()]
         _, inverse = np.unique(np.stack(keys, axis=1), axis=0, return_inverse=True)
         inverse = inverse.ravel()

@@ -344,18 +344,20 @@ def _is(cls, base) -> bool:
     return found
 
 
+_INF = math.inf
+_COUPLERS = registry.couplers
+
+
 def _scalar_flow(rheology, wall, tube, q):
     """The lean scalar path: one flow rate through a scene of scalars whose curve table is cached
     (a Monte Carlo loop over a modulus, a viscosity, the tube's size or the load). None where it
     does not apply; the general path then answers (and builds the table for the next call)."""
-    if type(tube) is not Tube:
+    if type(tube) is not Tube or not 0.0 < q < _INF:
         return None
-    chosen = _AUTO.get((type(rheology), type(wall), registry.couplers.generation))
+    chosen = _AUTO.get((type(rheology), type(wall), _COUPLERS.generation))
     if chosen is None:                         # first time for this pair of classes
         chosen = _auto(rheology, wall)
-    if chosen is False:
-        return None
-    if not (q > 0.0 and q < math.inf) or wall.is_rigid or wall._installed_tube(tube) is not tube:
+    if chosen is False or wall.is_rigid or wall._installed_tube(tube) is not tube:
         return None
     k = rheology.radius_exponent
     a, t, L = tube.radius, tube.thickness, tube.length

@@ -121,9 +121,10 @@ class _ThinForms(_NeoHookeanLaw):
         return scale * unit
 
     def _pressure_at_log_stretch(self, log_stretch, strain, tb):
-        # reference thickness: lam - lam^-3 = e^v (1 - e^{-4v}) = -e^v expm1(-4v): two exponentials
-        # of exact arguments (4v is) and a product, to a few ulp at any v (no cancellation at small
-        # v; e^{-3v} would round 3v: a relative 3v eps) where the strain form takes ten passes
+        # reference thickness: lam - lam^-3 = lam (1 - e^{-4v}) = -(1 + strain) expm1(-4v): one
+        # exponential of an exact argument (4v is) and a product, to a few ulp at any v (no
+        # cancellation at small v; e^{-3v} would round 3v: a relative 3v eps), where the strain
+        # form takes ten passes
         v = log_stretch
         if (self.thickness_convention != "reference" or type(v) is not np.ndarray or type(tb) is not float
                 or type(self._installed_modulus()) is not float or v.shape != np.shape(strain)
@@ -131,7 +132,8 @@ class _ThinForms(_NeoHookeanLaw):
             return self._pressure_at_strain(strain, tb)
         out = np.multiply(v, -4.0)
         np.expm1(out, out=out)
-        out *= np.exp(v)
+        lam = np.add(strain, 1.0)
+        out *= lam
         out *= -self._installed_modulus() * tb
         return out
 
