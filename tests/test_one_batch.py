@@ -17,6 +17,7 @@ import tubefsi
 from accuracy_helpers import ref_wall
 from tubefsi.couplers import separated
 from tubefsi.registry import rheologies, walls
+from tubefsi.scene import make_scene
 from tubefsi.testing.reference.power_law import flow_rate_cases
 
 
@@ -116,3 +117,20 @@ def test_short_intervals_take_degree_12_and_the_answer_is_the_points_own(monkeyp
     few = np.r_[0:8, size - 60:size]                        # 68 points, another mix of both degrees
     part = tubefsi.solve(rheologies["power-law"](consistency=m, index=n[few]), wall, tube, flow_rate=q[few])
     np.testing.assert_array_equal(part.pressure_drop, sol.pressure_drop[few])
+
+
+def test_the_integrand_at_the_outlet_is_the_integrand_at_zero():
+    """The linear guess's slope, computed without the exponentials of u = 0, is the integrand's
+    value there to the bit, for array parameters and for a wall whose slope is generic."""
+    rng = np.random.default_rng(2)
+    size = 300
+    tube = tubefsi.Tube(radius=rng.uniform(5e-5, 2e-4, size), thickness=rng.uniform(1e-5, 5e-5, size), length=1e-2)
+    fluid = rheologies["power-law"](consistency=rng.uniform(0.005, 0.05, size), index=rng.uniform(0.4, 1.2, size))
+    for wall in (walls["thick-neo-hookean"](shear_modulus=rng.uniform(1e3, 1e4, size)),
+                 walls["thick-fung"](shear_modulus=2e3, stiffening=rng.uniform(0.5, 20.0, size)),
+                 walls["thin-mooney-rivlin"](c1=1e3, c2=rng.uniform(0.0, 500.0, size))):
+        scene = make_scene(fluid, wall, tube).flat((size,))
+        engine = tubefsi.select_coupler(fluid, wall)
+        points = scene.at(np.arange(size))
+        np.testing.assert_array_equal(engine._integrand_at_outlet(points, (size,)),
+                                      engine.integrand(points, np.zeros(size)))

@@ -166,12 +166,13 @@ class SeparatedVariables(Coupler):
             warn_unconverged("the separated-variables integral", result)
         return result.value
 
-    def pressure_rise(self, scene: Scene, v, index):
-        r""":math:`P(\lambda_{out}e^v) - p_{out}` at the points ``index``, without cancellation."""
+    def pressure_rise(self, scene: Scene, v, index, *, points=None, strain=None):
+        r""":math:`P(\lambda_{out}e^v) - p_{out}` at the points ``index``, without cancellation
+        (``points``: ``scene.at(index)`` and ``strain``: ``expm1(v)``, if the caller has them)."""
         v = np.asarray(v, dtype=float)
-        pts = scene.at(index)
+        pts = scene.at(index) if points is None else points
         if np.ndim(scene.outlet_pressure) == 0 and scene.outlet_pressure == 0.0:
-            return pts.wall._pressure_at_strain(np.expm1(v), pts.tb)
+            return pts.wall._pressure_at_strain(np.expm1(v) if strain is None else strain, pts.tb)
         rise = self.integrate(scene, lambda u, i: self._slope(scene.at(index[i], column=True), u), v, index)
         zero_out = np.asarray(pts.outlet_pressure) == 0.0
         if np.any(zero_out):                  # the tube law itself, where the outlet is unloaded
@@ -223,6 +224,22 @@ class SeparatedVariables(Coupler):
             return slope / rheo._radius_factor(a * s)
         qq = np.broadcast_to(q, np.shape(u))
         return slope / rheo._pressure_gradient(qq, a * s)
+
+    def _integrand_at_outlet(self, points: Points, shape, q=None):
+        """``integrand(points, zeros(shape), q)`` (the linear guess's slope), with the exponentials
+        of u = 0 left out where the fluid is a separable power law and the outlet unloaded: the
+        same values (e^0 = 1 and 1 * scale = scale exactly), a third of the passes."""
+        rheo = points.rheology
+        k = rheo.radius_exponent if q is None and rheo.separable else None
+        if k is None or not (type(points.outlet_stretch) is float and points.outlet_stretch == 1.0):
+            return self.integrand(points, np.zeros(shape), q)
+        slope = points.wall._log_slope(np.ones(shape), points.tb)
+        with np.errstate(over="ignore", under="ignore"):
+            scale = (points.radius * points.outlet_stretch) ** k
+        if not (np.all(np.abs(np.log(scale)) < _LOG_RANGE)
+                and np.broadcast_shapes(np.shape(slope), np.shape(scale)) == tuple(shape)):
+            return self.integrand(points, np.zeros(shape), q)
+        return slope * scale
 
     @staticmethod
     def target(points: Points, q):
@@ -313,6 +330,7 @@ class SeparatedVariables(Coupler):
                 v[sub] = v_c
                 dp[sub] = self.pressure_rise(scene, v_c, sub)
                 direct[sub] = False
+        strain = None
         if np.any(direct):
             start = time.perf_counter()
             sub = np.flatnonzero(direct)
@@ -320,11 +338,17 @@ class SeparatedVariables(Coupler):
             if not np.all(ok):
                 self._raise_runaway(scene, q[sub], ok, sub)
             v[sub] = v_d
-            dp[sub] = self.pressure_rise(scene, v_d, sub)
+            if sub.size == q.size and type(scene.outlet_strain) is float and scene.outlet_strain == 0.0:
+                # every point solved here at an unloaded outlet (a broadcast solve): the strain is
+                # expm1(v) itself (strain_at's 0 + 1 * expm1(v)), computed once for both uses
+                strain = np.expm1(v)
+                dp[sub] = self.pressure_rise(scene, v_d, sub, points=pts, strain=strain)
+            else:
+                dp[sub] = self.pressure_rise(scene, v_d, sub)
             if table is None:
                 _charge(scene, time.perf_counter() - start)
         dp[target == 0] = 0.0
-        return State(q, dp, self.strain_at(pts, v) + 0.0 * v, v)
+        return State(q, dp, self.strain_at(pts, v) + 0.0 * v if strain is None else strain, v)
 
     def curve_from_table(self, scene: Scene, q):
         """The state of every flow rate ``q`` (a flat array of positive ones) of a scene of
@@ -454,7 +478,7 @@ class SeparatedVariables(Coupler):
                 guess = np.ones(target.shape)
         else:
             with np.errstate(divide="ignore", invalid="ignore"):   # G(0, R) = 0: only where target = 0
-                slope0 = self.integrand(scene.at(index), np.zeros(target.shape), qflat)
+                slope0 = self._integrand_at_outlet(scene.at(index), target.shape, qflat)
                 guess = np.where(target > 0, np.minimum(target / slope0, 1.0), 0.0)
         if upper is not None:
             guess = np.minimum(guess, upper)
