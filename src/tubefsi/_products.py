@@ -48,5 +48,7 @@ def fixed_width_product(a, b, *, out=None, width=256):
         buffer[:, :count] = b[:, start:start + count]
         if count < width:
             buffer[:, count:] = 0.0
-        out[:, start:start + count] = (a @ buffer)[:, :count]
+            out[:, start:start + count] = (a @ buffer)[:, :count]
+        else:                           # a whole block: written in place (the same product, no copy)
+            np.matmul(a, buffer, out=out[:, start:start + width])
     return out
