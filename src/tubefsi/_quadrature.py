@@ -28,13 +28,11 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import functools
-import math
-import threading
 
 import attrs
 import numpy as np
 
-from ._products import fixed_width_product, rows_dot
+from ._products import fixed_width_product, rows_dot, scratch
 from .errors import AccuracyWarning, warn_user
 
 __all__ = ["Integral", "adaptive", "adaptive_to_pole", "solve_integral", "warn_unconverged", "quiet", "KRONROD_NODES",
@@ -341,39 +339,19 @@ def _lobatto_rule(n):
     return _LobattoRule(n, t, nodes, matrix, slice(0, n + 1), slice(n + 1, 2 * n + 3), slice(2 * n + 3, 3 * n + 4))
 
 
-_RULE = _lobatto_rule(CHEBYSHEV_DEGREE)
-_T, _MAP = _RULE.t, _RULE.matrix
 #: The Chebyshev–Lobatto nodes of :func:`solve_integral` on [0, 1] (an end node is exactly 0, the other 1).
-LOBATTO_NODES = _RULE.nodes
+LOBATTO_NODES = _lobatto_rule(CHEBYSHEV_DEGREE).nodes
 #: Points per matrix product: OpenBLAS runs a product above ~2.6e5 multiply-adds on several
 #: threads, which on a busy machine costs ten times the arithmetic; blocks stay below that.
 _BLOCK = 256
 
 
-_SCRATCH = threading.local()
-
-
-def _workspace(name, shape):
-    """An uninitialized float array of ``shape`` from this thread's scratch buffer ``name``, reused
-    by every call (valid until the next call asks for the same name). Why: the arrays of a batch
-    of 10^4 points are megabytes, which glibc allocates with mmap and unmaps on free, so that a
-    fresh one costs a page fault per 4 KiB written (~1000 per batch, a quarter of a broadcast
-    solve's time). A buffer grows to the largest batch seen (at most ``CHUNK`` points of a solve:
-    7 MB)."""
-    size = math.prod(shape)
-    buffer = getattr(_SCRATCH, name, None)
-    if buffer is None or buffer.size < size:
-        buffer = np.empty(size)
-        setattr(_SCRATCH, name, buffer)
-    return buffer[:size].reshape(shape)
-
-
-def _apply_map(y, matrix=_MAP):
+def _apply_map(y, matrix):
     """``matrix @ y.T`` (shape (52, P) at degree 16, rows contiguous), in blocks of ``_BLOCK``
     points of one shape (:func:`~tubefsi._products.fixed_width_product`: a point's answer must not
     depend on the batch it came in: a broadcast solve equals its scalar solves), into this
     thread's scratch buffer (valid until the next call)."""
-    return fixed_width_product(matrix, y.T, out=_workspace("maps", (matrix.shape[0], y.shape[0])), width=_BLOCK)
+    return fixed_width_product(matrix, y.T, out=scratch("maps", (matrix.shape[0], y.shape[0])), width=_BLOCK)
 
 
 def _clenshaw(coef, t):
@@ -419,7 +397,7 @@ def solve_integral(f, target, upper, *, rtol=1e-14, values=None, degree=CHEBYSHE
     target = np.asarray(target, dtype=float).ravel()
     upper = np.broadcast_to(np.asarray(upper, dtype=float), target.shape)
     if values is None:          # (the nodes in a scratch buffer: f's temporaries are its own)
-        nodes = np.multiply(upper[:, None], rule.nodes, out=_workspace("nodes", (target.size, rule.nodes.size)))
+        nodes = np.multiply(upper[:, None], rule.nodes, out=scratch("nodes", (target.size, rule.nodes.size)))
         values = f(nodes, np.arange(target.size))
     y = np.asarray(values, dtype=float)
     half = 0.5 * upper

@@ -419,6 +419,13 @@ def _resolve(kind, value, base, registry):
     return value
 
 
+def _log_max_stretch(wall, tb) -> float:
+    r""":math:`\ln\lambda_{max}` of a wall of scalar parameters at a scalar t/a (``inf`` unless it
+    locks): the ``log_stretch_max`` of its scene at an unloaded outlet."""
+    lam_max = wall._max_stretch(tb)
+    return math.log(lam_max) if type(lam_max) is float else float(np.log(lam_max))
+
+
 def make_scene(rheology, wall, tube, *, outlet_pressure=0.0, external_pressure=0.0) -> Scene:
     """Resolve and validate the models, the tube and the outlet and external pressures into a
     :class:`Scene` (whose ``outlet_pressure`` is the transmural one, ``outlet_pressure -
@@ -449,9 +456,7 @@ def make_scene(rheology, wall, tube, *, outlet_pressure=0.0, external_pressure=0
             and external_pressure == 0.0):   # the common case: an unloaded outlet is below every limit
         if parameter_shape(rheology) == () and parameter_shape(wall) == () and parameter_shape(tube) == ():
             # every parameter a float (a curve): the fields __attrs_post_init__ would derive, directly
-            lam_max = wall._max_stretch(tube.reduced_thickness)
-            return Scene._trusted(rheology, wall, tube, math.log(lam_max) if type(lam_max) is float
-                                  else float(np.log(lam_max)))
+            return Scene._trusted(rheology, wall, tube, _log_max_stretch(wall, tube.reduced_thickness))
         return Scene(rheology=rheology, wall=wall, tube=tube, outlet_pressure=0.0)
     p_out = as_array("outlet_pressure", outlet_pressure, "[0, inf)", lambda a: a >= 0)
     p_out = float(p_out) if p_out.ndim == 0 else p_out

@@ -29,7 +29,7 @@ from .couplers.separated import _TABLES, SeparatedVariables, curve_span
 from .geometry import Tube
 from .rheology.base import Rheology
 from .rheology.power_law import FactorRangeError
-from .scene import Scene, State, _resolve, make_scene, _scalar_state
+from .scene import Scene, State, _log_max_stretch, _resolve, _scalar_state, make_scene
 from .solution import Solution
 from .validity import SLENDERNESS, check, warn
 from .walls.base import WallModel
@@ -392,9 +392,7 @@ def _scalar_flow(rheology, wall, tube, q):
     drop = scale * math.exp(log_rise)
     log_stretch_max = table.log_stretch_max
     if log_stretch_max is None:                # the key's (wall shape, t/a): the same for every scene of it
-        lam_max = wall._max_stretch(t / a)
-        log_stretch_max = table.log_stretch_max = (math.log(lam_max) if type(lam_max) is float
-                                                   else float(np.log(lam_max)))
+        log_stretch_max = table.log_stretch_max = _log_max_stretch(wall, t / a)
     parts = (rheology, wall, tube, log_stretch_max)
     if a * (1.0 + strain) > SLENDERNESS * L or strain > wall.calibrated_strain:
         warn(check(Scene._trusted(*parts), q, strain))
@@ -410,9 +408,7 @@ def _curve_flow(rheology, wall, tube, flow_rate):
     if (type(tube) is not Tube or flow_rate.ndim != 1 or not 0 < flow_rate.size <= CHUNK
             or type(tube.radius) is not float or type(tube.thickness) is not float or type(tube.length) is not float):
         return None
-    chosen = _AUTO.get((type(rheology), type(wall), registry.couplers.generation))
-    if chosen is None:
-        chosen = _auto(rheology, wall)
+    chosen = _auto(rheology, wall)
     if chosen is False or not _is(type(chosen[0]), SeparatedVariables) or chosen[0].refined() is not None:
         return None
     if parameter_shape(rheology) != () or parameter_shape(wall) != ():     # array parameters: a broadcast solve

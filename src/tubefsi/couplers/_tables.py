@@ -38,9 +38,30 @@ _FIT = np.polynomial.chebyshev.chebvander(_NODES, _DEGREE)
 _FIT_INV = np.linalg.inv(_FIT)
 _CHECK = np.array([-0.97, -0.81, -0.55, -0.23, 0.11, 0.43, 0.71, 0.93])              # not nodes
 _AT_CHECK = np.polynomial.chebyshev.chebvander(_CHECK, _DEGREE)
-#: Row k: the monomial coefficients of T_k (numpy's cheb2poly), to degree _DEGREE.
-_CHEB_TO_MONO = np.array([np.pad(np.polynomial.chebyshev.cheb2poly(np.eye(_DEGREE + 1)[k]), (0, _DEGREE - k))
-                          for k in range(_DEGREE + 1)])
+
+
+def _cheb_to_mono(degree):
+    """Row k: the monomial coefficients of T_k (numpy's cheb2poly), to ``degree``."""
+    return np.array([np.pad(np.polynomial.chebyshev.cheb2poly(np.eye(degree + 1)[k]), (0, degree - k))
+                     for k in range(degree + 1)])
+
+
+_CHEB_TO_MONO = _cheb_to_mono(_DEGREE)
+
+
+def _fit_panels(f, a, b):
+    """The degree-10 Chebyshev coefficients of ``f`` (vectorized) on the panels ``a[i] .. b[i]``
+    and, per panel, the interpolant's miss at the check points and its tail, both relative to
+    ``max(1, |f|)``: ``(coef, miss, tail, mid)``."""
+    mid, half = 0.5 * (a + b), 0.5 * (b - a)
+    x = np.concatenate([mid[:, None] + half[:, None] * _NODES, mid[:, None] + half[:, None] * _CHECK], axis=1)
+    values = np.asarray(f(x.ravel()), dtype=float).reshape(x.shape)
+    y_nodes, y_check = values[:, :_DEGREE + 1], values[:, _DEGREE + 1:]
+    coef = y_nodes @ _FIT_INV.T
+    scale = np.maximum(1.0, np.max(np.abs(y_nodes), axis=1))
+    miss = np.max(np.abs(coef @ _AT_CHECK.T - y_check), axis=1) / scale
+    tail = np.max(np.abs(coef[:, -3:]), axis=1) / scale
+    return coef, miss, tail, mid
 
 
 class Chebyshev:
@@ -172,15 +193,7 @@ def fit_on_breaks(f, breaks, *, tol=5e-14):
     """``(Chebyshev, error)`` of ``f`` (vectorized) on the given panels ``breaks``, each panel's
     tail and check points within ``tol`` (as in :func:`fit_chebyshev`); ``(None, inf)`` if a panel
     misses (no splitting: the panels are another interpolant's, whose scalar path this one joins)."""
-    a, b = np.asarray(breaks[:-1], dtype=float), np.asarray(breaks[1:], dtype=float)
-    mid, half = 0.5 * (a + b), 0.5 * (b - a)
-    x = np.concatenate([mid[:, None] + half[:, None] * _NODES, mid[:, None] + half[:, None] * _CHECK], axis=1)
-    values = np.asarray(f(x.ravel()), dtype=float).reshape(x.shape)
-    y_nodes, y_check = values[:, :_DEGREE + 1], values[:, _DEGREE + 1:]
-    coef = y_nodes @ _FIT_INV.T
-    scale = np.maximum(1.0, np.max(np.abs(y_nodes), axis=1))
-    miss = np.max(np.abs(coef @ _AT_CHECK.T - y_check), axis=1) / scale
-    tail = np.max(np.abs(coef[:, -3:]), axis=1) / scale
+    coef, miss, tail, _ = _fit_panels(f, np.asarray(breaks[:-1], dtype=float), np.asarray(breaks[1:], dtype=float))
     if not np.all(np.isfinite(miss) & (miss <= tol) & (tail <= tol)):
         return None, math.inf
     return Chebyshev(breaks, coef), float(np.max(miss))
@@ -243,16 +256,7 @@ def fit_chebyshev(f, lo, hi, *, panels=4, tol=1e-14, max_panels=256):
             return None, math.inf
         a = np.array([p[0] for p in pending])
         b = np.array([p[1] for p in pending])
-        mid, half = 0.5 * (a + b), 0.5 * (b - a)
-        x_nodes = mid[:, None] + half[:, None] * _NODES
-        x_check = mid[:, None] + half[:, None] * _CHECK
-        values = np.asarray(f(np.concatenate([x_nodes, x_check], axis=1).ravel()), dtype=float).reshape(len(a), -1)
-        y_nodes, y_check = values[:, :_DEGREE + 1], values[:, _DEGREE + 1:]
-        coef = y_nodes @ _FIT_INV.T
-        interp = coef @ _AT_CHECK.T
-        scale = np.maximum(1.0, np.max(np.abs(y_nodes), axis=1))
-        miss = np.max(np.abs(interp - y_check), axis=1) / scale
-        tail = np.max(np.abs(coef[:, -3:]), axis=1) / scale
+        coef, miss, tail, mid = _fit_panels(f, a, b)
         ok = np.isfinite(miss) & (miss <= tol) & (tail <= tol)
         nxt = []
         for i in range(len(a)):
@@ -342,9 +346,7 @@ def fit_uniform(f, lo, hi, *, tol=2e-15, rules=_UNIFORM_RULES):
         values = np.asarray(f(probe.panel_nodes(nodes).ravel()), dtype=float).reshape(panels, degree + 1)
         t = 2.0 * nodes - 1.0
         cheb = np.linalg.solve(np.polynomial.chebyshev.chebvander(t, degree), values.T).T
-        to_mono = np.array([np.pad(np.polynomial.chebyshev.cheb2poly(np.eye(degree + 1)[k]), (0, degree - k))
-                            for k in range(degree + 1)])
-        fitted = UniformPolynomial(lo, hi, cheb @ to_mono @ _shift_to_unit(degree))
+        fitted = UniformPolynomial(lo, hi, cheb @ _cheb_to_mono(degree) @ _shift_to_unit(degree))
         x_check = np.clip(fitted.panel_nodes(_UNIFORM_CHECK).ravel(), lo, hi)
         want = np.asarray(f(x_check), dtype=float)
         miss = float(np.max(np.abs(fitted(x_check) - want) / np.maximum(1.0, np.abs(want))))

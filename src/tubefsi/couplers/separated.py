@@ -43,8 +43,8 @@ import numpy as np
 
 from .._lazy import lazy_module
 from .._numerics import EPS, integrate_graded, solve_increasing
-from .._products import rows_dot
-from .._quadrature import (CHEBYSHEV_DEGREE, Integral, _workspace, adaptive_to_pole, quiet, recording, solve_integral,
+from .._products import rows_dot, scratch
+from .._quadrature import (CHEBYSHEV_DEGREE, Integral, adaptive_to_pole, quiet, recording, solve_integral,
                            warn_unconverged)
 from ..errors import ConvergenceError, InvalidParameterError, NoSteadyStateError, StretchRangeError
 from ..scene import Points, Scene, State
@@ -191,7 +191,7 @@ class SeparatedVariables(Coupler):
                 and points.outlet_stretch == 1.0:
             # a large batch: the stretches in a scratch buffer (a fresh array of megabytes costs a
             # page fault per 4 KiB); the wall reads them, and nothing returned refers to them
-            s = np.exp(u, out=_workspace("stretch", u.shape))
+            s = np.exp(u, out=scratch("stretch", u.shape))
         else:
             s = self.stretch_at(points, u)
         a = points.radius
@@ -350,7 +350,7 @@ class SeparatedVariables(Coupler):
         dp[target == 0] = 0.0
         return State(q, dp, self.strain_at(pts, v) + 0.0 * v if strain is None else strain, v)
 
-    def curve_from_table(self, scene: Scene, q):
+    def curve_from_table(self, scene: Scene, q) -> State | None:
         """The state of every flow rate ``q`` (a flat array of positive ones) of a scene of
         scalars from its table if the table is built and serves every point, else None (what
         :meth:`flow_controlled` does first; the lean curve path of :func:`tubefsi.solve`)."""
