@@ -379,3 +379,52 @@ def test_a_scalar_path_solution_is_a_whole_solution():
     assert fast.pressure(0.5 * TUBE.length) == pytest.approx(general.pressure(0.5 * TUBE.length), rel=1e-12)
     with pytest.raises(AttributeError, match="no attribute 'scenery'"):
         fast.scenery
+
+
+def test_the_scalar_plan_gives_the_bits_of_a_fresh_one():
+    """The scalar path keeps what it read off the last rheology and tube (solve._Plan): a loop
+    that changes the fluid, the tube, the wall and the flow rate in every pattern gets, call by
+    call, the bits a fresh plan gives, and the general path's answer to 1e-13; two threads that
+    share the plan get their own answers."""
+    import threading
+    solve_module = importlib.import_module("tubefsi.solve")
+    fluids = [FLUID, rheologies["power-law"](consistency=0.02, index=0.9)]
+    tubes = [TUBE, tubefsi.Tube(radius=1.2e-4, thickness=3e-5, length=1.5e-2)]
+    for fluid in fluids:
+        for tube in tubes:          # build every key's table
+            tubefsi.solve(fluid, walls["thick-neo-hookean"](shear_modulus=2e3), tube,
+                          flow_rate=np.geomspace(1e-12, 1e-9, 100))
+    rng = np.random.default_rng(7)
+    calls = [(fluids[rng.integers(2)], tubes[rng.integers(2)], float(rng.uniform(1e3, 4e3)),
+              float(rng.choice([1e-10, 5e-10, 1e-9]))) for _ in range(60)]
+
+    def run(fresh):
+        out = []
+        for fluid, tube, mu, q in calls:
+            if fresh:
+                solve_module._LAST_PLAN[0] = None
+            sol = solve_module._scalar_flow(fluid, walls["thick-neo-hookean"](shear_modulus=mu), tube, q)
+            out.append((sol.pressure_drop, sol.inlet_displacement))
+        return out
+
+    kept, fresh = run(False), run(True)
+    assert kept == fresh
+    for (fluid, tube, mu, q), (drop, _) in zip(calls[:8], kept):
+        general = tubefsi.solve(fluid, walls["thick-neo-hookean"](shear_modulus=mu), tube, flow_rate=q,
+                                on_infeasible="nan")     # (an option the scalar path does not take)
+        assert drop == pytest.approx(general.pressure_drop, rel=1e-13)
+    answers = {}
+
+    def worker(name, q):
+        answers[name] = [solve_module._scalar_flow(FLUID, walls["thick-neo-hookean"](shear_modulus=2e3), TUBE, q)
+                         .pressure_drop for _ in range(2000)]
+
+    threads = [threading.Thread(target=worker, args=(q, q)) for q in (1e-10, 1e-9)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for q, got in answers.items():
+        solve_module._LAST_PLAN[0] = None
+        alone = solve_module._scalar_flow(FLUID, walls["thick-neo-hookean"](shear_modulus=2e3), TUBE, q).pressure_drop
+        assert set(got) == {alone}

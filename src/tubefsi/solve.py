@@ -348,6 +348,45 @@ _INF = math.inf
 _COUPLERS = registry.couplers
 
 
+class _Plan:
+    """What the scalar path reads off one rheology and one tube, checked once for the pair and
+    reused while the next call brings the same two objects (a Monte Carlo loop over a wall's
+    parameters): both are immutable, so what was read off them stands. ``flow`` is the last
+    ``(q, L phi(q))``, one tuple so that a thread never sees half of another's."""
+
+    __slots__ = ("rheology", "tube", "radius_exponent", "radius", "reduced_thickness", "length",
+                 "radius_power", "flow")
+
+    def __init__(self, rheology, tube):
+        self.rheology, self.tube = rheology, tube
+        self.radius_exponent = rheology.radius_exponent
+        self.radius, self.length = tube.radius, tube.length
+        self.reduced_thickness = tube.thickness / tube.radius
+        self.radius_power = self.radius**self.radius_exponent
+        self.flow = (None, None)
+
+
+#: The scalar path's last plan (None, or one that applies to the last call's rheology and tube).
+_LAST_PLAN: list = [None]
+
+
+def _plan(rheology, tube):
+    """A :class:`_Plan` of ``rheology`` and ``tube`` for the scalar path, or None where it does
+    not apply (a tube's field or the radius exponent not a float, a non-separable rheology)."""
+    if not rheology.separable:
+        return None
+    k = rheology.radius_exponent
+    if (type(k) is not float or type(tube.radius) is not float or type(tube.thickness) is not float
+            or type(tube.length) is not float):
+        return None
+    try:
+        plan = _Plan(rheology, tube)
+    except OverflowError:                      # a^k beyond the doubles: the general path says so
+        return None
+    _LAST_PLAN[0] = plan
+    return plan
+
+
 def _scalar_flow(rheology, wall, tube, q):
     """The lean scalar path: one flow rate through a scene of scalars whose curve table is cached
     (a Monte Carlo loop over a modulus, a viscosity, the tube's size or the load). None where it
@@ -358,13 +397,14 @@ def _scalar_flow(rheology, wall, tube, q):
     if chosen is None:                         # first time for this pair of classes
         chosen = _auto(rheology, wall)
     if chosen is False or wall.is_rigid or wall._installed_tube(tube) is not tube:
-        return None
-    k = rheology.radius_exponent
-    a, t, L = tube.radius, tube.thickness, tube.length
-    if type(k) is not float or type(a) is not float or type(t) is not float or type(L) is not float:
-        return None
+        return None                            # (False: not a pair of models)
+    plan = _LAST_PLAN[0]
+    if plan is None or plan.rheology is not rheology or plan.tube is not tube:
+        plan = _plan(rheology, tube)
+        if plan is None:
+            return None
     try:
-        table = _TABLES.get((type(wall), wall._shape_key(), t / a, k))
+        table = _TABLES.get((type(wall), wall._shape_key(), plan.reduced_thickness, plan.radius_exponent))
     except TypeError:                          # an array parameter in the wall's shape
         return None
     if not table:
@@ -372,13 +412,17 @@ def _scalar_flow(rheology, wall, tube, q):
     scale = wall._pressure_scale()
     if type(scale) is not float:
         return None
-    phi = rheology._flow_factor(q)
-    if type(phi) is not float or not rheology.separable:
+    last_q, length_factor = plan.flow
+    if q != last_q:
+        phi = rheology._flow_factor(q)
+        if type(phi) is not float:
+            return None
+        length_factor = plan.length * phi
+        plan.flow = (q, length_factor)
+    norm = plan.radius_power * scale
+    if not 2.2250738585072014e-308 <= norm < _INF:     # a power law of a large index: the general path
         return None
-    norm = a**k * scale
-    if not 2.2250738585072014e-308 <= norm < math.inf:     # a power law of a large index: the general path
-        return None
-    x = math.log(L * phi / norm)
+    x = math.log(length_factor / norm)
     if not table.x_lo <= x <= table.x_hi:
         return None
     pair = table.scalar_pair
@@ -392,9 +436,9 @@ def _scalar_flow(rheology, wall, tube, q):
     drop = scale * math.exp(log_rise)
     log_stretch_max = table.log_stretch_max
     if log_stretch_max is None:                # the key's (wall shape, t/a): the same for every scene of it
-        log_stretch_max = table.log_stretch_max = _log_max_stretch(wall, t / a)
+        log_stretch_max = table.log_stretch_max = _log_max_stretch(wall, plan.reduced_thickness)
     parts = (rheology, wall, tube, log_stretch_max)
-    if a * (1.0 + strain) > SLENDERNESS * L or strain > wall.calibrated_strain:
+    if plan.radius * (1.0 + strain) > SLENDERNESS * plan.length or strain > wall.calibrated_strain:
         warn(check(Scene._trusted(*parts), q, strain))
     return Solution._scalar_flow_controlled(parts, chosen[0], _scalar_state(q, drop, strain, v), chosen[1])
 
