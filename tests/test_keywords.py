@@ -105,3 +105,59 @@ def test_signatures_pickling_and_values_are_unchanged():
     assert type(back) is KeywordError and str(back) == str(error) and back.suggestion == "flow_rate"
     other = pickle.loads(pickle.dumps(InvalidParameterError("x", "(0, inf)", -1.0)))
     assert other.parameter == "x" and str(other) == "x must be in (0, inf) (got -1.0)"
+
+
+def _model_classes():
+    from tubefsi.network import Network as _Network
+    return [walls[n] for n in walls] + [rheologies[n] for n in rheologies] + [couplers[n] for n in couplers] + [
+        Tube, _Network]
+
+
+def test_the_check_is_inside_init_with_attrs_own_code():
+    """Every model, coupler and tube class has a checked ``__init__``; where attrs generated it,
+    the checked one is attrs' own code compiled again (no frame in between, no ``__call__`` on
+    the metaclass), and it builds what attrs' original builds, for every example parameter set."""
+    from tubefsi._keywords import KeywordChecked
+    assert "__call__" not in vars(KeywordChecked)
+    for cls in _model_classes():
+        init = cls.__init__
+        assert init._keyword_checked, cls
+        original = init.__globals__.get("_tubefsi_init")
+        if cls.__name__ != "Network":
+            assert original is not None and original.__code__.co_filename.startswith("<attrs generated"), cls
+            assert inspect.signature(init) == inspect.signature(original)
+        for kwargs in getattr(cls, "_examples", ()):
+            by_attrs = object.__new__(cls)
+            original(by_attrs, **kwargs)
+            assert cls(**kwargs) == by_attrs
+
+
+@pytest.mark.parametrize("slots", [True, False])
+def test_a_plugin_class_in_every_form_gets_the_check(slots):
+    """attrs classes with and without slots, positional fields, and a hand-written ``__init__``."""
+    @attrs.frozen(kw_only=False, slots=slots)
+    class Positional(ThinLinear):
+        extra: float = positive(doc="a plugin's own parameter", default=1.0)
+
+    # (the base's fields are keyword-only; the plugin's own field is positional)
+    made = Positional(2.0, youngs_modulus=1e4, poisson_ratio=0.3)
+    assert (made.youngs_modulus, made.poisson_ratio, made.extra) == (1e4, 0.3, 2.0)
+    assert Positional(youngs_modulus=1e4, poisson_ratio=0.3) == Positional(1.0, youngs_modulus=1e4, poisson_ratio=0.3)
+    with pytest.raises(KeywordError, match="did you mean 'extra'"):
+        Positional(youngs_modulus=1e4, poisson_ratio=0.3, extr=2.0)
+    with pytest.raises(KeywordError, match="missing required keyword 'poisson_ratio'"):
+        Positional(2.0, youngs_modulus=1e4)
+    with pytest.raises(KeywordError, match="takes 1 positional arguments but 2 were given"):
+        Positional(2.0, 3.0, youngs_modulus=1e4, poisson_ratio=0.3)
+    with pytest.raises(KeywordError, match="both by position and by keyword"):
+        Positional(2.0, extra=3.0, youngs_modulus=1e4, poisson_ratio=0.3)
+    with pytest.raises(InvalidParameterError, match="extra"):
+        Positional(-1.0, youngs_modulus=1e4, poisson_ratio=0.3)
+
+    class Handwritten(ThinLinear):
+        def __init__(self, *, stiffness):
+            super().__init__(youngs_modulus=stiffness, poisson_ratio=0.3)
+
+    assert Handwritten(stiffness=2e4).youngs_modulus == 2e4
+    with pytest.raises(KeywordError, match="did you mean 'stiffness'"):
+        Handwritten(stifness=2e4)

@@ -5,8 +5,9 @@ Python binds a call's arguments before the callee runs, and a keyword it cannot 
 and tube class (the metaclasses :class:`KeywordChecked` and :class:`KeywordCheckedABC`, which
 the base classes use, so plugins' models get it too) catch that ``TypeError``, and only when the
 arguments do not bind to the signature replace it by a :class:`~tubefsi.KeywordError` that names
-the keyword, suggests the closest valid one and lists the valid ones. The success path costs one
-Python call frame; the signature is read only on the error path.
+the keyword, suggests the closest valid one and lists the valid ones. The success path of a
+function costs one Python call frame, that of an attrs model none (its ``__init__`` checks the
+arguments itself, :func:`_check_init`); the signature is read only on the error path.
 """
 
 from __future__ import annotations
@@ -95,20 +96,118 @@ def checked_keywords(function, recover=None):
     return wrapper
 
 
+class _Missing:
+    """The default the checked ``__init__`` gives a required parameter (so that a missing one is
+    seen inside the call instead of by Python's binding, which no frame could catch)."""
+
+    __slots__ = ()
+
+    def __repr__(self):
+        return "<missing>"
+
+
+_MISSING = _Missing()
+
+
+def _reject(instance, original, args, kwargs, named):
+    """Raise the :class:`~tubefsi.KeywordError` of a construction whose arguments do not bind to
+    ``original`` (the ``__init__`` as written or generated), from what the checked ``__init__`` got."""
+    given = {k: v for k, v in named.items() if v is not _MISSING}       # (all keyword-only)
+    error = keyword_error(original, (instance,) + args, {**given, **kwargs}, name=f"{type(instance).__name__}()")
+    if error is None:                     # (not reached: the checked __init__ calls this only on a miss)
+        raise TypeError(f"{type(instance).__name__}() got arguments that do not bind to its signature")
+    raise error
+
+
+def _checked_source(init):
+    """The source of an attrs-generated ``__init__`` with the keyword check inside it, or None
+    where it is not such a function of keyword-only parameters (a closure, a positional field:
+    Python itself would reject a field given both ways before any code of ours ran).
+
+    Every required parameter gets the default :data:`_MISSING` and the function ``*args`` and
+    ``**kwargs``, so that every call binds; its first statement rejects a call with positional
+    arguments, an unknown keyword or a missing one. The rest is attrs' code, unchanged."""
+    import ast
+    import inspect
+    import textwrap
+
+    code = init.__code__
+    if code.co_freevars or not code.co_filename.startswith("<attrs generated"):
+        return None
+    try:
+        tree = ast.parse(textwrap.dedent(inspect.getsource(init)))
+    except (OSError, SyntaxError, TypeError):
+        return None
+    fn = tree.body[0]
+    if not isinstance(fn, ast.FunctionDef):
+        return None
+    a = fn.args
+    if a.vararg or a.kwarg or a.posonlyargs or len(a.args) != 1:
+        return None
+    required = [p.arg for p, d in zip(a.kwonlyargs, a.kw_defaults) if d is None]
+    a.kw_defaults = [ast.Name("_tubefsi_missing", ast.Load()) if d is None else d for d in a.kw_defaults]
+    a.vararg, a.kwarg = ast.arg("_tubefsi_args"), ast.arg("_tubefsi_kwargs")
+    test = " or ".join(["_tubefsi_args", "_tubefsi_kwargs"] + [f"{n} is _tubefsi_missing" for n in required])
+    named = ", ".join(f"{p.arg!r}: {p.arg}" for p in a.kwonlyargs)
+    fn.body = ast.parse(f"if {test}:\n    _tubefsi_reject({a.args[0].arg}, _tubefsi_init, _tubefsi_args, "
+                        f"_tubefsi_kwargs, {{{named}}})").body + fn.body
+    return ast.unparse(ast.fix_missing_locations(tree)) + "\n"
+
+
+def _check_init(cls) -> None:
+    """Give ``cls`` an ``__init__`` that raises :class:`~tubefsi.KeywordError` for arguments that do
+    not bind, if its own ``__init__`` (in its ``__dict__``) is not one yet.
+
+    An attrs-generated ``__init__`` is compiled again with the check as its first statement
+    (:func:`_checked_source`: no frame more than attrs' own, so that building a model in a loop
+    costs what attrs costs); any other one is wrapped (one frame more). The signature shown is
+    the original's."""
+    import inspect
+    import linecache
+
+    init = cls.__dict__.get("__init__")
+    if init is None or getattr(init, "_keyword_checked", False) or not inspect.isfunction(init):
+        return
+    source = _checked_source(init)
+    if source is not None:
+        filename = f"{init.__code__.co_filename[:-1]}, keyword-checked>"
+        namespace = dict(init.__globals__, _tubefsi_missing=_MISSING, _tubefsi_reject=_reject, _tubefsi_init=init)
+        exec(compile(source, filename, "exec"), namespace)     # noqa: S102 (attrs' own code, rewritten)
+        linecache.cache[filename] = (len(source), None, source.splitlines(True), filename)   # for tracebacks
+        checked = namespace[init.__name__]
+        checked.__qualname__, checked.__module__, checked.__doc__ = init.__qualname__, init.__module__, init.__doc__
+        checked.__annotations__ = dict(init.__annotations__)
+    else:
+        @functools.wraps(init)
+        def checked(self, *args, **kwargs):
+            try:
+                init(self, *args, **kwargs)
+            except TypeError:
+                error = keyword_error(init, (self,) + args, kwargs, name=f"{type(self).__name__}()")
+                if error is None:
+                    raise
+                raise error from None
+    checked.__signature__ = inspect.signature(init)
+    checked._keyword_checked = True
+    type.__setattr__(cls, "__init__", checked)
+
+
 class KeywordChecked(type):
     """Metaclass: constructing the class with arguments that do not bind to its ``__init__``
-    raises :class:`~tubefsi.KeywordError`."""
+    raises :class:`~tubefsi.KeywordError`.
 
-    def __call__(cls, *args, **kwargs):
-        try:
-            return type.__call__(cls, *args, **kwargs)     # (no metaclass in between overrides it)
-        except TypeError:
-            # the signature of __init__ (the metaclass's own __call__ takes anything)
-            error = keyword_error(cls.__init__, (cls,) + args, kwargs, name=f"{cls.__name__}()")
-            if error is None:
-                raise
-        raise error
+    The check is inside ``__init__`` itself (:func:`_check_init`, applied to every class made
+    with this metaclass, and again once attrs has added its ``__init__``), not in a ``__call__``
+    of the metaclass: that frame and its re-packing of the arguments were a third of the cost
+    of building a model."""
 
+    def __init__(cls, name, bases, namespace, **kwargs):
+        super().__init__(name, bases, namespace, **kwargs)
+        _check_init(cls)          # a slotted attrs class is made with its __init__, a plain one may have its own
+
+    def __attrs_init_subclass__(cls):
+        # attrs calls this once it has finished the class (a dict class gets its __init__ only then)
+        _check_init(cls)
 
     @property
     def __signature__(cls):
