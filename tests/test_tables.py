@@ -369,8 +369,15 @@ def test_a_scalar_path_solution_is_a_whole_solution():
     wall = walls["thick-neo-hookean"](shear_modulus=2e3)
     tubefsi.solve(FLUID, wall, TUBE, flow_rate=np.geomspace(1e-12, 1e-9, 100))     # builds the table
     fast = solve_module._scalar_flow(FLUID, wall, TUBE, 1e-9)
-    assert fast is not None and "scene" not in vars(fast)
+    assert fast is not None and "scene" not in vars(fast) and "state" not in vars(fast)
+    drop, q = fast.pressure_drop, fast.flow_rate
+    assert type(drop) is float and q == 1e-9 and "state" not in vars(fast)     # read without a State
+    unbuilt = pickle.loads(pickle.dumps(fast))
     general = tubefsi.solve(FLUID, wall, TUBE, flow_rate=1e-9, on_infeasible="nan")
+    assert type(fast.state) is type(general.state) and fast.state.pressure_drop == drop
+    for name in ("flow_rate", "pressure_drop", "inlet_strain", "log_stretch"):
+        assert getattr(fast.state, name) == pytest.approx(getattr(general.state, name), rel=1e-13)
+    assert unbuilt.state == fast.state and unbuilt.pressure_drop == drop
     assert fast.scene == general.scene and fast.tube is TUBE and fast.wall is wall
     assert fast.pressure_drop == pytest.approx(general.pressure_drop, rel=1e-13)
     back = pickle.loads(pickle.dumps(fast))

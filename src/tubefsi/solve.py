@@ -29,7 +29,7 @@ from .couplers.separated import _TABLES, SeparatedVariables, curve_span
 from .geometry import Tube
 from .rheology.base import Rheology
 from .rheology.power_law import FactorRangeError
-from .scene import Scene, State, _log_max_stretch, _resolve, _scalar_state, make_scene
+from .scene import Scene, State, _log_max_stretch, _resolve, make_scene
 from .solution import Solution
 from .validity import SLENDERNESS, check, warn
 from .walls.base import WallModel
@@ -440,7 +440,7 @@ def _scalar_flow(rheology, wall, tube, q):
     parts = (rheology, wall, tube, log_stretch_max)
     if plan.radius * (1.0 + strain) > SLENDERNESS * plan.length or strain > wall.calibrated_strain:
         warn(check(Scene._trusted(*parts), q, strain))
-    return Solution._scalar_flow_controlled(parts, chosen[0], _scalar_state(q, drop, strain, v), chosen[1])
+    return Solution._scalar_flow_controlled(parts, chosen[0], (q, drop, strain, v), chosen[1])
 
 
 def _curve_flow(rheology, wall, tube, flow_rate):
