@@ -6,6 +6,8 @@ import pickle
 
 import attrs
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import tubefsi
 from tubefsi import InvalidParameterError, KeywordError, Network, Tube, advise, fit, max_flow_rate, solve
@@ -161,3 +163,33 @@ def test_a_plugin_class_in_every_form_gets_the_check(slots):
     assert Handwritten(stiffness=2e4).youngs_modulus == 2e4
     with pytest.raises(KeywordError, match="did you mean 'stiffness'"):
         Handwritten(stifness=2e4)
+
+
+@settings(deadline=None, max_examples=60)
+@given(st.lists(st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.sampled_from([0.0, -0.0, 1.0, 90.0]),
+                          st.integers(-3, 3), st.sampled_from(["thin", "thick", "reference", "current", "other"])),
+                min_size=6, max_size=6))
+def test_the_checked_init_accepts_and_rejects_as_attrs_does(values):
+    """The checked ``__init__`` (with its store of in-range floats) against attrs' original on
+    the same arguments: equal models, or the same error with the same message."""
+    for cls in _model_classes()[:-1]:
+        if getattr(cls, "__abstractmethods__", None):
+            continue
+        names = [a.alias for a in attrs.fields(cls) if a.init]
+        if not names or len(names) > len(values):
+            continue
+        kwargs = dict(zip(names, values))
+        original = cls.__init__.__globals__["_tubefsi_init"]
+        by_attrs = object.__new__(cls)
+        try:
+            original(by_attrs, **kwargs)
+        except Exception as error:            # noqa: BLE001 (compared below)
+            expected = error
+        else:
+            expected = None
+        if expected is None:
+            assert cls(**kwargs) == by_attrs, (cls, kwargs)
+        else:
+            with pytest.raises(type(expected)) as info:
+                cls(**kwargs)
+            assert str(info.value) == str(expected), (cls, kwargs)

@@ -119,14 +119,71 @@ def _reject(instance, original, args, kwargs, named):
     raise error
 
 
-def _checked_source(init):
+def _float_guard(name, attribute, namespace):
+    """The test under which ``attribute``'s converter and validator would pass the value of the
+    parameter ``name`` through unchanged (a float in its interval, a str among its options;
+    True for a field with neither), with its bounds put into ``namespace``; None if unknown."""
+    converter = getattr(attribute.converter, "converter", attribute.converter)     # (an attrs.Converter)
+    validator = attribute.validator
+    if converter is not None and not getattr(converter, "passes_floats", False):
+        return None
+    interval = getattr(validator, "float_interval", None)
+    if interval is not None:
+        low, high, low_open, high_open = interval
+        namespace[f"_tubefsi_low_{name}"], namespace[f"_tubefsi_high_{name}"] = low, high
+        return (f"type({name}) is float and _tubefsi_low_{name} {'<' if low_open else '<='} {name} "
+                f"{'<' if high_open else '<='} _tubefsi_high_{name}")
+    options = getattr(validator, "string_options", None)
+    if options is not None and converter is None:
+        namespace[f"_tubefsi_options_{name}"] = tuple(options)
+        return f"type({name}) is str and {name} in _tubefsi_options_{name}"
+    if validator is None:
+        return f"type({name}) is float" if converter is not None else "True"
+    return None
+
+
+def _fast_block(fn, attributes, namespace):
+    """Statements that store every field at once where each value is one its converter returns
+    unchanged and its validator accepts (:func:`_float_guard`), then return; [] where some field
+    is beyond that (another converter or validator, a factory default, ``__attrs_pre_init__``).
+
+    attrs converts every field, then validates every one; for such values both are identities,
+    so storing them is what attrs' code does, without its four calls per field."""
+    import ast
+
+    import attrs
+
+    self_name = fn.args.args[0].arg
+    hooks = {node.attr for node in ast.walk(fn) if isinstance(node, ast.Attribute)
+             and isinstance(node.value, ast.Name) and node.value.id == self_name}
+    if "__attrs_pre_init__" in hooks or not attributes:
+        return []
+    guards, stores = [], []
+    for attribute in attributes:
+        if not attribute.init or isinstance(attribute.default, attrs.Factory):
+            return []
+        guard = _float_guard(attribute.alias, attribute, namespace)
+        if guard is None:
+            return []
+        guards.append(guard)
+        stores.append(f"    _tubefsi_set({self_name}, {attribute.name!r}, {attribute.alias})")
+    if "__attrs_post_init__" in hooks:
+        stores.append(f"    {self_name}.__attrs_post_init__()")
+    namespace["_tubefsi_set"] = object.__setattr__
+    return ast.parse(f"if {' and '.join(guards)}:\n" + "\n".join(stores) + "\n    return").body
+
+
+def _checked_source(init, attributes=(), namespace=None):
     """The source of an attrs-generated ``__init__`` with the keyword check inside it, or None
     where it is not such a function of keyword-only parameters (a closure, a positional field:
     Python itself would reject a field given both ways before any code of ours ran).
 
     Every required parameter gets the default :data:`_MISSING` and the function ``*args`` and
     ``**kwargs``, so that every call binds; its first statement rejects a call with positional
-    arguments, an unknown keyword or a missing one. The rest is attrs' code, unchanged."""
+    arguments, an unknown keyword or a missing one. With the class's ``attributes`` (attrs'
+    fields) the next one stores values that need no conversion or check beyond its test
+    (:func:`_fast_block`, whose constants go into ``namespace``). The rest is attrs' code,
+    unchanged."""
     import ast
     import inspect
     import textwrap
@@ -149,8 +206,9 @@ def _checked_source(init):
     a.vararg, a.kwarg = ast.arg("_tubefsi_args"), ast.arg("_tubefsi_kwargs")
     test = " or ".join(["_tubefsi_args", "_tubefsi_kwargs"] + [f"{n} is _tubefsi_missing" for n in required])
     named = ", ".join(f"{p.arg!r}: {p.arg}" for p in a.kwonlyargs)
+    fast = _fast_block(fn, attributes, {} if namespace is None else namespace)
     fn.body = ast.parse(f"if {test}:\n    _tubefsi_reject({a.args[0].arg}, _tubefsi_init, _tubefsi_args, "
-                        f"_tubefsi_kwargs, {{{named}}})").body + fn.body
+                        f"_tubefsi_kwargs, {{{named}}})").body + fast + fn.body
     return ast.unparse(ast.fix_missing_locations(tree)) + "\n"
 
 
@@ -158,20 +216,20 @@ def _check_init(cls) -> None:
     """Give ``cls`` an ``__init__`` that raises :class:`~tubefsi.KeywordError` for arguments that do
     not bind, if its own ``__init__`` (in its ``__dict__``) is not one yet.
 
-    An attrs-generated ``__init__`` is compiled again with the check as its first statement
-    (:func:`_checked_source`: no frame more than attrs' own, so that building a model in a loop
-    costs what attrs costs); any other one is wrapped (one frame more). The signature shown is
-    the original's."""
+    An attrs-generated ``__init__`` is compiled again with the check as its first statement and
+    a store of plain in-range floats as its second (:func:`_checked_source`: no frame more than
+    attrs' own, and none for the converters and validators of a model built in a loop from
+    floats); any other one is wrapped (one frame more). The signature shown is the original's."""
     import inspect
     import linecache
 
     init = cls.__dict__.get("__init__")
     if init is None or getattr(init, "_keyword_checked", False) or not inspect.isfunction(init):
         return
-    source = _checked_source(init)
+    namespace = dict(init.__globals__, _tubefsi_missing=_MISSING, _tubefsi_reject=_reject, _tubefsi_init=init)
+    source = _checked_source(init, getattr(cls, "__attrs_attrs__", ()), namespace)
     if source is not None:
         filename = f"{init.__code__.co_filename[:-1]}, keyword-checked>"
-        namespace = dict(init.__globals__, _tubefsi_missing=_MISSING, _tubefsi_reject=_reject, _tubefsi_init=init)
         exec(compile(source, filename, "exec"), namespace)     # noqa: S102 (attrs' own code, rewritten)
         linecache.cache[filename] = (len(source), None, source.splitlines(True), filename)   # for tracebacks
         checked = namespace[init.__name__]
