@@ -193,3 +193,62 @@ def test_the_checked_init_accepts_and_rejects_as_attrs_does(values):
             with pytest.raises(type(expected)) as info:
                 cls(**kwargs)
             assert str(info.value) == str(expected), (cls, kwargs)
+
+
+def test_the_check_holds_for_every_way_a_plugin_class_gets_its_init():
+    """A cached hash, a dict class whose base has its own ``__attrs_init_subclass__``, a
+    dataclass, a class's own ``__setattr__`` (which attrs' code goes through: the fast store must
+    not bypass it), and the name a hand-written ``__init__``'s bad ``super().__init__`` call gets."""
+    import dataclasses
+
+    from tubefsi.couplers.base import Coupler
+
+    @attrs.frozen(kw_only=True, cache_hash=True)
+    class Hashed(ThinLinear):
+        pass
+
+    assert hash(Hashed(youngs_modulus=1e4, poisson_ratio=0.3)) == hash(Hashed(youngs_modulus=1e4, poisson_ratio=0.3))
+
+    @attrs.frozen(kw_only=True, slots=False)
+    class Registering(ThinLinear):
+        @classmethod
+        def __attrs_init_subclass__(cls):        # a plugin's own registration hook
+            pass
+
+    @attrs.frozen(kw_only=True, slots=False)
+    class Child(Registering):
+        extra: float = positive(default=1.0)
+
+    with pytest.raises(KeywordError, match="did you mean 'extra'"):
+        Child(youngs_modulus=1e4, poisson_ratio=0.3, extr=2.0)
+
+    @dataclasses.dataclass(frozen=True, kw_only=True)
+    class DataCoupler(Coupler):
+        tolerance: float = 1e-6
+
+    DataCoupler.__abstractmethods__ = frozenset()      # (its methods do not matter here)
+    assert DataCoupler(tolerance=1e-3).tolerance == 1e-3
+    with pytest.raises(KeywordError, match="did you mean 'tolerance'"):
+        DataCoupler(tolerence=1e-8)
+
+    seen = []
+
+    @attrs.define(kw_only=True, on_setattr=attrs.setters.NO_OP)
+    class Watched(Coupler):
+        tol: float = positive(default=1e-6)
+
+        def __setattr__(self, name, value):
+            seen.append(name)
+            object.__setattr__(self, name, value)
+
+    Watched.__abstractmethods__ = frozenset()
+    Watched(tol=1e-3)
+    Watched(tol=1)
+    assert seen == ["tol", "tol"]
+
+    class Handwritten(ThinLinear):
+        def __init__(self, *, stiffness):
+            super().__init__(youngs_modulus=stiffness, poisson_ratio=0.3, stifness=1.0)
+
+    with pytest.raises(KeywordError, match=r"^ThinLinear\(\) got an unexpected keyword 'stifness'"):
+        Handwritten(stiffness=2e4)

@@ -389,10 +389,10 @@ def test_a_scalar_path_solution_is_a_whole_solution():
 
 
 def test_the_scalar_plan_gives_the_bits_of_a_fresh_one():
-    """The scalar path keeps what it read off the last rheology and tube (solve._Plan): a loop
-    that changes the fluid, the tube, the wall and the flow rate in every pattern gets, call by
-    call, the bits a fresh plan gives, and the general path's answer to 1e-13; two threads that
-    share the plan get their own answers."""
+    """The scalar path keeps what it read off the last rheology and tube (solve._LAST_PLAN) and
+    the last flow factor (solve._LAST_FLOW): a loop that changes the fluid, the tube, the wall
+    and the flow rate in every pattern gets, call by call, the bits a fresh plan gives, and the
+    general path's answer to 1e-13; two threads that share the plan get their own answers."""
     import threading
     solve_module = importlib.import_module("tubefsi.solve")
     fluids = [FLUID, rheologies["power-law"](consistency=0.02, index=0.9)]
@@ -409,7 +409,7 @@ def test_the_scalar_plan_gives_the_bits_of_a_fresh_one():
         out = []
         for fluid, tube, mu, q in calls:
             if fresh:
-                solve_module._LAST_PLAN[0] = None
+                solve_module._LAST_PLAN[0], solve_module._LAST_FLOW[0] = (None, None), (None, None, None)
             sol = solve_module._scalar_flow(fluid, walls["thick-neo-hookean"](shear_modulus=mu), tube, q)
             out.append((sol.pressure_drop, sol.inlet_displacement))
         return out
@@ -432,6 +432,6 @@ def test_the_scalar_plan_gives_the_bits_of_a_fresh_one():
     for t in threads:
         t.join()
     for q, got in answers.items():
-        solve_module._LAST_PLAN[0] = None
+        solve_module._LAST_PLAN[0], solve_module._LAST_FLOW[0] = (None, None), (None, None, None)
         alone = solve_module._scalar_flow(FLUID, walls["thick-neo-hookean"](shear_modulus=2e3), TUBE, q).pressure_drop
         assert set(got) == {alone}

@@ -113,7 +113,12 @@ def _reject(instance, original, args, kwargs, named):
     """Raise the :class:`~tubefsi.KeywordError` of a construction whose arguments do not bind to
     ``original`` (the ``__init__`` as written or generated), from what the checked ``__init__`` got."""
     given = {k: v for k, v in named.items() if v is not _MISSING}       # (all keyword-only)
-    error = keyword_error(original, (instance,) + args, {**given, **kwargs}, name=f"{type(instance).__name__}()")
+    called = type(instance)
+    # the class called, where this is its __init__; else the class that owns it (a subclass's own
+    # __init__ called it: the keywords listed are this one's)
+    owner = called.__name__ if getattr(called.__init__, "__globals__", {}).get("_tubefsi_init") is original \
+        else original.__qualname__.rpartition(".")[0] or called.__name__
+    error = keyword_error(original, (instance,) + args, {**given, **kwargs}, name=f"{owner}()")
     if error is None:                     # (not reached: the checked __init__ calls this only on a miss)
         raise TypeError(f"{type(instance).__name__}() got arguments that do not bind to its signature")
     raise error
@@ -142,10 +147,43 @@ def _float_guard(name, attribute, namespace):
     return None
 
 
+def _only_stores(fn, names) -> bool:
+    """Whether attrs' ``__init__`` body ``fn`` does nothing but what :func:`_fast_block` repeats:
+    ``_setattr = _cached_setattr_get(self)``, ``_setattr(name, ...)`` for the fields ``names``
+    (each once), the validators under ``if _config._run_validators is True`` and
+    ``self.__attrs_post_init__()``. Anything else (a cached hash reset, ``self.x = ...`` through
+    a class's own ``__setattr__``, ``__attrs_pre_init__``) and the fast block is not made."""
+    import ast
+
+    self_name = fn.args.args[0].arg
+    stored = []
+    for statement in fn.body:
+        if (isinstance(statement, ast.Assign) and len(statement.targets) == 1
+                and isinstance(statement.targets[0], ast.Name) and statement.targets[0].id == "_setattr"):
+            continue
+        call = statement.value if isinstance(statement, ast.Expr) and isinstance(statement.value, ast.Call) else None
+        if call is not None and isinstance(call.func, ast.Name) and call.func.id == "_setattr" and call.args \
+                and isinstance(call.args[0], ast.Constant):
+            stored.append(call.args[0].value)
+            continue
+        if (call is not None and isinstance(call.func, ast.Attribute) and call.func.attr == "__attrs_post_init__"
+                and isinstance(call.func.value, ast.Name) and call.func.value.id == self_name and not call.args):
+            continue
+        if (isinstance(statement, ast.If) and not statement.orelse
+                and ast.unparse(statement.test) == "_config._run_validators is True"
+                and all(isinstance(inner, ast.Expr) and isinstance(inner.value, ast.Call)
+                        and isinstance(inner.value.func, ast.Name)
+                        and inner.value.func.id.startswith("__attr_validator_") for inner in statement.body)):
+            continue
+        return False
+    return sorted(stored) == sorted(names)
+
+
 def _fast_block(fn, attributes, namespace):
     """Statements that store every field at once where each value is one its converter returns
     unchanged and its validator accepts (:func:`_float_guard`), then return; [] where some field
-    is beyond that (another converter or validator, a factory default, ``__attrs_pre_init__``).
+    is beyond that (another converter or validator, a factory default) or attrs' code does more
+    than store, validate and call ``__attrs_post_init__`` (:func:`_only_stores`).
 
     attrs converts every field, then validates every one; for such values both are identities,
     so storing them is what attrs' code does, without its four calls per field."""
@@ -153,11 +191,9 @@ def _fast_block(fn, attributes, namespace):
 
     import attrs
 
-    self_name = fn.args.args[0].arg
-    hooks = {node.attr for node in ast.walk(fn) if isinstance(node, ast.Attribute)
-             and isinstance(node.value, ast.Name) and node.value.id == self_name}
-    if "__attrs_pre_init__" in hooks or not attributes:
+    if not attributes or not _only_stores(fn, [a.name for a in attributes]):
         return []
+    self_name = fn.args.args[0].arg
     guards, stores = [], []
     for attribute in attributes:
         if not attribute.init or isinstance(attribute.default, attrs.Factory):
@@ -167,7 +203,7 @@ def _fast_block(fn, attributes, namespace):
             return []
         guards.append(guard)
         stores.append(f"    _tubefsi_set({self_name}, {attribute.name!r}, {attribute.alias})")
-    if "__attrs_post_init__" in hooks:
+    if any(isinstance(node, ast.Attribute) and node.attr == "__attrs_post_init__" for node in ast.walk(fn)):
         stores.append(f"    {self_name}.__attrs_post_init__()")
     namespace["_tubefsi_set"] = object.__setattr__
     return ast.parse(f"if {' and '.join(guards)}:\n" + "\n".join(stores) + "\n    return").body
@@ -229,6 +265,8 @@ def _check_init(cls) -> None:
     namespace = dict(init.__globals__, _tubefsi_missing=_MISSING, _tubefsi_reject=_reject, _tubefsi_init=init)
     source = _checked_source(init, getattr(cls, "__attrs_attrs__", ()), namespace)
     if source is not None:
+        source = ("# attrs' __init__ with the keyword check of tubefsi._keywords (_check_init) first\n"
+                  + source)
         filename = f"{init.__code__.co_filename[:-1]}, keyword-checked>"
         exec(compile(source, filename, "exec"), namespace)     # noqa: S102 (attrs' own code, rewritten)
         linecache.cache[filename] = (len(source), None, source.splitlines(True), filename)   # for tracebacks
@@ -255,7 +293,7 @@ class KeywordChecked(type):
     raises :class:`~tubefsi.KeywordError`.
 
     The check is inside ``__init__`` itself (:func:`_check_init`, applied to every class made
-    with this metaclass, and again once attrs has added its ``__init__``), not in a ``__call__``
+    with this metaclass and to every ``__init__`` set on it later), not in a ``__call__``
     of the metaclass: that frame and its re-packing of the arguments were a third of the cost
     of building a model."""
 
@@ -263,9 +301,11 @@ class KeywordChecked(type):
         super().__init__(name, bases, namespace, **kwargs)
         _check_init(cls)          # a slotted attrs class is made with its __init__, a plain one may have its own
 
-    def __attrs_init_subclass__(cls):
-        # attrs calls this once it has finished the class (a dict class gets its __init__ only then)
-        _check_init(cls)
+    def __setattr__(cls, name, value):
+        # an __init__ set on the finished class: attrs' for a dict class, a dataclass's, a user's
+        super().__setattr__(name, value)
+        if name == "__init__":
+            _check_init(cls)
 
     @property
     def __signature__(cls):

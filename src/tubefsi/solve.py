@@ -348,40 +348,30 @@ _INF = math.inf
 _COUPLERS = registry.couplers
 
 
-class _Plan:
-    """What the scalar path reads off one rheology and one tube, checked once for the pair and
-    reused while the next call brings the same two objects (a Monte Carlo loop over a wall's
-    parameters): both are immutable, so what was read off them stands. ``flow`` is the last
-    ``(q, L phi(q))``, one tuple so that a thread never sees half of another's."""
-
-    __slots__ = ("rheology", "tube", "radius_exponent", "radius", "reduced_thickness", "length",
-                 "radius_power", "flow")
-
-    def __init__(self, rheology, tube):
-        self.rheology, self.tube = rheology, tube
-        self.radius_exponent = rheology.radius_exponent
-        self.radius, self.length = tube.radius, tube.length
-        self.reduced_thickness = tube.thickness / tube.radius
-        self.radius_power = self.radius**self.radius_exponent
-        self.flow = (None, None)
-
-
-#: The scalar path's last plan (None, or one that applies to the last call's rheology and tube).
-_LAST_PLAN: list = [None]
+#: The scalar path's plan of the last rheology and tube it saw: ``(rheology, tube, radius
+#: exponent k, radius a, t/a, length L, a^k)``, read off the two objects once and reused while
+#: the next call brings the same two (a Monte Carlo loop over a wall's parameters); both are
+#: immutable, so what was read off them stands. A tuple: a loop that changes the fluid or the
+#: tube every call pays one tuple for it. (None, None, ...) before the first call.
+_LAST_PLAN: list = [(None, None)]
+#: The last ``(rheology, q, phi(q))`` of the scalar path (one tuple: a thread never sees half
+#: of another's).
+_LAST_FLOW: list = [(None, None, None)]
 
 
 def _plan(rheology, tube):
-    """A :class:`_Plan` of ``rheology`` and ``tube`` for the scalar path, or None where it does
-    not apply (a tube's field or the radius exponent not a float, a non-separable rheology)."""
+    """The scalar path's plan (:data:`_LAST_PLAN`) of ``rheology`` and ``tube``, stored, or None
+    where the path does not apply (a field or the radius exponent not a float, a non-separable
+    rheology, a^k beyond the doubles: the general path says so)."""
     if not rheology.separable:
         return None
     k = rheology.radius_exponent
-    if (type(k) is not float or type(tube.radius) is not float or type(tube.thickness) is not float
-            or type(tube.length) is not float):
+    a, t, length = tube.radius, tube.thickness, tube.length
+    if type(k) is not float or type(a) is not float or type(t) is not float or type(length) is not float:
         return None
     try:
-        plan = _Plan(rheology, tube)
-    except OverflowError:                      # a^k beyond the doubles: the general path says so
+        plan = (rheology, tube, k, a, t / a, length, a**k)
+    except OverflowError:
         return None
     _LAST_PLAN[0] = plan
     return plan
@@ -399,12 +389,13 @@ def _scalar_flow(rheology, wall, tube, q):
     if chosen is False or wall.is_rigid or wall._installed_tube(tube) is not tube:
         return None                            # (False: not a pair of models)
     plan = _LAST_PLAN[0]
-    if plan is None or plan.rheology is not rheology or plan.tube is not tube:
+    if plan[0] is not rheology or plan[1] is not tube:
         plan = _plan(rheology, tube)
         if plan is None:
             return None
+    _, _, k, a, tb, length, radius_power = plan
     try:
-        table = _TABLES.get((type(wall), wall._shape_key(), plan.reduced_thickness, plan.radius_exponent))
+        table = _TABLES.get((type(wall), wall._shape_key(), tb, k))
     except TypeError:                          # an array parameter in the wall's shape
         return None
     if not table:
@@ -412,17 +403,18 @@ def _scalar_flow(rheology, wall, tube, q):
     scale = wall._pressure_scale()
     if type(scale) is not float:
         return None
-    last_q, length_factor = plan.flow
-    if q != last_q:
+    flow = _LAST_FLOW[0]
+    if flow[0] is rheology and flow[1] == q:
+        phi = flow[2]
+    else:
         phi = rheology._flow_factor(q)
         if type(phi) is not float:
             return None
-        length_factor = plan.length * phi
-        plan.flow = (q, length_factor)
-    norm = plan.radius_power * scale
+        _LAST_FLOW[0] = (rheology, q, phi)
+    norm = radius_power * scale
     if not 2.2250738585072014e-308 <= norm < _INF:     # a power law of a large index: the general path
         return None
-    x = math.log(length_factor / norm)
+    x = math.log(length * phi / norm)
     if not table.x_lo <= x <= table.x_hi:
         return None
     pair = table.scalar_pair
@@ -436,9 +428,9 @@ def _scalar_flow(rheology, wall, tube, q):
     drop = scale * math.exp(log_rise)
     log_stretch_max = table.log_stretch_max
     if log_stretch_max is None:                # the key's (wall shape, t/a): the same for every scene of it
-        log_stretch_max = table.log_stretch_max = _log_max_stretch(wall, plan.reduced_thickness)
+        log_stretch_max = table.log_stretch_max = _log_max_stretch(wall, tb)
     parts = (rheology, wall, tube, log_stretch_max)
-    if plan.radius * (1.0 + strain) > SLENDERNESS * plan.length or strain > wall.calibrated_strain:
+    if a * (1.0 + strain) > SLENDERNESS * length or strain > wall.calibrated_strain:
         warn(check(Scene._trusted(*parts), q, strain))
     return Solution._scalar_flow_controlled(parts, chosen[0], (q, drop, strain, v), chosen[1])
 
