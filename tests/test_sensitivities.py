@@ -185,6 +185,12 @@ def test_parameter_derivatives_match_differences(case):
         value = float(getattr(model, field))
         reference = _richardson(drop, value, H)
         np.testing.assert_allclose(sol.dpressure_drop_dparameter(name), reference, rtol=1e-8, err_msg=name)
+    # all of them in one pass (the fit's Jacobian): each one's own call, to the bit
+    together = sol._dpressure_drop_dparameters(names)
+    for name, value in zip(names, together):
+        assert np.array_equal(value, sol.dpressure_drop_dparameter(name)), name
+    scalar = tubefsi.solve(rheo, wall, TUBE, flow_rate=1e-9)
+    assert scalar._dpressure_drop_dparameters(names) == [scalar.dpressure_drop_dparameter(n) for n in names]
 
 
 def test_parameter_derivative_rejects_what_it_cannot_do():

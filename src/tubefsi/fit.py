@@ -153,14 +153,21 @@ def fit(flow_rate, pressure_drop, rheology, wall, tube, *, parameters, outlet_pr
             return np.zeros((q.size, theta.size))
         jac = np.empty((q.size, theta.size))
         values = natural(theta)
+        analytic = {}
+        if np.all(ok):
+            try:                               # every parameter in one pass over the points
+                analytic = dict(zip(names, sol._dpressure_drop_dparameters(names)))
+            except InvalidParameterError:      # some parameter has none: ask one by one
+                for name in names:
+                    try:
+                        analytic[name] = sol.dpressure_drop_dparameter(name)
+                    except InvalidParameterError:
+                        pass
         for j, name in enumerate(names):
             column = None
-            if np.all(ok):
-                try:
-                    column = np.asarray(sol.dpressure_drop_dparameter(name), dtype=float) / drop
-                    column = column * (values[j] if logs[j] else 1.0)
-                except InvalidParameterError:
-                    column = None
+            if name in analytic:
+                column = np.asarray(analytic[name], dtype=float) / drop
+                column = column * (values[j] if logs[j] else 1.0)
             if column is None or not np.all(np.isfinite(column)):
                 h = 1e-7 * max(1.0, abs(theta[j]))
                 shifted = theta.copy()

@@ -224,24 +224,33 @@ class Solution:
         :math:`(\Delta p - L G_{in})/\mu`. Other wall parameters raise
         ``InvalidParameterError`` (difference two solves). 0 where ``q = 0``.
         """
+        return self._dpressure_drop_dparameters((parameter,))[0]
+
+    def _dpressure_drop_dparameters(self, parameters):
+        """:meth:`dpressure_drop_dparameter` of each of ``parameters`` (a list of arrays or
+        floats), in one pass over the points: the chunks, their state and the inlet gradient are
+        shared (``tubefsi.fit``'s Jacobian asks for every fitted parameter at once)."""
         if self.scene.graded:
             raise InvalidParameterError("parameter", "a parameter of a uniform tube's solve (a graded tube: "
-                                        "difference two solves)", parameter)
-        owner, _, field = parameter.partition(".")
-        model = {"rheology": self.rheology, "wall": self.wall}.get(owner)
-        if model is None or not attrs.has(type(model)) or field not in attrs.fields_dict(type(model)):
-            raise InvalidParameterError("parameter", "'rheology.<field>' or 'wall.<field>' of the solved models",
-                                        parameter)
-        if owner == "wall" and not self._is_pressure_scale(field):
-            raise InvalidParameterError(
-                "parameter", "a rheology field, or the wall's modulus with an unloaded outlet (others: "
-                "difference two solves)", parameter)
+                                        "difference two solves)", parameters[0])
+        kinds = []
+        for parameter in parameters:
+            owner, _, field = parameter.partition(".")
+            model = {"rheology": self.rheology, "wall": self.wall}.get(owner)
+            if model is None or not attrs.has(type(model)) or field not in attrs.fields_dict(type(model)):
+                raise InvalidParameterError("parameter", "'rheology.<field>' or 'wall.<field>' of the solved models",
+                                            parameter)
+            if owner == "wall" and not self._is_pressure_scale(field):
+                raise InvalidParameterError(
+                    "parameter", "a rheology field, or the wall's modulus with an unloaded outlet (others: "
+                    "difference two solves)", parameter)
+            kinds.append((owner, field))
         shape = np.shape(self.state.flow_rate)
-        out = np.full(int(np.prod(shape, dtype=int)), np.nan)
+        out = np.full((len(kinds), int(np.prod(shape, dtype=int))), np.nan)
         fields, parts = self._parts(shape)
         for idx, chunk, sub in parts:
             q = np.asarray(sub.flow_rate)
-            value = np.zeros(idx.size)
+            value = np.zeros((len(kinds), idx.size))
             live = np.flatnonzero(q > 0)
             if live.size:
                 part = chunk if live.size == idx.size else chunk.take(live)
@@ -249,19 +258,20 @@ class Solution:
                 pts = part.at(np.arange(live.size))
                 r_in = pts.radius * (1.0 + state.inlet_strain)
                 g_in = pts.rheology._pressure_gradient(state.flow_rate, r_in)
-                if owner == "rheology" and field in type(pts.rheology)._gradient_scales:
-                    # G proportional to the field: d ln G / d theta = 1/theta all along the tube
-                    value[live] = g_in * pts.length / np.asarray(getattr(pts.rheology, field), dtype=float)
-                elif owner == "rheology":
-                    def weight(rheology, flow_rate, radius):
-                        return rheology._log_gradient_derivative(field, flow_rate, radius)
+                for j, (owner, field) in enumerate(kinds):
+                    if owner == "rheology" and field in type(pts.rheology)._gradient_scales:
+                        # G proportional to the field: d ln G / d theta = 1/theta all along the tube
+                        value[j, live] = g_in * pts.length / np.asarray(getattr(pts.rheology, field), dtype=float)
+                    elif owner == "rheology":
+                        def weight(rheology, flow_rate, radius, field=field):
+                            return rheology._log_gradient_derivative(field, flow_rate, radius)
 
-                    value[live] = g_in * self.coupler.length_integral(part, state, weight)
-                else:
-                    modulus = np.asarray(getattr(pts.wall, field), dtype=float)
-                    value[live] = (state.pressure_drop - pts.length * g_in) / modulus
-            out[idx] = value
-        return as_output(out.reshape(shape), self.scalar)
+                        value[j, live] = g_in * self.coupler.length_integral(part, state, weight)
+                    else:
+                        modulus = np.asarray(getattr(pts.wall, field), dtype=float)
+                        value[j, live] = (state.pressure_drop - pts.length * g_in) / modulus
+            out[:, idx] = value
+        return [as_output(row.reshape(shape), self.scalar) for row in out]
 
     def _is_pressure_scale(self, field) -> bool:
         """Whether the wall's tube law is proportional to ``field`` (and the outlet unloaded)."""
