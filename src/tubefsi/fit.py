@@ -13,6 +13,7 @@ errors come from the Gauss–Newton covariance :math:`s^2 (J^T J)^{-1}`,
 
 from __future__ import annotations
 
+import contextlib
 import math
 import warnings
 
@@ -21,6 +22,7 @@ import numpy as np
 from scipy import optimize
 
 from ._progress import bar
+from .couplers.separated import start_hint
 from .errors import InvalidParameterError, ModelValidityWarning, TubefsiError
 from ._keywords import checked_keywords
 from .scene import make_scene
@@ -125,10 +127,12 @@ def fit(flow_rate, pressure_drop, rheology, wall, tube, *, parameters, outlet_pr
             m = build(theta)
             # beyond the maximum flow rate the drop is continued by its supremum, the limit
             # pressure rise, so trial parameters with no steady state still steer the fit
+            previous = next(iter(cache.values()))[1].state.log_stretch if cache else None
             with warnings.catch_warnings():    # trial points: validity is the fitted model's business
                 warnings.simplefilter("ignore", ModelValidityWarning)
-                sol = solve(m["rheology"], m["wall"], tube, flow_rate=q, outlet_pressure=outlet_pressure,
-                            coupler=coupler, on_infeasible="nan")
+                with start_hint(q, previous) if previous is not None else contextlib.nullcontext():
+                    sol = solve(m["rheology"], m["wall"], tube, flow_rate=q, outlet_pressure=outlet_pressure,
+                                coupler=coupler, on_infeasible="nan")
             out = np.array(sol.pressure_drop, dtype=float)
             ok = np.isfinite(out)
             if not np.all(ok):

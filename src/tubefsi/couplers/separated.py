@@ -480,6 +480,10 @@ class SeparatedVariables(Coupler):
             with np.errstate(divide="ignore", invalid="ignore"):   # G(0, R) = 0: only where target = 0
                 slope0 = self._integrand_at_outlet(scene.at(index), target.shape, qflat)
                 guess = np.where(target > 0, np.minimum(target / slope0, 1.0), 0.0)
+        hint = _START_HINT.get()
+        if hint is not None and shared and q is not None and hint[0].shape == np.shape(q) and np.array_equal(hint[0], q):
+            ok_hint = (target > 0) & np.isfinite(hint[1]) & (hint[1] > 0)
+            guess = np.where(ok_hint, hint[1], guess)
         if upper is not None:
             guess = np.minimum(guess, upper)
         cap = self._log_stretch_cap(scene, index) + np.zeros(target.shape)
@@ -979,6 +983,21 @@ class _Span:
 
 
 _CURVE_SPAN = contextvars.ContextVar("tubefsi_curve_span", default=None)
+#: (flow rates, inlet log-stretches) of a nearby solve of the same flow rates (see start_hint).
+_START_HINT = contextvars.ContextVar("tubefsi_start_hint", default=None)
+
+
+@contextlib.contextmanager
+def start_hint(flow_rate, log_stretch):
+    """Within the block, a direct solve of exactly these flow rates through a scene of shared
+    quantities starts its Gauss iteration from ``log_stretch`` (a nearby solution: the same
+    data at the previous parameters of a fit) instead of the linear guess. Only a start: the
+    error-controlled iteration that follows decides the answer."""
+    token = _START_HINT.set((np.asarray(flow_rate, dtype=float), np.asarray(log_stretch, dtype=float)))
+    try:
+        yield
+    finally:
+        _START_HINT.reset(token)
 
 
 @contextlib.contextmanager
