@@ -252,3 +252,30 @@ def test_the_check_holds_for_every_way_a_plugin_class_gets_its_init():
 
     with pytest.raises(KeywordError, match=r"^ThinLinear\(\) got an unexpected keyword 'stifness'"):
         Handwritten(stiffness=2e4)
+
+
+def test_a_hand_written_init_in_a_slotted_attrs_class_and_one_set_later():
+    """A slotted attrs class keeps its own ``__init__`` (whose ``super()`` must see the class
+    attrs made), and an ``__init__`` written outside any class and set on it later is checked
+    with ``self`` not counted as a keyword or a positional argument."""
+    @attrs.frozen(kw_only=True)
+    class Stiff(ThinLinear):
+        def __init__(self, *, stiffness):
+            super().__init__(youngs_modulus=stiffness, poisson_ratio=0.3)
+
+    assert Stiff(stiffness=2e4).youngs_modulus == 2e4
+    with pytest.raises(KeywordError, match=r"did you mean 'stiffness'\? \(valid keywords: stiffness\)"):
+        Stiff(stifness=2e4)
+
+    def init(self, *, stiffness):
+        ThinLinear.__init__(self, youngs_modulus=stiffness, poisson_ratio=0.3)
+
+    class Later(ThinLinear):
+        pass
+
+    Later.__init__ = init
+    assert Later(stiffness=3e4).youngs_modulus == 3e4
+    with pytest.raises(KeywordError, match=r"\(valid keywords: stiffness\)$"):
+        Later(stifness=3e4)
+    with pytest.raises(KeywordError, match="takes 0 positional arguments but 1 were given"):
+        Later(3e4)

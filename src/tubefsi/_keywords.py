@@ -20,10 +20,12 @@ from .errors import KeywordError
 __all__ = ["checked_keywords", "KeywordChecked", "KeywordCheckedABC", "keyword_error"]
 
 
-def keyword_error(target, args, kwargs, name=None):
+def keyword_error(target, args, kwargs, name=None, *, method=None):
     """The :class:`~tubefsi.KeywordError` of a call of ``target`` with ``args`` and ``kwargs``
     that does not bind to its signature; ``None`` if it binds (the ``TypeError`` came from inside).
-    A method's ``self`` or ``cls`` is in ``args`` and is not listed as a keyword."""
+    A method's ``self`` or ``cls`` is in ``args`` and is not listed as a keyword; ``method``
+    says whether ``target`` is one (None: a function defined in a class body whose first
+    parameter is ``self`` or ``cls``)."""
     import difflib
     import inspect
 
@@ -39,8 +41,9 @@ def keyword_error(target, args, kwargs, name=None):
         return None
     kinds = inspect.Parameter
     params = signature.parameters.values()
-    bound_self = 1 if "." in getattr(target, "__qualname__", "") and args and next(iter(signature.parameters), "") in (
-        "self", "cls") else 0
+    if method is None:
+        method = "." in getattr(target, "__qualname__", "") and next(iter(signature.parameters), "") in ("self", "cls")
+    bound_self = 1 if method and args else 0
     valid = [p.name for p in params if p.kind in (kinds.POSITIONAL_OR_KEYWORD, kinds.KEYWORD_ONLY)][bound_self:]
     name = name or f"{getattr(target, '__qualname__', repr(target))}()"
     if not any(p.kind is kinds.VAR_KEYWORD for p in params):
@@ -118,7 +121,7 @@ def _reject(instance, original, args, kwargs, named):
     # __init__ called it: the keywords listed are this one's)
     owner = called.__name__ if getattr(called.__init__, "__globals__", {}).get("_tubefsi_init") is original \
         else original.__qualname__.rpartition(".")[0] or called.__name__
-    error = keyword_error(original, (instance,) + args, {**given, **kwargs}, name=f"{owner}()")
+    error = keyword_error(original, (instance,) + args, {**given, **kwargs}, name=f"{owner}()", method=True)
     if error is None:                     # (not reached: the checked __init__ calls this only on a miss)
         raise TypeError(f"{type(instance).__name__}() got arguments that do not bind to its signature")
     raise error
@@ -248,6 +251,17 @@ def _checked_source(init, attributes=(), namespace=None):
     return ast.unparse(ast.fix_missing_locations(tree)) + "\n"
 
 
+def _repoint_class_cells(function, old, new) -> None:
+    """Point the closure cells of ``function`` that hold the class ``old`` at ``new`` (what attrs
+    does for a slotted class's own methods)."""
+    for cell in getattr(function, "__closure__", None) or ():
+        try:
+            if cell.cell_contents is old:
+                cell.cell_contents = new
+        except ValueError:                 # an empty cell
+            pass
+
+
 def _check_init(cls) -> None:
     """Give ``cls`` an ``__init__`` that raises :class:`~tubefsi.KeywordError` for arguments that do
     not bind, if its own ``__init__`` (in its ``__dict__``) is not one yet.
@@ -260,7 +274,16 @@ def _check_init(cls) -> None:
     import linecache
 
     init = cls.__dict__.get("__init__")
-    if init is None or getattr(init, "_keyword_checked", False) or not inspect.isfunction(init):
+    if init is None or not inspect.isfunction(init):
+        return
+    if getattr(init, "_keyword_checked", False):
+        owner = init._keyword_owner
+        if owner is not cls:
+            # the class made again with this __init__ (attrs' slotted class): attrs points the
+            # __class__ cells (super()) of the functions in its dict at the new class, but the
+            # function this one wraps is not in it
+            _repoint_class_cells(getattr(init, "__wrapped__", None), owner, cls)
+            init._keyword_owner = cls
         return
     namespace = dict(init.__globals__, _tubefsi_missing=_MISSING, _tubefsi_reject=_reject, _tubefsi_init=init)
     source = _checked_source(init, getattr(cls, "__attrs_attrs__", ()), namespace)
@@ -279,12 +302,12 @@ def _check_init(cls) -> None:
             try:
                 init(self, *args, **kwargs)
             except TypeError:
-                error = keyword_error(init, (self,) + args, kwargs, name=f"{type(self).__name__}()")
+                error = keyword_error(init, (self,) + args, kwargs, name=f"{type(self).__name__}()", method=True)
                 if error is None:
                     raise
                 raise error from None
     checked.__signature__ = inspect.signature(init)
-    checked._keyword_checked = True
+    checked._keyword_checked, checked._keyword_owner = True, cls
     type.__setattr__(cls, "__init__", checked)
 
 

@@ -232,7 +232,7 @@ class Solution:
         shared (``tubefsi.fit``'s Jacobian asks for every fitted parameter at once)."""
         if self.scene.graded:
             raise InvalidParameterError("parameter", "a parameter of a uniform tube's solve (a graded tube: "
-                                        "difference two solves)", parameters[0])
+                                        "difference two solves)", parameters[0] if parameters else None)
         kinds = []
         for parameter in parameters:
             owner, _, field = parameter.partition(".")
