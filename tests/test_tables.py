@@ -435,3 +435,22 @@ def test_the_scalar_plan_gives_the_bits_of_a_fresh_one():
         solve_module._LAST_PLAN[0], solve_module._LAST_FLOW[0] = (None, None), (None, None, None)
         alone = solve_module._scalar_flow(FLUID, walls["thick-neo-hookean"](shear_modulus=2e3), TUBE, q).pressure_drop
         assert set(got) == {alone}
+
+
+def test_the_scalar_plan_keeps_no_mutable_rheology():
+    """A rheology that can change after it is made (here a subclass with a plain __setattr__)
+    is read afresh on every call: changing its consistency changes the answer (the plan keeps
+    only frozen attrs rheologies and Tubes, whose values cannot change)."""
+    from tubefsi.rheology.power_law import PowerLaw
+
+    class Mutable(PowerLaw):
+        __setattr__ = object.__setattr__
+
+    fluid = Mutable(consistency=0.01, index=0.8)
+    wall = walls["thick-neo-hookean"](shear_modulus=2e3)
+    tubefsi.solve(fluid, wall, TUBE, flow_rate=np.geomspace(1e-12, 1e-9, 100))     # builds the table
+    before = tubefsi.solve(fluid, wall, TUBE, flow_rate=1e-9).pressure_drop
+    fluid.consistency = 0.02
+    after = tubefsi.solve(fluid, wall, TUBE, flow_rate=1e-9).pressure_drop
+    fresh = tubefsi.solve(Mutable(consistency=0.02, index=0.8), wall, TUBE, flow_rate=1e-9).pressure_drop
+    assert after == fresh and after > 1.2 * before

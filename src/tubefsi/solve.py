@@ -351,9 +351,18 @@ _COUPLERS = registry.couplers
 #: The scalar path's plan of the last rheology and tube it saw: ``(rheology, tube, radius
 #: exponent k, radius a, t/a, length L, a^k)``, read off the two objects once and reused while
 #: the next call brings the same two (a Monte Carlo loop over a wall's parameters); both are
-#: immutable, so what was read off them stands. A tuple: a loop that changes the fluid or the
-#: tube every call pays one tuple for it. (None, None, ...) before the first call.
+#: immutable (a ``Tube``, a frozen attrs rheology: for any other rheology the plan holds None
+#: and is made again each call), so what was read off them stands. A tuple: a loop that changes
+#: the fluid or the tube every call pays one tuple for it. (None, None) before the first call.
 _LAST_PLAN: list = [(None, None)]
+
+
+@attrs.frozen
+class _FrozenProbe:
+    """A frozen attrs class, for the ``__setattr__`` every frozen attrs class has."""
+
+
+_FROZEN_SETATTR = _FrozenProbe.__setattr__
 #: The last ``(rheology, q, phi(q))`` of the scalar path (one tuple: a thread never sees half
 #: of another's).
 _LAST_FLOW: list = [(None, None, None)]
@@ -369,8 +378,9 @@ def _plan(rheology, tube):
     a, t, length = tube.radius, tube.thickness, tube.length
     if type(k) is not float or type(a) is not float or type(t) is not float or type(length) is not float:
         return None
+    kept = rheology if type(rheology).__setattr__ is _FROZEN_SETATTR else None   # (a mutable one: not kept)
     try:
-        plan = (rheology, tube, k, a, t / a, length, a**k)
+        plan = (kept, tube, k, a, t / a, length, a**k)
     except OverflowError:
         return None
     _LAST_PLAN[0] = plan
@@ -410,7 +420,7 @@ def _scalar_flow(rheology, wall, tube, q):
         phi = rheology._flow_factor(q)
         if type(phi) is not float:
             return None
-        _LAST_FLOW[0] = (rheology, q, phi)
+        _LAST_FLOW[0] = (plan[0], q, phi)       # (plan[0]: None for a rheology that is not kept)
     norm = radius_power * scale
     if not 2.2250738585072014e-308 <= norm < _INF:     # a power law of a large index: the general path
         return None
