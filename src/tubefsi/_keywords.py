@@ -74,11 +74,13 @@ class _Never(Exception):
     """Raised by nothing: the exception a wrapper without ``recover`` catches."""
 
 
-def checked_keywords(function, recover=None):
+def checked_keywords(function, recover=None, *, name=None, method=None):
     """Decorate a public function or method: a call whose arguments do not bind raises
     :class:`~tubefsi.KeywordError` instead of Python's ``TypeError``. ``recover``, optional, is
     ``(exception class, handler)``: where the call raises that exception, ``handler(function, args,
-    kwargs)`` answers instead (None: the exception stands). One call frame on the ordinary path."""
+    kwargs)`` answers instead (None: the exception stands). ``name(args)``, optional, is what the
+    error calls the callee and ``method`` is passed to :func:`keyword_error`. One call frame on the
+    ordinary path."""
     caught, handler = recover if recover is not None else (_Never, None)
 
     @functools.wraps(function)
@@ -86,7 +88,7 @@ def checked_keywords(function, recover=None):
         try:
             return function(*args, **kwargs)
         except TypeError:
-            error = keyword_error(function, args, kwargs)
+            error = keyword_error(function, args, kwargs, None if name is None else name(args), method=method)
             if error is None:
                 raise
         except caught:
@@ -296,16 +298,8 @@ def _check_init(cls) -> None:
         checked = namespace[init.__name__]
         checked.__qualname__, checked.__module__, checked.__doc__ = init.__qualname__, init.__module__, init.__doc__
         checked.__annotations__ = dict(init.__annotations__)
-    else:
-        @functools.wraps(init)
-        def checked(self, *args, **kwargs):
-            try:
-                init(self, *args, **kwargs)
-            except TypeError:
-                error = keyword_error(init, (self,) + args, kwargs, name=f"{type(self).__name__}()", method=True)
-                if error is None:
-                    raise
-                raise error from None
+    else:                                      # named after the class called, as a model is
+        checked = checked_keywords(init, name=lambda args: f"{type(args[0]).__name__}()", method=True)
     checked.__signature__ = inspect.signature(init)
     checked._keyword_checked, checked._keyword_owner = True, cls
     type.__setattr__(cls, "__init__", checked)

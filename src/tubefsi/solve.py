@@ -355,6 +355,9 @@ _COUPLERS = registry.couplers
 #: and is made again each call), so what was read off them stands. A tuple: a loop that changes
 #: the fluid or the tube every call pays one tuple for it. (None, None) before the first call.
 _LAST_PLAN: list = [(None, None)]
+#: The last ``(rheology, q, phi(q))`` of the scalar path (one tuple: a thread never sees half
+#: of another's).
+_LAST_FLOW: list = [(None, None, None)]
 
 
 @attrs.frozen
@@ -363,9 +366,6 @@ class _FrozenProbe:
 
 
 _FROZEN_SETATTR = _FrozenProbe.__setattr__
-#: The last ``(rheology, q, phi(q))`` of the scalar path (one tuple: a thread never sees half
-#: of another's).
-_LAST_FLOW: list = [(None, None, None)]
 
 
 def _plan(rheology, tube):
