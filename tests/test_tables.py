@@ -454,3 +454,41 @@ def test_the_scalar_plan_keeps_no_mutable_rheology():
     after = tubefsi.solve(fluid, wall, TUBE, flow_rate=1e-9).pressure_drop
     fresh = tubefsi.solve(Mutable(consistency=0.02, index=0.8), wall, TUBE, flow_rate=1e-9).pressure_drop
     assert after == fresh and after > 1.2 * before
+
+
+def test_the_lean_curve_path_keeps_only_frozen_models():
+    """The lean curve path resolves the last (rheology, wall, tube) once (solve._LAST_CURVE):
+    a second curve through the same objects gives the bits of a fresh resolution; a wall or
+    rheology that can change after it is made (a plain __setattr__) is resolved afresh each
+    call, so changing its modulus changes the answer; a new registry generation resolves anew."""
+    from tubefsi.walls.neo_hookean import ThinNeoHookean
+    from tubefsi.rheology.power_law import PowerLaw
+    solve_module = importlib.import_module("tubefsi.solve")
+    q = np.geomspace(1e-12, 1e-9, 300)
+    wall = walls["thin-neo-hookean"](shear_modulus=2e3, thickness_convention="reference")
+    first = tubefsi.solve(FLUID, wall, TUBE, flow_rate=q)                    # builds the table
+    kept = solve_module._curve_flow(FLUID, wall, TUBE, q)
+    assert solve_module._LAST_CURVE[0][:3] == (FLUID, wall, TUBE)
+    solve_module._LAST_CURVE[0] = (None,) * 7
+    fresh = solve_module._curve_flow(FLUID, wall, TUBE, q)
+    assert np.array_equal(kept.pressure_drop, fresh.pressure_drop)
+    assert np.array_equal(kept.pressure_drop, first.pressure_drop)
+
+    class MutableWall(ThinNeoHookean):
+        __setattr__ = object.__setattr__
+
+    class MutableFluid(PowerLaw):
+        __setattr__ = object.__setattr__
+
+    soft = MutableWall(shear_modulus=2e3, thickness_convention="reference")
+    fluid = MutableFluid(consistency=0.01, index=0.8)
+    tubefsi.solve(fluid, soft, TUBE, flow_rate=q)                          # builds its class's table
+    before = solve_module._curve_flow(fluid, soft, TUBE, q)
+    assert before is not None and solve_module._LAST_CURVE[0][1] is not soft
+    soft.shear_modulus = 4e3
+    fluid.consistency = 0.02
+    after = solve_module._curve_flow(fluid, soft, TUBE, q)
+    stiff = walls["thin-neo-hookean"](shear_modulus=4e3, thickness_convention="reference")
+    want = tubefsi.solve(rheologies["power-law"](consistency=0.02, index=0.8), stiff, TUBE, flow_rate=q)
+    assert np.array_equal(after.pressure_drop, want.pressure_drop)
+    assert not np.allclose(after.pressure_drop, before.pressure_drop)

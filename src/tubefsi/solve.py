@@ -360,6 +360,13 @@ _LAST_PLAN: list = [(None, None)]
 _LAST_FLOW: list = [(None, None, None)]
 
 
+#: The lean curve path's last ``(rheology, wall, tube, registry generation, coupler, coupler
+#: name, scene)``: a script that draws curve after curve through the same three objects (a
+#: parameter study plotting each) resolves and validates them once. Kept only for frozen attrs
+#: models of float parameters (nothing of them can change; a mutable one is resolved each call).
+_LAST_CURVE: list = [(None,) * 7]
+
+
 @attrs.frozen
 class _FrozenProbe:
     """A frozen attrs class, for the ``__setattr__`` every frozen attrs class has."""
@@ -454,16 +461,22 @@ def _curve_flow(rheology, wall, tube, flow_rate):
     if (type(tube) is not Tube or flow_rate.ndim != 1 or not 0 < flow_rate.size <= CHUNK
             or type(tube.radius) is not float or type(tube.thickness) is not float or type(tube.length) is not float):
         return None
-    chosen = _auto(rheology, wall)
-    if chosen is False or not _is(type(chosen[0]), SeparatedVariables) or chosen[0].refined() is not None:
-        return None
-    if parameter_shape(rheology) != () or parameter_shape(wall) != ():     # array parameters: a broadcast solve
-        return None
-    coupler, name = chosen
-    scene = make_scene(rheology, wall, tube)
-    if scene.shape != () or scene.graded or wall.is_rigid:
-        return None
-    _radius_power_in_range(scene)
+    last = _LAST_CURVE[0]
+    if last[0] is rheology and last[1] is wall and last[2] is tube and last[3] == _COUPLERS.generation:
+        coupler, name, scene = last[4:]
+    else:
+        chosen = _auto(rheology, wall)
+        if chosen is False or not _is(type(chosen[0]), SeparatedVariables) or chosen[0].refined() is not None:
+            return None
+        if parameter_shape(rheology) != () or parameter_shape(wall) != ():     # array parameters: a broadcast solve
+            return None
+        coupler, name = chosen
+        scene = make_scene(rheology, wall, tube)
+        if scene.shape != () or scene.graded or wall.is_rigid:
+            return None
+        _radius_power_in_range(scene)
+        if type(rheology).__setattr__ is _FROZEN_SETATTR and type(wall).__setattr__ is _FROZEN_SETATTR:
+            _LAST_CURVE[0] = (rheology, wall, tube, _COUPLERS.generation, coupler, name, scene)
     q = as_load("flow_rate", flow_rate).copy()             # (a copy: the solution keeps it)
     state = coupler.curve_from_table(scene, q)
     if state is None:

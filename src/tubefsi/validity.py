@@ -86,6 +86,10 @@ def _reynolds(scene, q, radius, density):
     return re
 
 
+def _scalar(value) -> bool:
+    return type(value) is float or np.ndim(value) == 0       # (a float: no call into numpy)
+
+
 def check(scene, flow_rate, inlet_strain, *, density=None) -> Validity:
     """Check a result: ``scene`` a flat scene (:meth:`~tubefsi.scene.Scene.flat`) and the flat
     arrays ``flow_rate``, ``inlet_strain`` of its points (NaN where infeasible)."""
@@ -95,7 +99,7 @@ def check(scene, flow_rate, inlet_strain, *, density=None) -> Validity:
         strain = np.broadcast_to(strain, q.shape)
     a, length = scene.tube.radius, scene.tube.length
     limit = getattr(scene.wall, "calibrated_strain", math.inf)
-    if density is None and q.size and np.ndim(a) == 0 and np.ndim(length) == 0 and np.ndim(limit) == 0:
+    if density is None and q.size and _scalar(a) and _scalar(length) and _scalar(limit):
         # one tube (a curve): R_in/L grows with the strain, so the largest strain decides both
         # checks: one reduction, and the per-point pass only when there is something to report
         top = float(np.fmax.reduce(strain, initial=-math.inf))    # NaN (infeasible points) ignored
