@@ -66,6 +66,11 @@ import time
 
 import attrs
 import numpy as np
+
+try:
+    import resource                     # (POSIX only: the page-fault count of row 4's note)
+except ImportError:                     # pragma: no cover
+    resource = None
 import scipy
 
 import tubefsi
@@ -316,10 +321,16 @@ def random_row(row, sizes, rng):
     else:
         row.err_tubefsi = "ref"
     strain = max(d.inlet_displacement / float(a) for d, a in zip(default, s["a"]))
+    faults = ""
+    if resource is not None and mode == "broadcast":   # what glibc's returning of freed memory costs
+        f0 = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+        ours(0)
+        faults = (f"{resource.getrusage(resource.RUSAGE_SELF).ru_minflt - f0} minor page faults per call "
+                  "(benchmarks/allocator.py)")
     row.note = "; ".join(filter(None, [
         why, f"{units} scenes per tubefsi pass, {count} per baseline pass",
         "mu 1-10 kPa, m 5-50 mPa s^n, n 0.5-1, a 50-200 um, t/a 0.1-0.5, L 5-20 mm, "
-        "q: rigid drop 5-90 % of the limit pressure", f"strain up to ~{strain:.2g}"]))
+        "q: rigid drop 5-90 % of the limit pressure", f"strain up to ~{strain:.2g}", faults]))
 
 
 def carreau_yasuda(**changes):

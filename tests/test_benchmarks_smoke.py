@@ -86,3 +86,16 @@ def test_network_benchmark_quick_prints_finite_ratios(tmp_path, capsys):
         assert r["nonlinear_s"] > 0 and r["linear_s"] > 0 and math.isfinite(r["ratio"])
         assert r["mass_balance"] <= 1e-12 and r["iterations"] >= 1
     assert "ratio" in capsys.readouterr().out
+
+
+def test_allocator_quick_prints_both_settings(capsys):
+    """benchmarks/allocator.py --quick: both malloc settings get a finite positive time per call."""
+    allocator = load("allocator")
+    assert allocator.main(["--quick"]) == 0
+    out = capsys.readouterr().out
+    rows = {line.split("  ")[0]: line for line in out.splitlines() if line.startswith(("glibc", "GLIBC"))}
+    assert set(rows) == {"glibc defaults", "GLIBC_TUNABLES set"}
+    for line in rows.values():
+        ms = float(line.split()[2])
+        assert math.isfinite(ms) and ms > 0
+    assert float(out.rsplit(":", 1)[1]) > 0
