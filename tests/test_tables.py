@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import importlib
 
+import attrs
 import numpy as np
 import pytest
 
@@ -459,8 +460,8 @@ def test_the_scalar_plan_keeps_no_mutable_rheology():
 def test_the_lean_curve_path_keeps_only_frozen_models():
     """The lean curve path resolves the last (rheology, wall, tube) once (solve._LAST_CURVE):
     a second curve through the same objects gives the bits of a fresh resolution; a wall or
-    rheology that can change after it is made (a plain __setattr__) is resolved afresh each
-    call, so changing its modulus changes the answer; a new registry generation resolves anew."""
+    rheology that can change after it is made (a plain __setattr__, or a frozen class with a
+    dict field) is resolved afresh each call, so changing it changes the answer."""
     from tubefsi.walls.neo_hookean import ThinNeoHookean
     from tubefsi.rheology.power_law import PowerLaw
     solve_module = importlib.import_module("tubefsi.solve")
@@ -492,3 +493,22 @@ def test_the_lean_curve_path_keeps_only_frozen_models():
     want = tubefsi.solve(rheologies["power-law"](consistency=0.02, index=0.8), stiff, TUBE, flow_rate=q)
     assert np.array_equal(after.pressure_drop, want.pressure_drop)
     assert not np.allclose(after.pressure_drop, before.pressure_drop)
+
+    @attrs.frozen(kw_only=True)
+    class Clamped(ThinNeoHookean):
+        """Frozen, but holding a dict that sets how long the tube is installed."""
+        settings: dict = attrs.field(factory=lambda: {"stretch": 1.0}, eq=False)
+
+        def _installed_tube(self, tube):
+            f = self.settings["stretch"]
+            return tube if f == 1.0 else tubefsi.Tube(radius=tube.radius, thickness=tube.thickness,
+                                                      length=tube.length * f)
+
+    clamped = Clamped(shear_modulus=2e3, thickness_convention="reference")
+    tubefsi.solve(FLUID, clamped, TUBE, flow_rate=q)                      # builds its class's table
+    short = solve_module._curve_flow(FLUID, clamped, TUBE, q)
+    assert short is not None and solve_module._LAST_CURVE[0][1] is not clamped
+    clamped.settings["stretch"] = 2.0
+    long = solve_module._curve_flow(FLUID, clamped, TUBE, q)
+    assert long.scene.tube.length == 2 * TUBE.length
+    assert np.all(long.pressure_drop > short.pressure_drop)

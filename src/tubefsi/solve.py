@@ -362,9 +362,11 @@ _LAST_FLOW: list = [(None, None, None)]
 
 #: The lean curve path's last ``(rheology, wall, tube, registry generation, coupler, coupler
 #: name, scene)``: a script that draws curve after curve through the same three objects (a
-#: parameter study plotting each) resolves and validates them once. Kept only for frozen attrs
-#: models of float parameters (nothing of them can change; a mutable one is resolved each call).
+#: parameter study plotting each) resolves and validates them once. Kept only for models that
+#: cannot change (:func:`_unchanging`); any other is resolved on every call.
 _LAST_CURVE: list = [(None,) * 7]
+#: Field values that cannot change in place.
+_LEAVES = (float, int, str, bool, type(None))
 
 
 @attrs.frozen
@@ -373,6 +375,22 @@ class _FrozenProbe:
 
 
 _FROZEN_SETATTR = _FrozenProbe.__setattr__
+
+
+def _unchanging(model) -> bool:
+    """Whether nothing of ``model`` can change after it is made: a frozen attrs class whose
+    fields all hold floats, ints, strings, booleans, None or tuples of these (a dict, a list or
+    an array field could be changed in place, and what was derived from it would go stale)."""
+    if type(model).__setattr__ is not _FROZEN_SETATTR:
+        return False
+    for field in attrs.fields(type(model)):
+        value = getattr(model, field.name)
+        if type(value) is tuple:
+            if not all(type(item) in _LEAVES for item in value):
+                return False
+        elif type(value) not in _LEAVES:
+            return False
+    return True
 
 
 def _plan(rheology, tube):
@@ -475,7 +493,7 @@ def _curve_flow(rheology, wall, tube, flow_rate):
         if scene.shape != () or scene.graded or wall.is_rigid:
             return None
         _radius_power_in_range(scene)
-        if type(rheology).__setattr__ is _FROZEN_SETATTR and type(wall).__setattr__ is _FROZEN_SETATTR:
+        if _unchanging(rheology) and _unchanging(wall):
             _LAST_CURVE[0] = (rheology, wall, tube, _COUPLERS.generation, coupler, name, scene)
     q = as_load("flow_rate", flow_rate).copy()             # (a copy: the solution keeps it)
     state = coupler.curve_from_table(scene, q)
