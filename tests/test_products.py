@@ -35,7 +35,7 @@ def test_rows_dot_is_batch_independent_and_correct(size, start, m, r, seed):
 def test_fixed_width_product_is_batch_independent_and_correct(size, start, width, seed):
     rng = np.random.default_rng(seed)
     a = rng.standard_normal((52, 17))
-    b = rng.standard_normal((700, 17)).T                   # a transposed view, as solve_integral passes it
+    b = rng.standard_normal((700, 17)).T                   # a transposed view (any strides are accepted)
     start = min(start, 700 - size)
     whole = fixed_width_product(a, b, width=width)
     part = fixed_width_product(a, b[:, start:start + size], width=width)

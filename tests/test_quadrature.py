@@ -171,12 +171,12 @@ def test_what_is_not_resolved_is_left_to_the_caller():
     upper = np.array([1.0, 1.0, 1.0, 1.0, 1.0])
 
     def f(u, i):
-        out = np.empty(u.shape)
-        out[0] = 0.2 + np.abs(u[0] - 0.3)
-        out[1] = 0.01 * np.exp(40.0 * u[1])
-        out[2] = u[2] - 0.5
-        out[3] = np.where(u[3] > 0.9, np.inf, 1.0)
-        out[4] = 1.0
+        out = np.empty(u.shape)                # nodes x points
+        out[:, 0] = 0.2 + np.abs(u[:, 0] - 0.3)
+        out[:, 1] = 0.01 * np.exp(40.0 * u[:, 1])
+        out[:, 2] = u[:, 2] - 0.5
+        out[:, 3] = np.where(u[:, 3] > 0.9, np.inf, 1.0)
+        out[:, 4] = 1.0
         return out
 
     x, solved, short = solve_integral(f, target, upper)
@@ -187,7 +187,7 @@ def test_what_is_not_resolved_is_left_to_the_caller():
 def test_vectorized_solve_equals_one_at_a_time():
     k = np.array([0.5, 2.0, 3.5])
     target = np.array([0.05, 0.2, 0.3])
-    x, solved, _ = solve_integral(lambda u, i: np.exp(k[i, None] * u), target, 1.5 * target)
+    x, solved, _ = solve_integral(lambda u, i: np.exp(k[i] * u), target, 1.5 * target)
     for j in range(3):
         xj, sj, _ = solve_integral(lambda u, i: np.exp(k[j] * u), target[j:j + 1], 1.5 * target[j:j + 1])
         assert sj[0] == solved[j]

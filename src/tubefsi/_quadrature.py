@@ -347,11 +347,12 @@ _BLOCK = 256
 
 
 def _apply_map(y, matrix):
-    """``matrix @ y.T`` (shape (52, P) at degree 16, rows contiguous), in blocks of ``_BLOCK``
-    points of one shape (:func:`~tubefsi._products.fixed_width_product`: a point's answer must not
-    depend on the batch it came in: a broadcast solve equals its scalar solves), into this
-    thread's scratch buffer (valid until the next call)."""
-    return fixed_width_product(matrix, y.T, out=scratch("maps", (matrix.shape[0], y.shape[0])), width=_BLOCK)
+    """``matrix @ y`` (``y`` of shape (n + 1, P); the result (52, P) at degree 16, rows
+    contiguous), in blocks of ``_BLOCK`` points of one shape
+    (:func:`~tubefsi._products.fixed_width_product`: a point's answer must not depend on the
+    batch it came in: a broadcast solve equals its scalar solves), into this thread's scratch
+    buffer (valid until the next call)."""
+    return fixed_width_product(matrix, y, out=scratch("maps", (matrix.shape[0], y.shape[1])), width=_BLOCK)
 
 
 def _clenshaw(coef, t):
@@ -376,9 +377,12 @@ def solve_integral(f, target, upper, *, rtol=1e-14, values=None, degree=CHEBYSHE
     r"""Solve :math:`\int_0^{x} f(u)\,du = T` for :math:`x \in (0, X]`, per point, from one
     batch of integrand values: a Chebyshev interpolant on ``[0, X]``, integrated exactly.
 
-    ``f(u, index)`` takes ``u`` of shape ``(P, n + 1)`` (the Chebyshev–Lobatto nodes of ``P``
-    points' intervals, ``n = degree``, 16 by default) and the positions ``index`` of those
-    points; ``f > 0``. The interpolant
+    ``f(u, index)`` takes ``u`` of shape ``(n + 1, P)`` (column ``p``: the Chebyshev–Lobatto
+    nodes of point ``p``'s interval, ``n = degree``, 16 by default) and the positions ``index``
+    of those points, and returns values of that shape; ``f > 0``. (Points along the last,
+    contiguous axis: a per-point parameter of shape ``(P,)`` then broadcasts along it, which
+    NumPy's loops run at full speed, where a ``(P, 1)`` column against ``(P, n + 1)`` took
+    twice the time.) The interpolant
     of degree ``n`` is integrated in closed form, bracketed at the nodes and solved by Newton's
     method on the polynomial (no further integrand values). Its error is estimated a
     posteriori from the tail of its Chebyshev coefficients (for a function analytic near the
@@ -397,7 +401,7 @@ def solve_integral(f, target, upper, *, rtol=1e-14, values=None, degree=CHEBYSHE
     target = np.asarray(target, dtype=float).ravel()
     upper = np.broadcast_to(np.asarray(upper, dtype=float), target.shape)
     if values is None:          # (the nodes in a scratch buffer: f's temporaries are its own)
-        nodes = np.multiply(upper[:, None], rule.nodes, out=scratch("nodes", (target.size, rule.nodes.size)))
+        nodes = np.multiply(rule.nodes[:, None], upper, out=scratch("nodes", (rule.nodes.size, target.size)))
         values = f(nodes, np.arange(target.size))
     y = np.asarray(values, dtype=float)
     half = 0.5 * upper
@@ -409,7 +413,7 @@ def solve_integral(f, target, upper, *, rtol=1e-14, values=None, degree=CHEBYSHE
         tail = np.abs(coef[-3:]).sum(axis=0) * upper
         # every value positive: one reduction over the whole batch (NaN fails it), the per-point
         # minimum (a strided reduction, ten times dearer) only where that fails
-        positive = True if y.min() > 0 else np.min(y, axis=1) > 0
+        positive = True if y.min() > 0 else np.min(y, axis=0) > 0
         usable = positive & np.isfinite(tail) & (target > 0)   # a nan or inf in y reaches the tail
         short = usable & (cumulative[-1] < target)
         good = usable & ~short & (tail <= rtol * target)
@@ -419,7 +423,7 @@ def solve_integral(f, target, upper, *, rtol=1e-14, values=None, degree=CHEBYSHE
         return x, good, short
     h, t_goal = half, target
     if live.size < target.size:
-        coef, anti, cumulative, y = coef[:, live], anti[:, live], cumulative[:, live], y[live]
+        coef, anti, cumulative, y = coef[:, live], anti[:, live], cumulative[:, live], y[:, live]
         h, t_goal = half[live], target[live]
     # the bracketing nodes, and the cubic Hermite interpolant of the integral between them (its
     # slopes are the integrand values themselves) as Newton's start: within ~1e-5 of the root
@@ -428,7 +432,7 @@ def solve_integral(f, target, upper, *, rtol=1e-14, values=None, degree=CHEBYSHE
     c0, c1 = cumulative[j - 1, cols], cumulative[j, cols]
     t0, t1 = rule.t[j - 1], rule.t[j]
     scale = h * (t1 - t0)
-    d0, d1 = y[cols, j - 1] * scale, y[cols, j] * scale      # dJ/ds at the ends, s in [0, 1]
+    d0, d1 = y[j - 1, cols] * scale, y[j, cols] * scale      # dJ/ds at the ends, s in [0, 1]
     rise, goal = c1 - c0, t_goal - c0
     s = np.clip(goal / rise, 0.0, 1.0)
     # the Hermite cubic in monomial form, H(s) = ((a3 s + a2) s + d0) s: Horner for it and for its

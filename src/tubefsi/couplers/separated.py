@@ -549,14 +549,14 @@ class SeparatedVariables(Coupler):
         def attempt(points, degree):
             """Solve ``points`` (flat positions) at ``degree``; returns their (good, short) masks."""
             ids = flat_index[points]
-            if flat_q is None:
+            if flat_q is None:         # (u: nodes x points, so per-point quantities as rows)
                 def f(u, i):
-                    return self.integrand(scene.at(ids[i], column=True), u)
+                    return self.integrand(scene.at(ids[i]), u)
             else:
                 q_live = flat_q[points]
 
                 def f(u, i):
-                    return self.integrand(scene.at(ids[i], column=True), u, q_live[i, None])
+                    return self.integrand(scene.at(ids[i]), u, q_live[i])
             with np.errstate(all="ignore"):
                 x, good, short = solve_integral(f, flat_target[points], top[points], rtol=self._RTOL, degree=degree)
             v.ravel()[points[good]] = x[good]
