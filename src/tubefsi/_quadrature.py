@@ -447,7 +447,7 @@ def solve_integral(f, target, upper, *, rtol=1e-14, values=None, degree=CHEBYSHE
     a3 = d0 + d1 - 2.0 * rise
     a2 = 3.0 * rise - 2.0 * d0 - d1
     a3_3, a2_2 = 3.0 * a3, 2.0 * a2
-    # the integrand values (points x nodes) and the bracket's ends are no longer needed: freed
+    # the integrand values (nodes x points) and the bracket's ends are no longer needed: freed
     # before the Newton iterations allocate theirs, the call's peak memory is lower, and with it
     # the heap that glibc trims after the call and the next call faults back in
     del values, y, flat_y, flat_cumulative, c0, c1, d1, rise, scale, j, cols

@@ -195,7 +195,7 @@ class _ThickForms(_NeoHookeanLaw):
 
     def _stiffness(self, stretch, tb):
         # mu d lam (lam^2 (d + 2) + d) / (lam^4 (lam^2 + d)^2), d = tb (2 + tb); the per-point factors
-        # (mu d, d + 2) first, then in place: the integrand's hot spot, on (points x nodes) arrays
+        # (mu d, d + 2) first, then in place: the integrand's hot spot, on (nodes x points) arrays
         lam2 = np.multiply(stretch, stretch)
         d = tb * (2.0 + tb)
         den = lam2 + d
@@ -211,7 +211,7 @@ class _ThickForms(_NeoHookeanLaw):
 
     def _log_slope(self, stretch, tb):
         # lam P' = mu d (lam^2 (d + 2) + d) / (lam^2 (lam^2 + d)^2): the stiffness's form with the
-        # factor lam cancelled, two passes fewer over (points x nodes); a subclass that overrides
+        # factor lam cancelled, two passes fewer over (nodes x points); a subclass that overrides
         # the stiffness gets its own
         if type(self)._stiffness is not _ThickForms._stiffness:
             return stretch * self._stiffness(stretch, tb)
@@ -220,7 +220,7 @@ class _ThickForms(_NeoHookeanLaw):
         den = lam2 + d
         den *= den
         den *= lam2
-        # (in place where the shapes allow: one array of points x nodes fewer)
+        # (in place where the shapes allow: one array of nodes x points fewer)
         inplace = type(lam2) is np.ndarray and np.broadcast_shapes(lam2.shape, np.shape(d)) == lam2.shape
         num = np.multiply(lam2, d + 2.0, out=lam2) if inplace else lam2 * (d + 2.0)
         num += d
