@@ -439,9 +439,9 @@ def test_the_scalar_plan_gives_the_bits_of_a_fresh_one():
 
 
 def test_the_scalar_plan_keeps_no_mutable_rheology():
-    """A rheology that can change after it is made (here a subclass with a plain __setattr__)
-    is read afresh on every call: changing its consistency changes the answer (the plan keeps
-    only frozen attrs rheologies and Tubes, whose values cannot change)."""
+    """A rheology that can change after it is made (a subclass with a plain __setattr__, or a
+    frozen one holding a dict) is read afresh on every call: changing it changes the answer
+    (the plan keeps only rheologies that cannot change, solve._unchanging, and Tubes)."""
     from tubefsi.rheology.power_law import PowerLaw
 
     class Mutable(PowerLaw):
@@ -455,6 +455,21 @@ def test_the_scalar_plan_keeps_no_mutable_rheology():
     after = tubefsi.solve(fluid, wall, TUBE, flow_rate=1e-9).pressure_drop
     fresh = tubefsi.solve(Mutable(consistency=0.02, index=0.8), wall, TUBE, flow_rate=1e-9).pressure_drop
     assert after == fresh and after > 1.2 * before
+
+    @attrs.frozen(kw_only=True)
+    class Scaled(PowerLaw):
+        """Frozen, but holding a dict that scales its flow factor."""
+        settings: dict = attrs.field(factory=lambda: {"factor": 1.0}, eq=False)
+
+        def _flow_factor(self, flow_rate):
+            return self.settings["factor"] * super()._flow_factor(flow_rate)
+
+    scaled = Scaled(consistency=0.01, index=0.8)
+    tubefsi.solve(scaled, wall, TUBE, flow_rate=np.geomspace(1e-12, 1e-9, 100))    # builds the table
+    once = tubefsi.solve(scaled, wall, TUBE, flow_rate=1e-9).pressure_drop
+    scaled.settings["factor"] = 2.0
+    twice = tubefsi.solve(scaled, wall, TUBE, flow_rate=1e-9).pressure_drop
+    assert once == pytest.approx(before, rel=1e-13) and twice > 1.2 * once
 
 
 def test_the_lean_curve_path_keeps_only_frozen_models():

@@ -351,8 +351,8 @@ _COUPLERS = registry.couplers
 #: The scalar path's plan of the last rheology and tube it saw: ``(rheology, tube, radius
 #: exponent k, radius a, t/a, length L, a^k)``, read off the two objects once and reused while
 #: the next call brings the same two (a Monte Carlo loop over a wall's parameters); both are
-#: immutable (a ``Tube``, a frozen attrs rheology: for any other rheology the plan holds None
-#: and is made again each call), so what was read off them stands. A tuple: a loop that changes
+#: immutable (a ``Tube``, a rheology that cannot change, :func:`_unchanging`: for any other
+#: rheology the plan holds None and is made again each call), so what was read off them stands. A tuple: a loop that changes
 #: the fluid or the tube every call pays one tuple for it. (None, None) before the first call.
 _LAST_PLAN: list = [(None, None)]
 #: The last ``(rheology, q, phi(q))`` of the scalar path (one tuple: a thread never sees half
@@ -377,14 +377,21 @@ class _FrozenProbe:
 _FROZEN_SETATTR = _FrozenProbe.__setattr__
 
 
+@functools.cache
+def _field_names(cls) -> tuple[str, ...]:
+    return tuple(field.name for field in attrs.fields(cls))
+
+
 def _unchanging(model) -> bool:
     """Whether nothing of ``model`` can change after it is made: a frozen attrs class whose
     fields all hold floats, ints, strings, booleans, None or tuples of these (a dict, a list or
-    an array field could be changed in place, and what was derived from it would go stale)."""
+    an array field could be changed in place, and what was derived from it would go stale).
+    What the scalar plan (:data:`_LAST_PLAN`) and the curve path (:data:`_LAST_CURVE`) keep by
+    identity."""
     if type(model).__setattr__ is not _FROZEN_SETATTR:
         return False
-    for field in attrs.fields(type(model)):
-        value = getattr(model, field.name)
+    for name in _field_names(type(model)):
+        value = getattr(model, name)
         if type(value) is tuple:
             if not all(type(item) in _LEAVES for item in value):
                 return False
@@ -403,7 +410,7 @@ def _plan(rheology, tube):
     a, t, length = tube.radius, tube.thickness, tube.length
     if type(k) is not float or type(a) is not float or type(t) is not float or type(length) is not float:
         return None
-    kept = rheology if type(rheology).__setattr__ is _FROZEN_SETATTR else None   # (a mutable one: not kept)
+    kept = rheology if _unchanging(rheology) else None     # (one that can change: not kept)
     try:
         plan = (kept, tube, k, a, t / a, length, a**k)
     except OverflowError:
