@@ -64,13 +64,13 @@ import subprocess
 import sys
 import time
 
-import attrs
-import numpy as np
-
 try:
     import resource                     # (POSIX only: the page-fault count of row 4's note)
 except ImportError:                     # pragma: no cover
     resource = None
+
+import attrs
+import numpy as np
 import scipy
 
 import tubefsi

@@ -430,15 +430,15 @@ def solve_integral(f, target, upper, *, rtol=1e-14, values=None, degree=CHEBYSHE
     j = np.maximum(np.minimum(np.count_nonzero(cumulative < t_goal, axis=0), rule.degree), 1)
     # the bracket's ends as flat positions in the (nodes x points) arrays: a 1-D take each,
     # a quarter of the time of a 2-D fancy index
-    cols = (j - 1) * live.size
-    cols += np.arange(live.size)
+    lower = (j - 1) * live.size              # each point's lower bracket node, as a flat position
+    lower += np.arange(live.size)
     flat_cumulative, flat_y = cumulative.ravel(), y.ravel()
-    c0, c1 = flat_cumulative.take(cols), flat_cumulative.take(cols + live.size)
+    c0, c1 = flat_cumulative.take(lower), flat_cumulative.take(lower + live.size)
     t0, t1 = rule.t.take(j - 1), rule.t.take(j)
     scale = h * (t1 - t0)
-    d0 = flat_y.take(cols)
+    d0 = flat_y.take(lower)
     d0 *= scale
-    d1 = flat_y.take(cols + live.size)
+    d1 = flat_y.take(lower + live.size)
     d1 *= scale                                              # dJ/ds at the ends, s in [0, 1]
     rise, goal = c1 - c0, t_goal - c0
     s = np.clip(goal / rise, 0.0, 1.0)
@@ -450,7 +450,7 @@ def solve_integral(f, target, upper, *, rtol=1e-14, values=None, degree=CHEBYSHE
     # the integrand values (nodes x points) and the bracket's ends are no longer needed: freed
     # before the Newton iterations allocate theirs, the call's peak memory is lower, and with it
     # the heap that glibc trims after the call and the next call faults back in
-    del values, y, flat_y, flat_cumulative, c0, c1, d1, rise, scale, j, cols
+    del values, y, flat_y, flat_cumulative, c0, c1, d1, rise, scale, j, lower
     for _ in range(3):
         value = a3 * s
         value += a2
