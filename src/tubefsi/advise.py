@@ -29,7 +29,7 @@ from ._keywords import checked_keywords
 from .errors import InvalidParameterError, ModelValidityWarning, NoSteadyStateError, TubefsiError, warn_user
 from .rheology.power_law import _PowerLawForms
 from .scene import make_scene
-from .solve import max_flow_rate, solve
+from .solve import max_flow_rate, solve, solve_unchecked
 from .walls.hyperelastic import HyperelasticWall, ThickWall, ThinWall
 from .walls.linear import ThickLinear, ThinLinear
 from .walls.rigid import Rigid
@@ -206,9 +206,8 @@ def advise(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, toleranc
     for rank, label, fluid, w in _candidates(rheology, wall, tube, load):
         start = time.perf_counter()
         try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", ModelValidityWarning)
-                dp = solve(fluid, w, tube, flow_rate=flow_rate, outlet_pressure=outlet_pressure).pressure_drop
+            # a candidate's own validity is not the question (no process-wide filter: threads)
+            dp = solve_unchecked(fluid, w, tube, flow_rate=flow_rate, outlet_pressure=outlet_pressure).pressure_drop
             note = ""
         except (NoSteadyStateError, TubefsiError) as exc:
             dp, note = math.nan, f"{type(exc).__name__}"

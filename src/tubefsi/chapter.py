@@ -29,7 +29,7 @@ import numpy as np
 from scipy import integrate
 from scipy.optimize import elementwise
 
-from ._numerics import as_output as _out
+from .numerics.kernels import as_output as _out
 from ._validation import nonnegative_array as _nonnegative_array
 from ._validation import positive_scalar as _positive
 from .dimensionless import scene

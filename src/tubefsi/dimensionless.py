@@ -44,7 +44,7 @@ import math
 import attrs
 import numpy as np
 
-from ._numerics import as_output as _out
+from .numerics.kernels import as_output as _out
 from ._validation import nonnegative_array as _nonnegative_array
 from ._validation import positive_scalar as _positive
 from .errors import InvalidParameterError

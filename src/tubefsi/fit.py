@@ -13,7 +13,6 @@ errors come from the Gauss–Newton covariance :math:`s^2 (J^T J)^{-1}`,
 
 from __future__ import annotations
 
-import contextlib
 import math
 import warnings
 
@@ -22,11 +21,10 @@ import numpy as np
 from scipy import optimize
 
 from ._progress import bar
-from .couplers.separated import start_hint
-from .errors import InvalidParameterError, ModelValidityWarning, TubefsiError
+from .errors import InvalidParameterError, TubefsiError
 from ._keywords import checked_keywords
 from .scene import make_scene
-from .solve import solve
+from .solve import solve_unchecked
 
 __all__ = ["fit", "FitResult"]
 
@@ -126,13 +124,10 @@ def fit(flow_rate, pressure_drop, rheology, wall, tube, *, parameters, outlet_pr
             shown.update()
             m = build(theta)
             # beyond the maximum flow rate the drop is continued by its supremum, the limit
-            # pressure rise, so trial parameters with no steady state still steer the fit
-            previous = next(iter(cache.values()))[1].state.log_stretch if cache else None
-            with warnings.catch_warnings():    # trial points: validity is the fitted model's business
-                warnings.simplefilter("ignore", ModelValidityWarning)
-                with start_hint(q, previous) if previous is not None else contextlib.nullcontext():
-                    sol = solve(m["rheology"], m["wall"], tube, flow_rate=q, outlet_pressure=outlet_pressure,
-                                coupler=coupler, on_infeasible="nan")
+            # pressure rise, so trial parameters with no steady state still steer the fit; trial
+            # points are not checked for validity (the fitted model is)
+            sol = solve_unchecked(m["rheology"], m["wall"], tube, flow_rate=q, outlet_pressure=outlet_pressure,
+                                  coupler=coupler, on_infeasible="nan")
             out = np.array(sol.pressure_drop, dtype=float)
             ok = np.isfinite(out)
             if not np.all(ok):

@@ -45,7 +45,7 @@ import numpy as np
 
 from . import registry
 from .errors import InvalidParameterError, ModelValidityWarning, NoSteadyStateError, StretchRangeError
-from .solve import max_flow_rate, solve
+from .solve import max_flow_rate, solve, solve_unchecked
 from .validity import SLENDERNESS
 from .walls.hyperelastic import HyperelasticWall
 
@@ -356,10 +356,9 @@ def _valid_flow_rate(fluid, wall, tube, outlet_pressure, coupler):
     if math.isfinite(lim) and dp >= lim - outlet_pressure:
         return math.inf
     try:
-        with warnings.catch_warnings():     # a probe: the curve drawn is checked, not this point
-            warnings.simplefilter("ignore", ModelValidityWarning)
-            return float(solve(fluid, wall, tube, pressure_drop=dp, outlet_pressure=outlet_pressure,
-                               coupler=coupler).flow_rate)
+        # a probe: the curve drawn is checked, not this point
+        return float(solve_unchecked(fluid, wall, tube, pressure_drop=dp, outlet_pressure=outlet_pressure,
+                                     coupler=coupler).flow_rate)
     except (NoSteadyStateError, StretchRangeError):
         return math.inf
 

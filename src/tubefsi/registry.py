@@ -65,6 +65,7 @@ class Registry(Mapping):
         self._entries: dict[str, type] | None = None  # names resolved so far; None: entry points unread
         self._origin: dict[str, str] = {}
         self._pending: dict[str, list[tuple[str, metadata.EntryPoint]]] = {}  # name -> providers, by priority
+        self._derived: dict = {}    # what callers derived from the registry (derived()), until refresh()
 
     def _read(self) -> dict[str, type]:
         """Read the entry points (once) and order each name's providers; import nothing."""
@@ -146,15 +147,20 @@ class Registry(Mapping):
                 return name
         return None
 
+    def derived(self, name: str, compute):
+        """``compute(self)``, computed once per state of the registry (e.g. the couplers that
+        ``coupler="auto"`` tries, in order) and forgotten by :meth:`refresh`."""
+        found = self._derived.get(name)
+        if found is None:
+            found = self._derived[name] = compute(self)
+        return found
+
     def refresh(self) -> None:
         """Forget the cache; the next access reads the entry points again."""
         self._entries = None
         self._origin = {}
         self._pending = {}
-        self.generation += 1
-
-    #: Incremented by :meth:`refresh`: lets callers cache what they derived from the registry.
-    generation = 0
+        self._derived = {}
 
     def __repr__(self) -> str:
         return f"Registry({self.group!r}: {', '.join(self)})"

@@ -63,27 +63,12 @@ class State:
         return State(**{name: value[index] for name, value in self.arrays(n).items()})
 
 
-_NEW = object.__new__
-_SET_FLOW, _SET_DROP, _SET_STRAIN, _SET_LOG = (State.__dict__[f.name].__set__ for f in attrs.fields(State))
-
-
-def _scalar_state(flow_rate: float, pressure_drop: float, inlet_strain: float, log_stretch: float) -> State:
-    """``State(...)`` of four floats through its slots directly (the scalar path of
-    :func:`tubefsi.solve`: a third of the constructor's cost, which checks nothing either)."""
-    state = _NEW(State)
-    _SET_FLOW(state, flow_rate)
-    _SET_DROP(state, pressure_drop)
-    _SET_STRAIN(state, inlet_strain)
-    _SET_LOG(state, log_stretch)
-    return state
-
-
 def _value_eq(a, b) -> bool:
     a, b = np.asarray(a), np.asarray(b)
     return a.shape == b.shape and bool(np.all(a == b))
 
 
-@attrs.frozen(kw_only=True, slots=False)      # a __dict__: the scalar path fills one in a single update
+@attrs.frozen(kw_only=True, slots=False)
 class Scene:
     r"""A rheology, a wall, a tube and an outlet pressure: everything but the load.
 
@@ -163,17 +148,6 @@ class Scene:
         with np.errstate(divide="ignore"):
             v_max = np.log(np.asarray(lam_max, dtype=float) / (1.0 + np.asarray(strain)))
         object.__setattr__(self, "log_stretch_max", float(v_max) if v_max.ndim == 0 else v_max)
-
-    @classmethod
-    def _trusted(cls, rheology, wall, tube, log_stretch_max) -> Scene:
-        """A scene of scalars with an unloaded outlet, from already validated models (the scalar
-        fast path of :func:`tubefsi.solve`)."""
-        new = object.__new__(cls)
-        fields = new.__dict__
-        fields.update(_UNLOADED)
-        fields["rheology"], fields["wall"], fields["tube"] = rheology, wall, tube
-        fields["log_stretch_max"] = log_stretch_max
-        return new
 
     @property
     def tb(self):
@@ -277,11 +251,6 @@ class Scene:
         return Points(self, index, column)
 
 
-#: the fields of a scene with an unloaded outlet that do not depend on its models
-_UNLOADED = {"outlet_pressure": 0.0, "external_pressure": 0.0, "gauge_outlet_pressure": 0.0, "shape": (),
-             "outlet_strain": 0.0, "outlet_stretch": 1.0}
-
-
 def _evolve_arrays(scene, transform):
     """The scene with ``transform`` applied to every array it holds (models, tube, outlet state)."""
     def models(m):
@@ -362,19 +331,12 @@ class Points:
         self.log_stretch_max = pick(scene.log_stretch_max)
 
 
-@functools.lru_cache(maxsize=8)
-def _positions(n):
-    out = np.arange(n)
-    out.flags.writeable = False
-    return out
-
-
 def _every_point(index, n) -> bool:
     """Whether ``index`` is ``0, 1, ..., n - 1`` (one comparison pass instead of a gather per
     quantity: a flat scene's points are most often asked for all at once)."""
     return (type(index) is np.ndarray and index.ndim == 1 and index.size == n and n > 1
             and index.dtype.kind in "iu" and index[0] == 0 and index[-1] == n - 1
-            and bool(np.array_equal(index, _positions(n))))
+            and bool(np.all(index[1:] > index[:-1])))     # n increasing integers from 0 to n - 1
 
 
 def _read_only(view):
@@ -389,16 +351,13 @@ def _viewed(model, column):
     return _replace(model, arrays) if arrays else model
 
 
-_KINDS = {"rheology": (Rheology, _rheologies), "wall": (WallModel, _walls)}
-
-
 def resolve(kind: str, value):
     """A model instance from a registered name, a class (built with its defaults) or an instance.
 
     ``kind`` is ``"rheology"`` or ``"wall"``; anything else raises
     :class:`~tubefsi.InvalidParameterError` naming ``kind``.
     """
-    base, registry = _KINDS[kind]
+    base, registry = (Rheology, _rheologies) if kind == "rheology" else (WallModel, _walls)
     return _resolve(kind, value, base, registry)
 
 
@@ -417,13 +376,6 @@ def _resolve(kind, value, base, registry):
     if not isinstance(value, base):
         raise InvalidParameterError(kind, f"an instance of {base.__name__} or a registered name", value)
     return value
-
-
-def _log_max_stretch(wall, tb) -> float:
-    r""":math:`\ln\lambda_{max}` of a wall of scalar parameters at a scalar t/a (``inf`` unless it
-    locks): the ``log_stretch_max`` of its scene at an unloaded outlet."""
-    lam_max = wall._max_stretch(tb)
-    return math.log(lam_max) if type(lam_max) is float else float(np.log(lam_max))
 
 
 def make_scene(rheology, wall, tube, *, outlet_pressure=0.0, external_pressure=0.0) -> Scene:
@@ -454,9 +406,6 @@ def make_scene(rheology, wall, tube, *, outlet_pressure=0.0, external_pressure=0
     tube = wall._installed_tube(tube)        # an axial pre-stretch installs the tube longer and narrower
     if (type(outlet_pressure) is float and outlet_pressure == 0.0 and type(external_pressure) is float
             and external_pressure == 0.0):   # the common case: an unloaded outlet is below every limit
-        if parameter_shape(rheology) == () and parameter_shape(wall) == () and parameter_shape(tube) == ():
-            # every parameter a float (a curve): the fields __attrs_post_init__ would derive, directly
-            return Scene._trusted(rheology, wall, tube, _log_max_stretch(wall, tube.reduced_thickness))
         return Scene(rheology=rheology, wall=wall, tube=tube, outlet_pressure=0.0)
     p_out = as_array("outlet_pressure", outlet_pressure, "[0, inf)", lambda a: a >= 0)
     p_out = float(p_out) if p_out.ndim == 0 else p_out

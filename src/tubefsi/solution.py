@@ -12,12 +12,12 @@ import attrs
 import numpy as np
 
 from . import export
-from ._numerics import as_output
+from .numerics.kernels import as_output
 from ._validation import as_array
 from .couplers.base import Coupler
 from .errors import InvalidParameterError
 from .profiles import Profile
-from .scene import Scene, State, _scalar_state
+from .scene import Scene, State
 
 __all__ = ["Solution"]
 
@@ -25,7 +25,7 @@ __all__ = ["Solution"]
 _CHUNK = 1 << 14
 
 
-@attrs.frozen(kw_only=True, slots=False)      # a __dict__: the scalar path fills one in a single update
+@attrs.frozen(kw_only=True)
 class Solution:
     """Flow rate, pressure drop, inlet state and profiles of a steady FSI problem.
 
@@ -46,35 +46,6 @@ class Solution:
     density: object = None
     #: The load ``solve`` was given: ``"flow_rate"`` or ``"pressure_drop"``.
     controlled: str = "flow_rate"
-
-    @classmethod
-    def _scalar_flow_controlled(cls, scene_parts, coupler, values, coupler_name) -> Solution:
-        """A flow-controlled scalar solution of validated parts, built without ``__init__`` (the
-        scalar fast path of :func:`tubefsi.solve`; the other fields take their defaults). Its
-        scene and its state are built on first use, from ``scene_parts``, the arguments of
-        :meth:`Scene._trusted <tubefsi.scene.Scene._trusted>`, and from ``values``, the four
-        floats of its :class:`~tubefsi.scene.State` in field order (a Monte Carlo loop that reads
-        only the pressure drop needs neither: :attr:`pressure_drop` reads the float)."""
-        new = object.__new__(cls)
-        fields = new.__dict__
-        fields.update(_SCALAR_DEFAULTS)
-        fields["_scene_parts"], fields["coupler"], fields["_state_values"], fields["coupler_name"] = (
-            scene_parts, coupler, values, coupler_name)
-        return new
-
-    def __getattr__(self, name):
-        # only for an attribute not in the instance: the scene or the state of a scalar-path solution
-        if name == "scene":
-            parts = self.__dict__.get("_scene_parts")
-            if parts is not None:
-                scene = self.__dict__["scene"] = Scene._trusted(*parts)
-                return scene
-        elif name == "state":
-            values = self.__dict__.get("_state_values")
-            if values is not None:
-                state = self.__dict__["state"] = _scalar_state(*values)
-                return state
-        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
     # ------------------------------------------------------------------ loads
     @property
@@ -102,17 +73,11 @@ class Solution:
     @property
     def flow_rate(self):
         """Volumetric flow rate q (m^3/s)."""
-        values = self.__dict__.get("_state_values")
-        if values is not None:                # the scalar path's floats (its State may not exist)
-            return values[0]
         return as_output(self.state.flow_rate, self.scalar)
 
     @property
     def pressure_drop(self):
         """Pressure drop p(0) - p(L) (Pa)."""
-        values = self.__dict__.get("_state_values")
-        if values is not None:
-            return values[1]
         return as_output(self.state.pressure_drop, self.scalar)
 
     @property
@@ -378,7 +343,3 @@ class Solution:
         return (f"Solution(flow_rate={self.flow_rate!r}, pressure_drop={self.pressure_drop!r}, "
                 f"inlet_displacement={self.inlet_displacement!r}, coupler={self.coupler_name!r})")
 
-
-#: The fields a flow-controlled scalar solution does not set itself, as ``__init__`` would.
-_SCALAR_DEFAULTS = {"scalar": True, "feasible": None, "density": None, "controlled": "flow_rate"}
-assert set(_SCALAR_DEFAULTS) | {"scene", "coupler", "state", "coupler_name"} == {f.name for f in attrs.fields(Solution)}

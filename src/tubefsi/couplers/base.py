@@ -37,7 +37,8 @@ from typing import ClassVar
 import numpy as np
 
 from .._keywords import KeywordCheckedABC
-from .._quadrature import adaptive, warn_unconverged
+from ..numerics.quadrature import adaptive, warn_unconverged
+from ..scene import State
 
 __all__ = ["Coupler"]
 
@@ -86,6 +87,42 @@ class Coupler(abc.ABC, metaclass=KeywordCheckedABC):
         ``strain`` is the hoop strain :math:`\lambda(z) - 1` (never formed by subtraction) and
         ``pressure_rise`` is :math:`p(z) - p_{out}`.
         """
+
+    def limit_pressure(self, scene):
+        """The transmural pressure the wall of each point of a flat scene never reaches (Pa; inf
+        for most laws): the wall's :meth:`~tubefsi.walls.WallModel.limit_pressure`."""
+        return scene.wall.limit_pressure(scene.tb)
+
+    def solve_feasible(self, scene, load, controlled: str):
+        """``(State, feasible)``: the solution at the points of ``load`` (a flat array of flow rates
+        or pressure drops, ``controlled`` says which) that have a steady state, NaN and ``False``
+        in ``feasible`` at those beyond a limit (``feasible`` None: every point has one).
+
+        The default finds the limit first (:meth:`max_flow_rate`, or :meth:`limit_pressure` minus
+        the outlet pressure) and solves the points below it; an engine that sees a point run away
+        overrides it. A point beyond the solver's range that is below the limit still raises.
+        """
+        load = np.asarray(load, dtype=float)
+        if controlled == "flow_rate":
+            limit = np.asarray(self.max_flow_rate(scene), dtype=float)
+            beyond = (load > 0) & (load >= limit)
+        else:
+            limit = np.asarray(self.limit_pressure(scene), dtype=float) - np.asarray(scene.outlet_pressure, dtype=float)
+            beyond = load >= limit
+        beyond = np.broadcast_to(beyond, load.shape)
+        method = self.flow_controlled if controlled == "flow_rate" else self.pressure_controlled
+        if not np.any(beyond):
+            return method(scene, load), None
+        feasible = ~beyond
+        go = np.flatnonzero(feasible)
+        fields = {f: np.full(load.shape, np.nan) for f in ("flow_rate", "pressure_drop", "inlet_strain", "log_stretch")}
+        fields["flow_rate" if controlled == "flow_rate" else "pressure_drop"] = load.copy()
+        if go.size:
+            sub = scene.take(go) if scene.size > 1 else scene
+            state = method(sub, load[go])
+            for name in fields:
+                fields[name][go] = np.broadcast_to(np.asarray(getattr(state, name), dtype=float), go.shape)
+        return State(**fields), feasible
 
     def length_integral(self, scene, state, weight, *, uniform=False):
         r""":math:`\int_0^L w(q, R(z))\,dz` per point of a flat scene (m times ``w``), for a weight
@@ -172,3 +209,4 @@ class Coupler(abc.ABC, metaclass=KeywordCheckedABC):
     def describe(self) -> str:
         """A short description for messages (default: the class name)."""
         return type(self).__name__
+

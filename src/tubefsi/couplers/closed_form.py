@@ -10,7 +10,9 @@ neo-Hookean conventions, e.g. thin reference thickness with :math:`\lambda_{out}
     J/(a^k\mu\bar t) = \frac{\lambda^{3n+2} - 1}{3n+2} + 3\,\frac{\lambda^{3n-2} - 1}{3n-2},
 
 evaluated as ``expm1(c v)/c``, exact through the removable singularities at
-:math:`n = 2/3` and (thin current thickness) :math:`n = 1`.
+:math:`n = 2/3` and (thin current thickness) :math:`n = 1`. Where the wall also gives the
+explicit inverse (linear walls, thin current thickness) it answers every flow rate; otherwise
+Newton's method on the closed form, or the wall's table where it declares a shape/scale split.
 """
 
 from __future__ import annotations
@@ -20,8 +22,8 @@ from typing import ClassVar, final
 import attrs
 import numpy as np
 
-from ..scene import State
-from .separated import MAX_LOG_STRETCH, SeparatedVariables
+from . import _inverse
+from .separated import SeparatedVariables, exact
 
 __all__ = ["ClosedForm"]
 
@@ -39,30 +41,29 @@ class ClosedForm(SeparatedVariables):
     def _J(self, scene, v, index, q=None):
         pts = scene.at(np.asarray(index))
         k = pts.rheology.radius_exponent
-        return pts.radius**k * pts.wall._power_law_integral(np.asarray(v, dtype=float), pts.outlet_stretch, k,
-                                                            pts.tb)
+        return exact(pts.radius**k * pts.wall._power_law_integral(np.asarray(v, dtype=float), pts.outlet_stretch, k,
+                                                                  pts.tb))
 
     def _J_infinity(self, scene, index, q=None):
         index = np.asarray(index)
-        return self._J(scene, np.full(index.shape, np.inf), index) + np.zeros(index.shape)
+        return exact(self._J(scene, np.full(index.shape, np.inf), index).value + np.zeros(index.shape))
 
-    def curve_from_table(self, scene, q):
-        # a wall with an explicit inverse is served by it, not by a table (flow_controlled)
-        return None if scene.wall._has_power_law_integral_inverse() else super().curve_from_table(scene, q)
+    def _table(self, scene):
+        # a wall with an explicit inverse needs no table: the closed form answers every point
+        return None if scene.wall._has_power_law_integral_inverse() else super()._table(scene)
 
-    def flow_controlled(self, scene, flow_rate):
-        """Explicit inverse where the wall has one (linear, thin current thickness), else Newton."""
-        q = np.asarray(flow_rate, dtype=float)
-        if scene.wall.is_rigid:
-            return super().flow_controlled(scene, q)
-        if not scene.wall._has_power_law_integral_inverse():   # (a property of the wall's class and options)
-            return super().flow_controlled(scene, q)    # no explicit inverse: the tables or Newton (in logs)
-        index = np.arange(q.size)
+    def _solve_J(self, scene, target, index, q=None, upper=None):
+        """The wall's explicit inverse where it has one, else Newton's method on the closed form."""
+        if not scene.wall._has_power_law_integral_inverse():
+            return super()._solve_J(scene, target, index, q, upper)
+        target = np.asarray(target, dtype=float).ravel()
+        index = np.asarray(index).ravel()
         pts = scene.at(index)
         k = pts.rheology.radius_exponent
-        target = self.target(pts, q)
         v = pts.wall._power_law_integral_inverse(target / pts.radius**k, pts.outlet_stretch, k, pts.tb)
-        v = np.where(q == 0, 0.0, v)
-        if not np.all(v <= MAX_LOG_STRETCH):
-            self._raise_runaway(scene, q, v <= MAX_LOG_STRETCH)
-        return State(q, self.pressure_rise(scene, v, index), self.strain_at(pts, v) + 0.0 * v, v)
+        v = np.where(target == 0, 0.0, v) + np.zeros(target.shape)
+        if upper is not None:
+            v = np.minimum(v, upper)
+        ok = v <= _inverse.MAX_LOG_STRETCH
+        value = np.where(ok, target, self._J_infinity(scene, index).value)
+        return v, ok, exact(value)

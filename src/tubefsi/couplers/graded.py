@@ -39,7 +39,7 @@ import attrs
 import numpy as np
 
 from .._lazy import lazy_module
-from .._quadrature import adaptive
+from ..numerics.quadrature import adaptive
 from ..errors import (AccuracyWarning, ConvergenceError, InvalidParameterError, NoSteadyStateError,
                       StretchRangeError, warn_user)
 from ..fields import _array_fields, at_position, model_at

@@ -1,10 +1,11 @@
 r"""``quadrature``: any rheology with any wall, by the separated-variables identity.
 
-:math:`J(v) = \int_0^v s P'(s)/G(q, as)\,du` is evaluated by adaptive Gauss–Kronrod
-quadrature in the log-stretch :math:`u` with an a-posteriori error estimate per point
-(``docs/theory.md``, section "Coupling without an ODE"), and the inlet log-stretch is found by
-safeguarded Newton iteration. No ODE is integrated. Toward a wall's locking stretch the
-integral is graded in :math:`\ln(v_{max} - u)` (:meth:`SeparatedVariables.integrate`).
+:math:`J(v) = \int_0^v s P'(s)/G(q, as)\,du` is evaluated by adaptive Gauss–Kronrod quadrature
+in the log-stretch :math:`u` with an a-posteriori error estimate per point (``docs/theory.md``,
+section "Coupling without an ODE"). The inlet log-stretch is found from one batch of integrand
+values per point where a Chebyshev interpolant's tail vouches for it, else by safeguarded Newton
+iteration (:mod:`tubefsi.couplers._inverse`). No ODE is integrated. Toward a wall's locking
+stretch the integral is graded in :math:`\ln(v_{max} - u)`.
 """
 
 from __future__ import annotations
@@ -15,6 +16,8 @@ import attrs
 import numpy as np
 
 from ..fields import real
+from ..numerics.quadrature import Integral
+from . import _inverse
 from ._options import flag, integer, tolerance
 from .separated import SeparatedVariables
 
@@ -49,6 +52,9 @@ class Quadrature(SeparatedVariables):
     def _coarse(self) -> bool:
         return self.order is not None
 
+    def _table_options(self):
+        return None if self._coarse else (self.rtol,)
+
     def max_flow_rate(self, scene):
         # a property of the problem, not of the rule: a coarse rule must not move it
         return (Quadrature() if self._coarse else super()).max_flow_rate(scene)
@@ -77,3 +83,23 @@ class Quadrature(SeparatedVariables):
             def f(u, i):
                 return self.integrand(scene.at(index[i], column=True), u, qq[i, None])
         return self.integrate(scene, f, v, index, order=self.order, panel_width=self.panel_width)
+
+    def _solve_J(self, scene, target, index, q=None, upper=None):
+        """One batch of integrand values per point first (a separable fluid, the adaptive rule),
+        safeguarded Newton for the points it cannot vouch for."""
+        target = np.asarray(target, dtype=float).ravel()
+        index = np.asarray(index).ravel()
+        if self._coarse or not scene.rheology.separable or not np.any(target > 0):
+            return super()._solve_J(scene, target, index, q, upper)
+        bound = 0.5 * _inverse.log_stretch_cap(scene, index)
+        if upper is not None:
+            bound = np.minimum(bound, upper)
+        v, solved = _inverse.one_batch(self, scene, target, index, bound)
+        ok = np.ones(target.size, dtype=bool)
+        final = Integral.exact(target)              # the interpolant's tail met the tolerance
+        rest = np.flatnonzero(~solved & (target > 0))
+        if rest.size:
+            up = None if upper is None else np.broadcast_to(np.asarray(upper, dtype=float), target.shape)[rest]
+            v[rest], ok[rest], part = super()._solve_J(scene, target[rest], index[rest], None, up)
+            final = final.replaced(rest, part)
+        return v, ok, final

@@ -84,8 +84,8 @@ import weakref
 
 import numpy as np
 
-from .._products import rows_dot
-from .._quadrature import GAUSS_WEIGHTS, KRONROD_NODES, KRONROD_WEIGHTS, Integral, warn_unconverged
+from ..numerics.kernels import rows_dot
+from ..numerics.quadrature import GAUSS_WEIGHTS, KRONROD_NODES, KRONROD_WEIGHTS, Integral, warn_unconverged
 from ..errors import ConvergenceError, InvalidParameterError
 
 __all__ = ["FlowTable", "flow_table", "tanh_sinh", "unit_integral", "TOL"]

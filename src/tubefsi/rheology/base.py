@@ -35,7 +35,7 @@ import attrs
 import numpy as np
 
 from .._keywords import KeywordCheckedABC
-from .._numerics import as_output
+from ..numerics.kernels import as_output
 from .._validation import as_array
 from ..errors import InvalidParameterError
 from ..fields import _array_fields, evaluate, model_at

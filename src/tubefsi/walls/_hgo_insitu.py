@@ -27,7 +27,7 @@ import functools
 import numpy as np
 
 from .._lazy import lazy_module
-from .._quadrature import Integral, adaptive, quiet, warn_unconverged
+from ..numerics.quadrature import Integral, adaptive, warn_unconverged
 from ..errors import ConvergenceError, InvalidParameterError
 
 elementwise = lazy_module("scipy.optimize.elementwise", globals(), "elementwise")
@@ -114,9 +114,10 @@ class Law:
                             / np.where(self.c2 > 0, self.c2, 1.0), np.inf)
 
 
-def integrate(f, width, kinks, what, atol=0.0):
+def integrate(f, width, kinks, what, atol=0.0, *, warn=True):
     """``sum`` of adaptive quadratures of ``f(u, index)`` over ``[0, width]`` split at ``kinks``
-    (per point, ``width`` where none); warns with the estimate where one does not converge."""
+    (per point, ``width`` where none); with ``warn`` an ``AccuracyWarning`` gives the estimate where
+    one does not converge (trial points of an iteration pass False)."""
     width = np.asarray(width, dtype=float)
     edges = np.sort(np.stack([np.zeros_like(width)] + [np.minimum(k, width) for k in kinks] + [width]), axis=0)
     value = np.zeros(width.shape)
@@ -134,7 +135,7 @@ def integrate(f, width, kinks, what, atol=0.0):
     # a piece that holds a tiny part of the integral may miss its own relative tolerance: the
     # point is judged on its total
     ok |= error <= np.maximum(atol, RTOL * np.abs(value))
-    if not np.all(ok):
+    if warn:
         warn_unconverged(what, Integral(value=value, error=error, converged=ok, panels=np.zeros(value.shape, int)))
     return value
 
@@ -163,7 +164,7 @@ def membrane_rest(law, n):
     def f(e, i):
         return law.at(need[i]).H(1.0, e)
 
-    with quiet():
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         res = elementwise.find_root(f, (lo, np.zeros(need.size)), args=(np.arange(need.size),), tolerances=_TOL)
     if not np.all(res.success):
         raise ConvergenceError("the rest state of the pre-stretched HGO membrane did not converge")
@@ -186,7 +187,7 @@ def thick_rest(law, tb, installed):
     def width(e, i):
         return 0.5 * np.log1p((1.0 + e) * d[i]) if installed else 0.5 * np.log1p(d[i])
 
-    def f(e, i):
+    def f(e, i, warn=False):
         idx = need[i]
         part = law.at(idx)
         w_end = width(e, idx)
@@ -196,16 +197,16 @@ def thick_rest(law, tb, installed):
 
         scale = (np.abs(part.H(1.0, e)) + np.abs(part.H(np.exp(-2.0 * w_end), e))) * w_end
         return integrate(g, w_end, [part.kink(e, w_end)], "the rest state of the pre-stretched HGO tube",
-                         atol=1e-16 * scale)
+                         atol=1e-16 * scale, warn=warn)
 
     top = e0[need]
-    with quiet():
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         bracket = elementwise.bracket_root(f, top - 0.05 * (1.0 + top), top, xmin=np.full(need.size, -1.0 + 1e-12),
                                            xmax=top, args=(np.arange(need.size),))
         res = elementwise.find_root(f, bracket.bracket, args=(np.arange(need.size),), tolerances=_TOL)
     if not np.all(bracket.success & res.success):
         raise ConvergenceError("the rest state of the pre-stretched thick HGO tube did not converge")
-    f(res.x, np.arange(need.size))          # the root's own quadrature, its estimate checked (AccuracyWarning)
+    f(res.x, np.arange(need.size), warn=True)     # the root's own quadrature, its estimate checked (AccuracyWarning)
     e0[need] = res.x
     return e0
 

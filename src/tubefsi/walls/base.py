@@ -27,8 +27,8 @@ import numpy as np
 
 from .._keywords import KeywordCheckedABC
 from .._lazy import lazy_module
-from .._numerics import solve_signed
-from .._quadrature import quiet
+from ..numerics.quadrature import Integral, warn_unconverged
+from ..numerics.roots import solve_signed
 from .._validation import as_array, real_array
 from ..fields import evaluate, flat_points, model_at, take
 from ..errors import BucklingError, ConvergenceError, InvalidParameterError, NoSteadyStateError
@@ -88,10 +88,22 @@ class WallModel(abc.ABC, metaclass=KeywordCheckedABC):
                                                             ``closed_form_integral = True``)
     ``_power_law_integral_inverse(integral, ...)``          None; its explicit inverse, where there is one
     ``_has_power_law_integral_inverse()``                   whether that inverse is given (overridden)
-    ``_pressure_scale()``, ``_shape_key()``                 1 and every parameter: ``P = scale * P_hat(key)``
-                                                            lets a curve table serve every modulus
-    ``_pressure_needs_quadrature()``                        False (True for a generic thick wall)
+    ``_pressure_estimate(strain, tb)``                      ``_pressure_at_strain`` as an exact
+                                                            :class:`~tubefsi.numerics.quadrature.Integral`;
+                                                            a law that integrates returns its estimate
+                                                            (the root finders warn only at the answer)
+    ``_shape_key()``, ``_pressure_scale()``, ``_unit_wall()``  None, 1, None: the opt-in split
+                                                            ``P = scale * P_hat(stretch; tb, shape)`` that
+                                                            lets one table serve every modulus (see below)
     ======================================================  ==============================================
+
+    *The shape/scale split.* A law whose pressure is proportional to one modulus declares it:
+    ``_pressure_scale()`` the modulus (a float, or an array per point), ``_shape_key()`` everything
+    else the law depends on as plain values (floats, ints, strings, tuples of them) and
+    ``_unit_wall()`` the same law at unit modulus (whose ``_pressure_scale()`` is 1.0 and whose
+    ``_shape_key()`` is the same). The couplers then share one table among every wall of the same
+    class and shape (:mod:`tubefsi.couplers.tables`); ``tubefsi.testing`` checks the declaration.
+    A law that declares nothing gets no table: the same answers, from the direct path.
 
     Class attributes: ``is_rigid`` (True only for :class:`~tubefsi.walls.Rigid`),
     ``closed_form_integral`` (True where ``_power_law_integral`` is implemented, which makes
@@ -230,7 +242,7 @@ class WallModel(abc.ABC, metaclass=KeywordCheckedABC):
             # still exists), steps kept clear of a locking stretch
             room = wall._max_stretch(tb) - lam
             step = 0.1 * np.minimum(lam, np.where(np.isfinite(room), 0.2 * room, np.inf))
-            res = differentiate.derivative(lambda s, i: model_at(wall, i)._pressure_at_strain(s - 1.0, take(tb, i)), lam,
+            res = differentiate.derivative(lambda s, i: model_at(wall, i)._trial_pressure(s - 1.0, take(tb, i)), lam,
                                            args=(index,), initial_step=step, tolerances=_DIFF_TOL)
             return res.df.reshape(shape)
         # only the inverse is natural: dP/dlam = 1 / (d lam / dp), with steps no smaller than a
@@ -302,24 +314,32 @@ class WallModel(abc.ABC, metaclass=KeywordCheckedABC):
         if np.all(p == 0):
             return 1.0 + 0.0 * p
         finite = np.isfinite(p)
-        with quiet():
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             e = self._strain(np.where(finite, p, 0.0), tb)
         return np.where(p == 0, 1.0, np.where(finite, 1.0 + e, 0.0))
 
-    # -- for the tables of whole curves (``tubefsi.couplers._tables``): P = scale * P_hat(shape)
+    def _pressure_estimate(self, strain, tb) -> Integral:
+        """The pressure at hoop strain with its error estimate (exact unless the law integrates)."""
+        return Integral.exact(self._pressure_at_strain(strain, tb))
+
+    def _trial_pressure(self, strain, tb):
+        """The pressure at a trial strain of an iteration: no warning (the answer is checked)."""
+        return self._pressure_estimate(strain, tb).value
+
+    # -- the opt-in shape/scale split (the class docstring): P = scale * P_hat(stretch; tb, shape)
     def _pressure_scale(self):
-        """The modulus the tube law is proportional to (``P = scale * P_hat``); 1 unless overridden."""
+        """The modulus the tube law is proportional to (``P = scale * P_hat``); 1 unless declared."""
         return 1.0
 
     def _shape_key(self):
-        """What the tube law depends on besides ``_pressure_scale`` (hashable); all parameters
-        unless overridden."""
-        return tuple((f.name, getattr(self, f.name)) for f in attrs.fields(type(self))) if attrs.has(type(self)) \
-            else ()
+        """What the tube law depends on besides ``_pressure_scale``, as plain values; None (no
+        split declared: no table is shared) unless overridden."""
+        return None
 
-    def _pressure_needs_quadrature(self) -> bool:
-        """Whether evaluating the tube law costs a quadrature (the tables then tabulate it too)."""
-        return False
+    def _unit_wall(self):
+        """The same law at unit modulus (``_pressure_scale() == 1.0``, the same ``_shape_key()``),
+        for a declared split; None otherwise."""
+        return None
 
     # ------------------------------------------------------------------ generic inverses
     def _invert_pressure(self, pressure, tb):
@@ -336,7 +356,7 @@ class WallModel(abc.ABC, metaclass=KeywordCheckedABC):
         index = np.arange(p.size)
 
         def f(e, p, i):
-            return model_at(wall, i)._pressure_at_strain(e, take(tb, i)) - p
+            return model_at(wall, i)._trial_pressure(e, take(tb, i)) - p
 
         negative = p < 0
         if np.any(negative):                     # the collapsing branch: strains in (min_stretch - 1, 0)
@@ -347,7 +367,7 @@ class WallModel(abc.ABC, metaclass=KeywordCheckedABC):
             neg = np.flatnonzero(negative)
             bound = np.asarray(wall._collapse_stretch(tb), dtype=float) + 0.0 * p
             xmin = np.nextafter(bound[neg], 1.0) - 1.0        # inside the law's domain (the pressure is checked)
-            with quiet():
+            with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
                 bracket = elementwise.bracket_root(f, np.maximum(-np.minimum(-p[neg] / scale[neg], 0.5), 0.5 * xmin),
                                                    np.zeros(neg.size), xmin=xmin, xmax=0.0, args=(p[neg], neg))
                 res = elementwise.find_root(f, bracket.bracket, args=(p[neg], neg),
@@ -364,13 +384,13 @@ class WallModel(abc.ABC, metaclass=KeywordCheckedABC):
         # never evaluate the law at a locking stretch (where it is singular): the largest strain
         # searched is that of the last double below the lock (lam - 1 is exact for lam < 2^53)
         xmax = np.where(finite, np.nextafter(lam_max, 1.0) - 1.0, 1e15)
-        with quiet():
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             bracket = elementwise.bracket_root(f, np.zeros_like(p), np.maximum(guess, 1e-300),
                                                xmin=0.0, xmax=xmax, args=(p, index))
         if not np.all(bracket.success | (p == 0)):
             bad = int(np.argmax(~(bracket.success | (p == 0))))
-            with quiet():
-                top = float(model_at(wall, index[bad:bad + 1])._pressure_at_strain(
+            with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+                top = float(model_at(wall, index[bad:bad + 1])._trial_pressure(
                     xmax[bad:bad + 1] * 0.999999, take(tb, index[bad:bad + 1]))[0])
             limit = float(np.broadcast_to(wall._limit_pressure(tb), p.shape)[bad])
             if top < limit:     # not a physical limit: the stretch cannot be told from its lock
@@ -379,7 +399,7 @@ class WallModel(abc.ABC, metaclass=KeywordCheckedABC):
                     f"beyond it the stretch is the largest the wall admits, {float(np.ravel(lam_max)[bad]):.10g}, to "
                     "double precision" if finite[bad] else "beyond it the strain exceeds 1e15")
             raise NoSteadyStateError("pressure", limit, float(p[bad]), "the tube law never reaches it")
-        with quiet():
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             res = elementwise.find_root(f, bracket.bracket, args=(p, index),
                                         tolerances=dict(xrtol=2 * np.finfo(float).eps, xatol=1e-300))
         wall._pressure_at_strain(res.x, tb)      # the answer's own error estimate (AccuracyWarning)
@@ -398,8 +418,8 @@ class WallModel(abc.ABC, metaclass=KeywordCheckedABC):
             lower = np.asarray(self._collapse_stretch(tb), dtype=float) - 1.0 + 0.0 * p
             guess = np.maximum(guess, 0.5 * lower)
         try:
-            with quiet():                        # trial strains: no warnings (the answer is checked below)
-                e, ok = solve_signed(lambda x, i: model_at(self, i)._pressure_at_strain(x, take(tb, i)),
+            with np.errstate(over="ignore", invalid="ignore", divide="ignore"):                        # trial strains: no warnings (the answer is checked below)
+                e, ok = solve_signed(lambda x, i: model_at(self, i)._trial_pressure(x, take(tb, i)),
                                      lambda x, i: model_at(self, i)._stiffness(1.0 + x, take(tb, i)),
                                      p, guess=guess, lower=lower, upper=upper, xmax=1e15, maxiter=100)
         except ConvergenceError:

@@ -40,6 +40,7 @@ import numpy as np
 
 from ..errors import InvalidParameterError
 from ..fields import flat_points, positive, real
+from ..numerics.quadrature import Integral
 from . import _hgo_insitu as insitu
 from .hyperelastic import HyperelasticWall, ThickWall, ThinWall, axial_stretch
 
@@ -200,7 +201,7 @@ class ThinHGO(ThinWall, HolzapfelGasserOgden):
     def _dW_at_strain(self, strain):
         if self._in_situ():                        # the membrane law is formed from the strain itself
             shape, wall, (e,) = flat_points(self, strain)
-            return insitu.membrane(wall, e).reshape(shape)
+            return Integral.exact(insitu.membrane(wall, e).reshape(shape))
         return super()._dW_at_strain(strain)
 
     def _rest_kind(self):
@@ -227,14 +228,14 @@ class ThickHGO(ThickWall, HolzapfelGasserOgden):
         e = np.broadcast_to(e, (max(1, math.prod(shape)),))   # with the parameters: a scalar strain too
         return insitu.thick_pressure(wall, e, t).reshape(shape)
 
+    def _pressure_estimate(self, strain, tb):
+        return Integral.exact(self._pressure_at_strain(strain, tb)) if self._in_situ() else self._lame(strain, tb)
+
     def _stiffness(self, stretch, tb):
         if not self._in_situ():
             return super()._stiffness(stretch, tb)
         shape, wall, (lam, t) = flat_points(self, stretch, tb)
         lam = np.broadcast_to(lam, (max(1, math.prod(shape)),))
         return insitu.thick_pressure(wall, lam - 1.0, t, slope=True).reshape(shape)
-
-    def _pressure_needs_quadrature(self) -> bool:
-        return True
 
     _examples = ({**PRESETS["rabbit-carotid-adventitia"]},)     # in situ: tests/test_walls_beyond.py

@@ -48,7 +48,7 @@ import attrs
 import numpy as np
 
 from .._lazy import lazy_module
-from .._quadrature import adaptive, adaptive_to_pole, warn_unconverged
+from ..numerics.quadrature import Integral, adaptive, adaptive_to_pole, warn_unconverged
 from ..errors import InvalidParameterError
 from ..geometry import Tube
 from ..fields import choice, evaluate, flat_points, model_at, positive, take
@@ -318,12 +318,21 @@ class ThinWall(HyperelasticWall):
     _SMALL_STRAIN = 0.1
 
     def _pressure_at_strain(self, strain, tb):
-        lam = 1.0 + strain
-        p = tb * self._dW_at_strain(strain)
-        return p if self.thickness_convention == "reference" else p / lam
+        result = self._pressure_estimate(strain, tb)
+        warn_unconverged("the thin-wall law at small strain", result)
+        return result.value
 
-    def _dW_at_strain(self, strain):
-        r""":math:`\hat W'(1+\varepsilon)` without rounding :math:`1 + \varepsilon` where it matters.
+    def _pressure_estimate(self, strain, tb):
+        if type(self)._pressure_at_strain is not ThinWall._pressure_at_strain:     # a closed form overrides it
+            return Integral.exact(self._pressure_at_strain(strain, tb))
+        lam = 1.0 + strain
+        dw = self._dW_at_strain(strain)
+        p = tb * dw.value
+        return attrs.evolve(dw, value=p if self.thickness_convention == "reference" else p / lam)
+
+    def _dW_at_strain(self, strain) -> Integral:
+        r""":math:`\hat W'(1+\varepsilon)` without rounding :math:`1 + \varepsilon` where it matters,
+        with its error estimate.
 
         Forming the stretch :math:`1 + \varepsilon` rounds the strain to the spacing of doubles
         near 1, a relative error :math:`\epsilon_{mach}/\varepsilon` in :math:`\hat W'` (which
@@ -334,7 +343,9 @@ class ThinWall(HyperelasticWall):
         """
         shape, wall, (e,) = flat_points(self, strain)
         e = np.broadcast_to(e, (max(1, math.prod(shape)),))   # with the parameters: a scalar strain too
-        out = wall._dW(1.0 + e)
+        out = np.array(wall._dW(1.0 + e), dtype=float) + 0.0 * e
+        error = np.zeros(out.shape)
+        converged = np.ones(out.shape, dtype=bool)
         small = np.flatnonzero(np.abs(e) < self._SMALL_STRAIN)
         if small.size:
             es = e[small]
@@ -343,11 +354,11 @@ class ThinWall(HyperelasticWall):
                 return model_at(wall, small[i], column=True)._d2W(1.0 + t * es[i, None])
 
             result = adaptive(f, 0.0, 1.0 + 0.0 * es, rtol=1e-14)
-            if not np.all(result.converged):
-                warn_unconverged("the thin-wall law at small strain", result)
-            out = np.array(out, dtype=float) + 0.0 * e
             out[small] = es * result.value
-        return out.reshape(shape)
+            error[small] = np.abs(es) * result.error
+            converged[small] = result.converged
+        return Integral(value=out.reshape(shape), error=error.reshape(shape), converged=converged.reshape(shape),
+                        panels=np.zeros(shape, dtype=int))
 
     def _min_pressure(self, tb):
         r"""Minus the long-ring buckling pressure :math:`\mu_0\bar t^3` (:math:`E = 3\mu_0`,
@@ -369,6 +380,16 @@ class ThickWall(HyperelasticWall):
     _RTOL = 1e-14
 
     def _pressure_at_strain(self, strain, tb):
+        result = self._lame(strain, tb)
+        warn_unconverged("the thick-wall (Lamé) integral", result)
+        return result.value
+
+    def _pressure_estimate(self, strain, tb):
+        if type(self)._pressure_at_strain is not ThickWall._pressure_at_strain:     # a closed form overrides it
+            return Integral.exact(self._pressure_at_strain(strain, tb))
+        return self._lame(strain, tb)
+
+    def _lame(self, strain, tb) -> Integral:
         r""":math:`\int_{\ln\lambda_o}^{\ln\lambda} s\,\hat W'(s)/(s^2-1)\,du`, :math:`s = e^u`, by adaptive
         Gauss–Kronrod quadrature with an a-posteriori error estimate per point; graded toward a
         locking stretch in :math:`\ln(\ln\lambda_{max} - u)`."""
@@ -395,12 +416,8 @@ class ThickWall(HyperelasticWall):
             return sg * s * model_at(wall, idx, column=True)._thick_integrand(s)
 
         result = adaptive_to_pole(f, 0.0, width, pole, gap=gap, rtol=self._RTOL)
-        if not np.all(result.converged):
-            warn_unconverged("the thick-wall (Lamé) integral", result)
-        return result.value.reshape(shape)
-
-    def _pressure_needs_quadrature(self) -> bool:
-        return type(self)._pressure_at_strain is ThickWall._pressure_at_strain
+        return Integral(value=result.value.reshape(shape), error=result.error.reshape(shape),
+                        converged=result.converged.reshape(shape), panels=result.panels.reshape(shape))
 
     def _min_pressure(self, tb):
         r"""Minus the long-ring buckling pressure taken at the outer radius,

@@ -21,7 +21,7 @@ from __future__ import annotations
 import attrs
 import numpy as np
 
-from .._numerics import expm1_ratio, log1p_ratio
+from ..numerics.kernels import expm1_ratio, log1p_ratio
 from ..fields import choice, positive, real
 from .base import WallModel
 
@@ -43,6 +43,9 @@ class _LinearWall(WallModel):
 
     def _shape_key(self):
         return tuple((f.name, getattr(self, f.name)) for f in attrs.fields(type(self)) if f.name != "youngs_modulus")
+
+    def _unit_wall(self):
+        return attrs.evolve(self, youngs_modulus=1.0)
 
     def _compliance(self, tb):
         """:math:`d\\lambda/dp` (1/Pa)."""

@@ -57,6 +57,9 @@ class MooneyRivlin(HyperelasticWall):
         lz = self.axial_stretch
         return 2.0 * (self.c1 / lz + self.c2 * lz)
 
+    def _unit_parameters(self):
+        return {"c1": 0.5, "c2": 0.0, "axial_stretch": 1.0}
+
 
 @attrs.frozen(kw_only=True)
 class ThinMooneyRivlin(_ThinForms, ThinWall, MooneyRivlin):

@@ -26,7 +26,8 @@ import math
 import attrs
 import numpy as np
 
-from .._numerics import expm1_ratio, log1p_ratio, solve_signed
+from ..numerics.kernels import expm1_ratio, log1p_ratio
+from ..numerics.roots import solve_signed
 from ..fields import positive
 from .hyperelastic import HyperelasticWall, ThickWall, ThinWall, axial_stretch
 
@@ -44,6 +45,10 @@ class _NeoHookeanLaw:
 
     def _shape_key(self):
         return (getattr(self, "thickness_convention", "thick"),)
+
+    def _unit_wall(self):
+        # the law of the installed tube is the modulus times that of the unit neo-Hookean law
+        return attrs.evolve(self, **self._unit_parameters())
 
     def _dW(self, stretch):
         return self._installed_modulus() * (stretch - stretch**-3)
@@ -255,6 +260,9 @@ class NeoHookean(HyperelasticWall):
 
     def _installed_modulus(self):
         return self.shear_modulus / self.axial_stretch
+
+    def _unit_parameters(self):
+        return {"shear_modulus": 1.0, "axial_stretch": 1.0}
 
 
 @attrs.frozen(kw_only=True)

@@ -26,7 +26,8 @@ import math
 import attrs
 import numpy as np
 
-from .._numerics import expm1_ratio, solve_signed
+from ..numerics.kernels import expm1_ratio
+from ..numerics.roots import solve_signed
 from ..fields import positive
 from .base import WallModel
 
@@ -53,6 +54,9 @@ class Shapiro(WallModel):
 
     def _shape_key(self):
         return (self.n1, self.n2)
+
+    def _unit_wall(self):
+        return attrs.evolve(self, tube_stiffness=1.0)
 
     def _pressure_at_strain(self, strain, tb):
         x = np.log1p(np.asarray(strain, dtype=float))

@@ -50,6 +50,9 @@ class Fung(HyperelasticWall):
     def _shape_key(self):
         return (self.stiffening, self.axial_stretch, getattr(self, "thickness_convention", "thick"))
 
+    def _unit_wall(self):
+        return attrs.evolve(self, shear_modulus=1.0)
+
     def _max_stretch(self, tb):
         # b (I1 - 3) = 600: (lam - 1/lam)^2 = lz (600/b - c)
         lz = self.axial_stretch

@@ -51,6 +51,9 @@ class Gent(HyperelasticWall):
     def _shape_key(self):
         return (self.locking_parameter, self.axial_stretch, getattr(self, "thickness_convention", "thick"))
 
+    def _unit_wall(self):
+        return attrs.evolve(self, shear_modulus=1.0)
+
     def _reach(self):
         r""":math:`\lambda_z(J_m - c)`: the largest :math:`(\lambda - 1/\lambda)^2` of the installed tube."""
         return self.axial_stretch * (self.locking_parameter - self._installed_invariants(1.0)[0])

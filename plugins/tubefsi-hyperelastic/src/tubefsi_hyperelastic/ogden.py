@@ -97,6 +97,9 @@ class Ogden(LimitPoint, HyperelasticWall):
         return (tuple(m / total for m in self.moduli), self.exponents, self.axial_stretch,
                 getattr(self, "thickness_convention", "thick"))
 
+    def _unit_wall(self):               # from the shape alone (its scale is 1 to rounding)
+        return attrs.evolve(self, moduli=self._shape_key()[0])
+
     def _terms(self):
         return zip((2.0 * m / a for m, a in zip(self._installed_moduli(), self.exponents)), self.exponents)
 

@@ -53,6 +53,10 @@ class Yeoh(LimitPoint, HyperelasticWall):
     def _shape_key(self):
         return (self.c2 / self.c1, self.c3 / self.c1, self.axial_stretch, getattr(self, "thickness_convention", "thick"))
 
+    def _unit_wall(self):               # from the shape alone: equal shapes give the same unit wall
+        c2, c3, _, _ = self._shape_key()
+        return attrs.evolve(self, c1=1.0, c2=c2, c3=c3)
+
     def _W1(self, i1, i2):       # dW/dI1 at y = I1 - 3
         return self.c1 + i1 * (2.0 * self.c2 + 3.0 * self.c3 * i1)
 

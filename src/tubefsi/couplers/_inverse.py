@@ -1,0 +1,482 @@
+r"""The direct solution of the separated identity, point by point (vectorized over points).
+
+Where no table serves a point (:mod:`tubefsi.couplers.tables`), its inlet log-stretch :math:`v`
+solves :math:`J(v) = T` directly:
+
+* :func:`one_batch` (the ``quadrature`` coupler's first try): one batch of integrand values per
+  point, a Chebyshev interpolant on :math:`[0, 1.5 v_0]` integrated exactly
+  (:func:`~tubefsi.numerics.spectral.solve_integral`), accepted only where the tail of its
+  coefficients meets the tolerance;
+* :func:`newton`: safeguarded Newton on :math:`\ln J` with the coupler's error-controlled
+  :math:`J`, from a start that an eight-point Gauss estimate of :math:`J` brings within ~1e-10.
+
+Every point takes the same steps whatever batch it comes in. The rest of the module: the
+inlet log-stretch of a pressure drop (:func:`inlet_log_stretch`), the flow rate of a
+non-separable fluid at a given inlet (:func:`solve_flow_rate`), :math:`J(\infty)` and the maximum
+flow rate, and what a point whose solve ran away is: beyond the maximum flow rate
+(``NoSteadyStateError``) or beyond the solver's range (``StretchRangeError``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .._lazy import lazy_module
+from ..errors import ConvergenceError, InvalidParameterError, NoSteadyStateError, StretchRangeError
+from ..numerics.kernels import EPS, rows_dot
+from ..numerics.quadrature import Integral, warn_unconverged
+from ..numerics.roots import solve_increasing
+from ..numerics.spectral import CHEBYSHEV_DEGREE, solve_integral
+
+optimize = lazy_module("scipy.optimize", globals(), "optimize")
+elementwise = lazy_module("scipy.optimize.elementwise", globals(), "elementwise")
+
+__all__ = ["MAX_LOG_STRETCH", "newton", "one_batch", "inlet_log_stretch", "solve_flow_rate", "j_infinity",
+           "max_flow_rate", "classify_runaway", "log_stretch_cap"]
+
+#: Largest inlet stretch (relative to the outlet) a solve may reach: ln(1e15). Not a physical
+#: limit (``max_flow_rate`` is the one limit): beyond it ``StretchRangeError``.
+MAX_LOG_STRETCH = math.log(1e15)
+#: Where :func:`j_infinity` ends its quadrature and adds the power-law tail: ln(1e8).
+_PROBE_LOG_STRETCH = math.log(1e8)
+#: A runaway solve within this relative distance of the maximum flow rate is at the limit (to the
+#: accuracy of q_max): beyond it, not beyond the solver's range.
+AT_THE_LIMIT = 1e-11
+#: Newton on ln J stops after a step below this, relative to v and to the distance to a maximum
+#: stretch: its error is then ~(step)^2 / 2 relative to both, and the evaluation it came from,
+#: that close, is the answer's error estimate (:func:`tubefsi.numerics.roots.solve_increasing`).
+_QUADRATIC_STEP = 1e-8
+#: A pressure drop below this fraction of the outlet pressure starts its Newton iteration from the
+#: linearized rise (:func:`inlet_log_stretch`): the strain difference then holds few digits.
+_SMALL_DROP = 1e-3
+#: The Gauss start: eight Gauss–Legendre nodes on [0, 1] and the end, at most eight steps.
+_START_NODES, _START_WEIGHTS = np.polynomial.legendre.leggauss(8)
+_START_NODES, _START_WEIGHTS = 0.5 * (_START_NODES + 1.0), 0.5 * _START_WEIGHTS
+_START_NODES_AND_END = np.append(_START_NODES, 1.0)
+_START_STEPS = 8
+#: A one-batch interval shorter than this (in v) tries degree 12 before degree 16: measured over
+#: the random scenes of benchmarks/speed.py, its tail met 1e-14 at every point below 0.19.
+_LOW_DEGREE, _LOW_DEGREE_REACH = 12, 0.15
+
+
+def _pick(value, index):
+    """A per-point quantity (scalar or flat array) at ``index``."""
+    return value if np.ndim(value) == 0 else value[index]
+
+
+def log_stretch_cap(scene, index):
+    """The largest log-stretch a solve may reach: below a maximum stretch, and ln(1e15)."""
+    v_max = np.asarray(_pick(scene.log_stretch_max, index), dtype=float) + np.zeros(np.shape(index))
+    return np.where(np.isfinite(v_max), np.minimum(MAX_LOG_STRETCH, v_max * (1 - 8 * EPS)), MAX_LOG_STRETCH)
+
+
+def _linear_guess(engine, scene, target, index, q):
+    """:math:`T/f(0)`, capped at 1: the root of the linearized identity."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        slope0 = engine.integrand(scene.at(index), np.zeros(target.shape), q)
+        return np.where(target > 0, np.minimum(target / slope0, 1.0), 0.0)
+
+
+def gauss_start(engine, scene, index, target, guess, q, top):
+    r"""A start within ~1e-10 of the root: Newton on an eight-point Gauss–Legendre estimate of
+    :math:`J(v)` over :math:`[0, v]` (its slope the exact integrand at :math:`v`), from the linear
+    guess until a step moves less than 1e-5 of :math:`v` (at most eight steps). Only a start: the
+    error-controlled iteration that follows decides the answer."""
+    live = np.flatnonzero((target > 0) & (guess > 0))
+    if live.size == 0:
+        return guess
+    ids, t, v = index[live], target[live], guess[live].copy()
+    hi = top[live] + np.zeros(live.size)
+    q_live = None if q is None else q[live]
+    act = np.arange(live.size)
+    with np.errstate(all="ignore"):
+        for _ in range(_START_STEPS):
+            va = v[act]
+            values = engine.integrand(scene.at(ids[act], column=True), va[:, None] * _START_NODES_AND_END,
+                                      None if q is None else q_live[act][:, None])
+            estimate = va * rows_dot(values[:, :-1], _START_WEIGHTS)
+            nxt = np.clip(va - np.log(estimate / t[act]) * estimate / values[:, -1], 0.5 * va,
+                          np.minimum(2.0 * va, hi[act]))
+            nxt = np.where(np.isfinite(nxt) & (nxt > 0), nxt, va)
+            v[act] = nxt
+            act = act[np.abs(nxt - va) > 1e-5 * va]
+            if act.size == 0:
+                break
+    out = guess.copy()
+    out[live] = v
+    return out
+
+
+def newton(engine, scene, target, index, q=None, upper=None):
+    r"""``(v, ok, final)``: safeguarded Newton on :math:`\ln J(v) = \ln T` at the points ``index``
+    (``q`` per point for a non-separable rheology), below ``upper`` and the largest log-stretch a
+    solve may reach. ``final`` is the :class:`~tubefsi.numerics.quadrature.Integral` of :math:`J`
+    at the answer (the iteration's last evaluation where it stands for it, else evaluated once
+    more). ``ok`` is False where no root exists there: ``v = inf`` where the target is at or beyond
+    :math:`J(\infty)` (without ``upper``, a wall with a limit pressure: checked before iterating,
+    ``final`` holding :math:`J(\infty)`), else the log-stretch the iteration ran to."""
+    target = np.asarray(target, dtype=float).ravel()
+    index = np.asarray(index).ravel()
+    n = target.size
+    qflat = None if scene.rheology.separable else np.broadcast_to(np.asarray(q, dtype=float), target.shape)
+    v, ok = np.zeros(n), np.ones(n, dtype=bool)
+    value, error, converged = np.array(target), np.zeros(n), np.ones(n, dtype=bool)
+    todo = np.flatnonzero(target > 0)
+    if upper is None and todo.size:
+        pts = scene.at(index[todo])
+        limited = np.isfinite(np.asarray(pts.wall._limit_pressure(pts.tb)) + np.zeros(todo.size))
+        if np.any(limited):
+            sub = todo[limited]
+            j_inf = engine._J_infinity(scene, index[sub], None if qflat is None else qflat[sub])
+            over = target[sub] >= j_inf.value * (1.0 - AT_THE_LIMIT)
+            where = sub[over]
+            v[where], ok[where] = np.inf, False
+            value[where], error[where], converged[where] = j_inf.value[over], j_inf.error[over], j_inf.converged[over]
+            todo = np.setdiff1d(todo, where, assume_unique=True)
+    if todo.size:
+        up = None if upper is None else np.broadcast_to(np.asarray(upper, dtype=float), target.shape)[todo]
+        v[todo], ok[todo], part = _iterate(engine, scene, target[todo], index[todo],
+                                           None if qflat is None else qflat[todo], up)
+        value[todo], error[todo], converged[todo] = part.value, part.error, part.converged
+    return v, ok, Integral(value=value, error=error, converged=converged, panels=np.zeros(n, dtype=int))
+
+
+def _iterate(engine, scene, target, index, qflat, upper):
+    """:func:`newton`'s iteration proper, on points with a positive target."""
+    n = target.size
+    last_ok = np.ones(n, dtype=bool)      # whether each point's last evaluation met its tolerance
+    last_error = np.zeros(n)
+    last_value = np.array(target)
+
+    def F(v, i):
+        result = engine._J(scene, v, index[i], None if qflat is None else qflat[i])
+        last_ok[i], last_error[i] = result.converged, result.error
+        last_value[i] = result.value
+        return np.asarray(result.value, dtype=float)
+
+    def dF(v, i):
+        return engine.integrand(scene.at(index[i]), v, None if qflat is None else qflat[i])
+
+    cap = log_stretch_cap(scene, index)
+    guess = _linear_guess(engine, scene, target, index, qflat)
+    if upper is not None:
+        guess = np.minimum(guess, upper)
+    guess = gauss_start(engine, scene, index, target, guess, qflat,
+                        np.minimum(0.5 * cap, np.inf if upper is None else upper))
+    capped = np.isfinite(np.asarray(_pick(scene.log_stretch_max, index), dtype=float) + np.zeros(n))
+    limit = np.where(capped, cap, np.inf)
+    upper = limit if upper is None else np.minimum(upper, limit)
+    guess = np.where(capped, np.minimum(guess, 0.5 * cap), guess)
+    evaluated = np.zeros(n, dtype=bool)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        v, ok = solve_increasing(F, dF, target, guess=guess, upper=upper, xmax=MAX_LOG_STRETCH, max_step=2.0,
+                                 log=True, evaluated=evaluated, quadratic=_QUADRATIC_STEP,
+                                 pole=np.where(capped, cap, np.inf))
+    again = np.flatnonzero(ok & ~evaluated)
+    if again.size:                 # the answer's own error estimate where the iteration ended elsewhere
+        F(v[again], again)
+    if np.any(capped):
+        # converged onto the maximum stretch without reaching the target: out of reach
+        at_cap = np.flatnonzero(capped & (v >= cap * (1 - 1e-12)))
+        if at_cap.size:
+            with np.errstate(all="ignore"):
+                short = F(v[at_cap], at_cap) < target[at_cap] * (1 - 1e-9)
+            ok = ok.copy()
+            ok[at_cap[short]] = False
+    return v, ok, Integral(value=last_value, error=last_error, converged=last_ok | ~ok, panels=np.zeros(n, dtype=int))
+
+
+def one_batch(engine, scene, target, index, bound):
+    r"""``(v, solved)``: :func:`~tubefsi.numerics.spectral.solve_integral` at the points with a
+    positive target (separable rheology), on :math:`[0, 1.5 v_0]` (:math:`v_0` the linear guess:
+    the root is within a few tens of per cent of it for a moderate strain), and on three times that
+    where the integral fell short; never beyond ``bound``. An interval shorter than
+    ``_LOW_DEGREE_REACH`` is tried at degree 12 first, at degree 16 where that interpolant's tail
+    misses: which degree answers depends on the point alone."""
+    target = np.asarray(target, dtype=float).ravel()
+    index = np.asarray(index).ravel()
+    v = np.zeros(target.size)
+    solved = np.zeros(target.size, dtype=bool)
+    bound = np.broadcast_to(bound, target.shape)
+    top = np.minimum(1.5 * _linear_guess(engine, scene, target, index, None), bound)
+
+    def attempt(points, degree):
+        """Solve ``points`` (positions) at ``degree``; returns their (good, short) masks."""
+        ids = index[points]
+
+        def f(u, i):            # u: nodes x points, so per-point quantities broadcast as rows
+            return engine.integrand(scene.at(ids[i]), u)
+
+        with np.errstate(all="ignore"):
+            x, good, short = solve_integral(f, target[points], top[points], rtol=engine._RTOL, degree=degree)
+        v[points[good]] = x[good]
+        solved[points[good]] = True
+        return good, short
+
+    live = np.flatnonzero((target > 0) & (top > 0))
+    for _ in range(2):
+        if live.size == 0:
+            break
+        near = top[live] < _LOW_DEGREE_REACH
+        low, high = live[near], live[~near]
+        short_low = np.zeros(0, dtype=int)
+        if low.size:
+            good, short = attempt(low, _LOW_DEGREE)
+            short_low = low[short]
+            high = np.concatenate([high, low[~good & ~short]])     # the tail missed: degree 16
+        short_high = high[attempt(high, CHEBYSHEV_DEGREE)[1]] if high.size else high
+        shorter = np.concatenate([short_low, short_high])
+        wider = np.minimum(3.0 * top[shorter], bound[shorter])
+        keep = wider > top[shorter]
+        top[shorter] = wider
+        live = np.sort(shorter[keep])
+    return v, solved
+
+
+def j_infinity(engine, scene, index, q=None) -> Integral:
+    r""":math:`J(\infty)` at the points ``index``: up to a maximum stretch where the tube law peaks
+    there, else the quadrature to ln(1e8) plus the power-law tail of the integrand beyond it
+    (:math:`sP' \sim s^{1-\kappa}`, :math:`\psi \sim R^{-\mu}`: a tail :math:`f(v_1)/\alpha`,
+    :math:`\alpha = \kappa - 1 - \mu > 0`); ``inf`` where the wall has no limit pressure or the
+    integrand does not decay."""
+    pts = scene.at(index)
+    n = index.size
+    value, error = np.full(n, np.inf), np.zeros(n)
+    converged = np.ones(n, dtype=bool)
+    limited = np.isfinite(np.asarray(pts.wall._limit_pressure(pts.tb)) + np.zeros(n))
+    qq = None if q is None else np.broadcast_to(np.asarray(q, dtype=float), index.shape)
+    v_max = np.asarray(pts.log_stretch_max, dtype=float) + np.zeros(n)
+    peak = limited & np.isfinite(v_max)
+    if np.any(peak):      # the tube law ends at its pressure peak: J stays finite up to it
+        part = engine._J(scene, v_max[peak] * (1 - 8 * EPS), index[peak], None if qq is None else qq[peak])
+        value[peak], error[peak], converged[peak] = part.value, part.error, part.converged
+    far = np.flatnonzero(limited & ~peak)
+    if far.size:
+        sub = index[far]
+        sp = scene.at(sub)
+        rheo = sp.rheology
+        mu = rheo.radius_exponent
+        if mu is None:            # the local exponent of G in R far out, where the probe ends
+            r = np.asarray(sp.radius * np.exp(_PROBE_LOG_STRETCH)) + np.zeros(sub.shape)
+            if rheo.separable:
+                g0, g1 = rheo._radius_factor(r), rheo._radius_factor(10 * r)
+            else:
+                g0, g1 = rheo._pressure_gradient(qq[far], r), rheo._pressure_gradient(qq[far], 10 * r)
+            mu = -np.log(g1 / g0) / np.log(10.0)
+        alpha = np.asarray(sp.wall._stiffness_decay_exponent(sp.tb)) - 1.0 - mu + np.zeros(sub.shape)
+        decays = alpha > 1e-12
+        if np.any(decays):
+            ids = sub[decays]
+            v1 = np.full(ids.size, _PROBE_LOG_STRETCH)
+            qd = None if qq is None else qq[far][decays]
+            head = engine._J(scene, v1, ids, qd)
+            tail = engine.integrand(scene.at(ids), v1, qd) / alpha[decays]
+            where = far[decays]
+            value[where], error[where], converged[where] = head.value + tail, head.error, head.converged
+    return Integral(value=value, error=error, converged=converged, panels=np.zeros(n, dtype=int))
+
+
+def max_flow_rate(engine, scene, index):
+    """The largest flow rate with a steady state at the points ``index`` of a flat scene (``inf``
+    where none): :math:`\\phi^{-1}(J(\\infty)/L)` for a separable fluid, a bracketed search in
+    :math:`\\ln q` of :math:`H(\\infty; q) = L` for any other."""
+    pts = scene.at(index)
+    limited = np.isfinite(np.asarray(pts.wall._limit_pressure(pts.tb), dtype=float) + np.zeros(index.shape))
+    out = np.full(index.shape, np.inf)
+    if not np.any(limited):
+        return out
+    ids = index[limited]
+    if not scene.rheology.separable:
+        out[limited] = [_max_flow_rate_point(engine, scene, int(i)) for i in ids]   # one search per point
+        return out
+    j_inf = engine._J_infinity(scene, ids)
+    finite = np.isfinite(j_inf.value)
+    if np.any(finite):
+        sp = scene.at(ids[finite])
+        with np.errstate(over="ignore"):
+            q = sp.rheology._flow_factor_inverse(j_inf.value[finite] / sp.length) + 0.0 * j_inf.value[finite]
+        q_all = np.full(ids.size, np.inf)
+        q_all[finite] = np.where(np.isfinite(q), q, np.inf)
+        out[limited] = q_all
+        # a stiffening law whose "limit" is where its pressure leaves double range has a maximum flow
+        # rate beyond it too (inf, exactly): an estimate matters only for a representable q_max
+        warn_unconverged("the integral to the maximum flow rate", j_inf, where=np.isfinite(q_all))
+    return out
+
+
+def _max_flow_rate_point(engine, scene, i):
+    """Non-separable rheology, point ``i``: the q with H(inf; q) = L (H decreases with q), by a
+    bracketed root search in ln q."""
+    ids = np.array([i])
+    pts = scene.at(ids)
+    L = float(np.asarray(pts.length).ravel()[0])
+    tau_y = float(scene.rheology.yield_stress)
+    if tau_y > 0 and not engine._J_infinity(scene, ids, 0.0).value[0] > L:
+        return 0.0  # even the limit pressure cannot yield the fluid all along the tube
+
+    def excess(log_q):
+        return math.log(engine._J_infinity(scene, ids, math.exp(log_q)).value[0]) - math.log(L)
+
+    a = float(np.asarray(pts.radius).ravel()[0])
+    g0 = max(float(np.asarray(pts.wall._limit_pressure(pts.tb)).ravel()[0]) / L, 4.0 * tau_y / a)
+    with np.errstate(all="ignore"):       # a start within the fluid's representable flow
+        for _ in range(40):
+            q0 = float(pts.rheology._flow_rate(np.asarray([a]), np.asarray([g0]))[0])
+            if math.isfinite(q0) and q0 > 0 or g0 <= 4.0 * tau_y / a:
+                break
+            g0 = max(1e-10 * g0, 4.0 * tau_y / a)
+    if not (math.isfinite(q0) and q0 > 0):
+        raise ConvergenceError(f"the maximum flow rate search finds no finite flow rate of {scene.rheology!r} "
+                               f"below the limit pressure gradient {g0:.6g} Pa/m")
+    log_q = math.log(q0)
+    if not math.isfinite(excess(log_q)):
+        return math.inf  # G(q, R) falls off too fast in R: every flow rate has a steady state
+    lo, hi = log_q, log_q
+    while excess(lo) < 0:              # steps of e^2: the doubles' range is crossed in ~700
+        lo -= 2.0
+        if log_q - lo > 1500:
+            raise ConvergenceError(f"the maximum flow rate search of {scene.rheology!r} does not bracket it")
+    try:
+        while excess(hi) > 0:
+            hi += 2.0
+            if hi - log_q > 200:
+                return math.inf
+    except InvalidParameterError:      # beyond the flow the fluid's law represents: none bigger
+        return math.inf
+    return math.exp(optimize.brentq(excess, lo, hi, xtol=1e-15, rtol=4 * np.finfo(float).eps))
+
+
+def classify_runaway(engine, scene, q, bad, v, final, *, raise_):
+    """What the points ``bad`` (positions) whose solve found no root are. Where the solve found the
+    target at or beyond :math:`J(\infty)` (``v = inf``, ``final.value`` the integral there) the
+    point is beyond its maximum flow rate; elsewhere (the iteration ran away) the maximum flow
+    rate decides (to its accuracy, :data:`AT_THE_LIMIT`). Points beyond it are returned (with
+    ``raise_``, the first is a ``NoSteadyStateError``); any other is beyond the solver's range: a
+    ``StretchRangeError`` or, below a maximum stretch, a ``NoSteadyStateError`` giving the flow rate
+    that reaches it."""
+    bad = np.asarray(bad)
+    q_bad = q[bad]
+    q_max = np.full(bad.size, np.nan)
+    known = np.isinf(v[bad])
+    if np.any(known) and scene.rheology.separable:     # beyond J(inf): the limit follows from it
+        sp = scene.at(bad[known])
+        with np.errstate(over="ignore"):
+            q_max[known] = sp.rheology._flow_factor_inverse(final.value[bad[known]] / sp.length)
+    if not np.all(known):
+        rest = bad[~known]
+        q_max[~known] = np.broadcast_to(np.asarray(engine.max_flow_rate(scene.take(rest) if scene.size > 1 else scene),
+                                                   dtype=float), rest.shape)
+    beyond = known | (np.isfinite(q_max) & (q_bad >= q_max * (1.0 - AT_THE_LIMIT)))
+    if raise_ and np.any(beyond):
+        i = int(np.argmax(beyond))
+        if np.isnan(q_max[i]):          # a non-separable fluid: its limit, for the message
+            q_max[i] = float(engine.max_flow_rate(scene.point(int(bad[i]))))
+        detail = "the tube inflates without bound" + ("" if q_bad[i] >= q_max[i] else (
+            f" (this flow rate is the maximum one to within {AT_THE_LIMIT:.0e}, its accuracy)"))
+        raise NoSteadyStateError("flow_rate", float(q_max[i]), float(q_bad[i]), detail)
+    if np.all(beyond):
+        return bad
+    i = int(np.argmax(~beyond))
+    one = scene.point(int(bad[i]))
+    ids = np.array([0])
+    cap = np.atleast_1d(log_stretch_cap(one, ids))
+    pts = one.at(ids)
+    if one.rheology.separable:
+        reach = float(np.ravel(pts.rheology._flow_factor_inverse(engine._J(one, cap, ids).value / pts.length))[0])
+    else:
+        reach = float(solve_flow_rate(engine, one, cap, engine.pressure_rise(one, cap, ids, warn=False), ids)[0])
+    if float(cap[0]) < MAX_LOG_STRETCH:
+        raise NoSteadyStateError("flow_rate", reach, float(q_bad[i]),
+                                 "the inlet stretch would reach the wall's maximum stretch")
+    limit = "max_flow_rate is inf" if not math.isfinite(q_max[i]) else f"below max_flow_rate = {q_max[i]:.6g} m^3/s"
+    raise StretchRangeError(reach, float(q_bad[i]), f"a steady state exists ({limit}) but its inlet stretch exceeds "
+                            "1e15, and R/L far exceeds 0.1 there: the model no longer applies")
+
+
+def inlet_log_stretch(engine, scene, dp, index):
+    r"""The inlet log-stretch under the pressure drop ``dp`` at the points ``index``.
+
+    With an unloaded outlet, :math:`v = \mathrm{log1p}(\varepsilon(\Delta p))` from the tube law's
+    inverse. With an outlet pressure, differencing the strains at :math:`p_{out}` and
+    :math:`p_{out} + \Delta p` would lose :math:`\varepsilon_{mach}\,p_{out}/\Delta p`; so the strain
+    difference only starts a Newton iteration on the pressure rise itself,
+    :math:`\int_0^v sP'(s)\,du = \Delta p`.
+    """
+    pts = scene.at(index)
+    e_in = pts.wall._strain(pts.outlet_pressure + dp, pts.tb)
+    v = np.log1p((e_in - pts.outlet_strain) / pts.outlet_stretch)
+    loaded = (np.asarray(pts.outlet_pressure) + np.zeros(dp.shape)) != 0      # transmural: may be < 0
+    polish = np.flatnonzero(loaded & (dp > 0))
+    if polish.size == 0:
+        return v
+    sub = index[polish]
+
+    def F(x, i):
+        return engine.pressure_rise(scene, x, sub[i], warn=False)
+
+    def dF(x, i):
+        return engine._slope(scene.at(sub[i]), x)
+
+    # a drop far below the outlet pressure: the strain difference is rounding noise, and Newton on
+    # ln F from far above a tiny root only bisects; the linearized rise is within O(v) of the root
+    guess = np.maximum(v[polish], 0.0)
+    small = dp[polish] <= _SMALL_DROP * np.abs(np.asarray(pts.outlet_pressure) + np.zeros(dp.shape))[polish]
+    if np.any(small):
+        guess[small] = dp[polish][small] / dF(np.zeros(int(np.count_nonzero(small))), np.flatnonzero(small))
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        w, _ = solve_increasing(F, dF, dp[polish], guess=guess, max_step=2.0, log=True)
+    engine.pressure_rise(scene, w, sub)          # the answer's own error estimate
+    v = v.copy()
+    v[polish] = w
+    return v
+
+
+def solve_flow_rate(engine, scene, v, dp, index):
+    r"""Non-separable rheology: find q with H(v; q) = L (H decreases with q), per point.
+
+    Rigid tubes of the outlet and inlet radii under the mean gradient dp/L bracket q. A
+    yield-stress fluid has a finite :math:`H(v; 0^+)`, with :math:`G = 2\tau_y/R`: where it does
+    not exceed L the pressure drop cannot yield the fluid all along the tube, and q = 0.
+    """
+    pts = scene.at(index)
+    a, L, rheo = pts.radius, pts.length, pts.rheology
+    v = np.asarray(v, dtype=float)
+    dp = np.asarray(dp, dtype=float)
+    g = np.where(dp == 0, 1.0, dp) / L
+    q_lo = rheo._flow_rate(a * pts.outlet_stretch + 0.0 * g, g)
+    q_hi = rheo._flow_rate(a * engine.stretch_at(pts, v), g)
+    flowing = (q_hi > 0) & (dp > 0)
+    if scene.rheology.yield_stress > 0 and np.any(flowing):
+        sel = np.flatnonzero(flowing)
+        flowing[sel] = engine._J(scene, v[sel], index[sel], np.zeros(sel.size)).value > _pick(L + 0.0 * v, sel)
+    q = np.zeros(v.shape)
+    if not np.any(flowing):
+        return q
+    sel = np.flatnonzero(flowing)
+    v_s, q_lo, q_hi = v[sel], q_lo[sel], q_hi[sel]
+    ids = index[sel]
+    log_length = np.log(np.asarray(L, dtype=float) + np.zeros(v.shape))[sel]
+
+    def f(log_q, v, i, log_l):
+        return np.log(engine._J(scene, v, i, np.exp(log_q)).value) - log_l
+
+    hi = np.log(q_hi)
+    hi = hi + 1e-15 * np.abs(hi) + 1e-15        # above q_hi whatever the sign of ln q_hi
+    with np.errstate(divide="ignore"):
+        lo = np.log(q_lo)
+    lo = lo - 1e-12 * np.abs(lo)
+    found = np.ones(v_s.shape, dtype=bool)
+    unyielded = q_lo <= 0          # the outlet section alone would not yield: search down
+    if np.any(unyielded):
+        top = hi[unyielded]
+        br = elementwise.bracket_root(f, top - 2.0, top, xmin=top - 700.0, xmax=top,
+                                      args=(v_s[unyielded], ids[unyielded], log_length[unyielded]))
+        lo[unyielded] = br.bracket[0]
+        hi[unyielded] = np.where(br.success, br.bracket[1], hi[unyielded])
+        found[unyielded] = br.success   # else q < 1e-304 q_hi: zero in double precision
+    res = elementwise.find_root(f, (lo, hi), args=(v_s, ids, log_length),
+                                tolerances=dict(xrtol=4 * np.finfo(float).eps, xatol=1e-300))
+    q[sel] = np.where(found, np.exp(res.x), 0.0)
+    return q
