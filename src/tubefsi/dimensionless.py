@@ -44,6 +44,7 @@ import math
 import attrs
 import numpy as np
 
+from ._keywords import construct
 from .numerics.kernels import as_output as _out
 from ._validation import nonnegative_array as _nonnegative_array
 from ._validation import positive_scalar as _positive
@@ -283,14 +284,14 @@ def _build_wall(cls, params, *, gamma, beta, pressure_scale, tb):
         if gamma is not None or beta is not None:
             raise InvalidParameterError("gamma / beta", "none for the rigid wall (its FSI parameters are 0)",
                                         gamma if gamma is not None else beta)
-        return cls(**params)
+        return construct(cls, params)            # (wall_options: a wrong keyword is a KeywordError)
     if gamma is None and beta is None:
         raise InvalidParameterError("gamma / beta", "exactly one of the two", None)
     names = {f.name for f in attrs.fields(cls)} if attrs.has(cls) else set()
     if {"youngs_modulus", "poisson_ratio"} <= names:
         nu = float(params.get("poisson_ratio", 0.5))
         e = pressure_scale / (beta * tb) if beta is not None else 2.0 * (1.0 + nu) * pressure_scale / (gamma * tb)
-        return cls(**{**params, "youngs_modulus": e, "poisson_ratio": nu})
+        return construct(cls, {**params, "youngs_modulus": e, "poisson_ratio": nu})
     if not issubclass(cls, HyperelasticWall):
         raise InvalidParameterError("wall", "a hyperelastic, linear or rigid wall", cls.__name__)
     mu = pressure_scale / (gamma * tb) if gamma is not None else pressure_scale / (3.0 * beta * tb)
@@ -301,7 +302,7 @@ def _build_wall(cls, params, *, gamma, beta, pressure_scale, tb):
         params.setdefault("c1", 1.0)
         params.setdefault("c2", 0.0)
     try:
-        template = cls(**params)
+        template = construct(cls, params)
     except TypeError as exc:
         raise InvalidParameterError("wall_options", f"the parameters of {cls.__name__} (a template whose "
                                     "moduli are rescaled)", params, str(exc)) from None

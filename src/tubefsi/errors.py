@@ -65,8 +65,9 @@ class InvalidParameterError(TubefsiError, ValueError):
 
 
 class KeywordError(InvalidParameterError, TypeError):
-    """A call to a public entry point or a model constructor with an unknown keyword, or without
-    a required one.
+    """A call to a public entry point (``solve``, ``max_flow_rate``, ``advise``, ``fit``, the
+    ``Network`` API) with an unknown keyword, or without a required one. (A model, coupler or
+    ``Tube`` constructor raises Python's own ``TypeError`` instead.)
 
     Both an :class:`InvalidParameterError` (so ``except tubefsi.InvalidParameterError`` and
     ``except ValueError`` catch it, as every other bad input) and a :class:`TypeError` (what

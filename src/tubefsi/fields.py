@@ -88,11 +88,6 @@ def _convert_real_field(value, instance, field):
     return _convert_real(value, field, instance)
 
 
-#: A float comes out as it went in (what the keyword-checked ``__init__`` of
-#: :mod:`tubefsi._keywords` relies on to store a float it has range-checked itself).
-_convert_real_field.passes_floats = True
-
-
 _real_converter = attrs.Converter(_convert_real_field, takes_self=True, takes_field=True)
 
 
@@ -149,9 +144,6 @@ def _interval_validator(low, high, low_open, high_open, admissible):
         def check(instance, attribute, value):
             if not (type(value) is float and low <= value <= high):
                 general(attribute, value)
-    # what a float must satisfy, for the keyword-checked __init__ of tubefsi._keywords, which
-    # tests a float in range itself and stores it without calling this or the converter
-    check.float_interval = (low, high, low_open, high_open)
     return check
 
 
@@ -210,8 +202,6 @@ def choice(options, *, doc="", default=attrs.NOTHING):
     def check(instance, attribute, value):
         if value not in options:
             raise InvalidParameterError(attribute.name, admissible, value)
-
-    check.string_options = options          # (tubefsi._keywords: a str among them passes)
 
     return attrs.field(validator=check, default=default,
                        metadata={"unit": "", "doc": doc, "admissible": admissible, "options": options})

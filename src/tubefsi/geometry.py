@@ -7,7 +7,6 @@ import math
 import attrs
 import numpy as np
 
-from ._keywords import KeywordChecked
 from .errors import InvalidParameterError
 from .fields import positive
 from .profiles import Profile
@@ -16,7 +15,7 @@ __all__ = ["Tube"]
 
 
 @attrs.frozen(kw_only=True)
-class Tube(metaclass=KeywordChecked):
+class Tube:
     r"""An undeformed straight tube, clamped at both ends.
 
     Parameters

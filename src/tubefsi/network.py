@@ -53,7 +53,7 @@ import scipy.sparse as sp
 from scipy.sparse import csgraph
 from scipy.sparse import linalg as spla
 
-from ._keywords import KeywordChecked, checked_keywords
+from ._keywords import checked_keywords
 from ._progress import bar
 from ._validation import as_array
 from . import validity
@@ -91,7 +91,7 @@ class _Tube:
     external_pressure: float = 0.0
 
 
-class Network(metaclass=KeywordChecked):
+class Network:
     """A graph of soft tubes between named nodes.
 
     Parameters
@@ -112,6 +112,7 @@ class Network(metaclass=KeywordChecked):
         result.pressure["j"], result.flow_rate[("j", "a")]
     """
 
+    @checked_keywords
     def __init__(self, rheology=None):
         self.rheology = None if rheology is None else resolve("rheology", rheology)
         self._tubes: dict = {}

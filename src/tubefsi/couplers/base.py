@@ -36,7 +36,6 @@ from typing import ClassVar
 
 import numpy as np
 
-from .._keywords import KeywordCheckedABC
 from ..numerics.quadrature import adaptive, warn_unconverged
 from ..scene import State
 
@@ -47,7 +46,7 @@ def _flow_index(rheology, flow_rate, radius):
     return rheology._flow_index(flow_rate, radius)
 
 
-class Coupler(abc.ABC, metaclass=KeywordCheckedABC):
+class Coupler(abc.ABC):
     """Abstract solution strategy (see the module docstring for the hooks).
 
     Loads arrive as float arrays (entries >= 0, already validated); the returned

@@ -34,7 +34,6 @@ from typing import ClassVar
 import attrs
 import numpy as np
 
-from .._keywords import KeywordCheckedABC
 from ..numerics.kernels import as_output
 from .._validation import as_array
 from ..errors import InvalidParameterError
@@ -48,7 +47,7 @@ def _overrides(obj, name) -> bool:
     return getattr(type(obj), name) is not getattr(Rheology, name)
 
 
-class Rheology(abc.ABC, metaclass=KeywordCheckedABC):
+class Rheology(abc.ABC):
     r"""Abstract base of every rheology (see the module docstring for the contract). Its
     parameters are numbers or arrays, never functions of z (``varies_along_z = False``).
 

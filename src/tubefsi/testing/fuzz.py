@@ -24,8 +24,9 @@ the same code as the built-ins):
   ``Tube``, the :class:`~tubefsi.Solution` accessors, the wall and rheology methods,
   ``advise``) given NaN, infinities, values outside the field's admissible range, strings,
   booleans, complex numbers, ``None`` and arrays with one bad entry; misspelt, unknown and
-  missing keywords of every constructor and entry point (a :class:`~tubefsi.KeywordError`
-  naming the keyword and suggesting the intended one); and extreme *valid* inputs (loads of
+  missing keywords of every entry point (a :class:`~tubefsi.KeywordError` naming the keyword
+  and suggesting the intended one) and of every model, coupler and ``Tube`` constructor
+  (Python's own ``TypeError`` naming the keyword will do there); and extreme *valid* inputs (loads of
   ``1e-300`` and ``1e300``, tiny drops on a loaded outlet, stretches of ``1e300``), which must
   give a typed error or a finite value that passes its check.
 * :func:`scene_outcomes` — random valid scenes drawn by hypothesis (a registered rheology,
@@ -143,6 +144,9 @@ class Probe:
     allow_inf: bool = False
     #: for a typed error: a function of it returning ``None`` or what is wrong with its words
     words: Callable | None = None
+    #: Python's own ``TypeError`` naming ``parameter`` is an answer too (a wrong keyword to a
+    #: model, coupler or ``Tube`` constructor, which Python rejects before any code of ours runs)
+    type_error: bool = False
 
 
 @dataclasses.dataclass(frozen=True)
@@ -205,6 +209,10 @@ def run_probe(probe: Probe, time_limit: float | None = TIME_LIMIT) -> Outcome:
     if time_limit is not None and seconds > time_limit:
         return out("hang", f"{seconds:.1f} s")
     if error is not None:
+        if probe.type_error and isinstance(error, TypeError) and not isinstance(error, TubefsiError):
+            if probe.parameter and probe.parameter not in str(error):
+                return out("wrong", f"TypeError does not name {probe.parameter!r}: {error}"[:200])
+            return out("typed", "TypeError")
         if not isinstance(error, TubefsiError):
             where = error.__traceback__
             while where is not None and where.tb_next is not None:
@@ -285,14 +293,15 @@ def _model_probes(kind, name):
             kwargs = {**example, field.name: value}
             yield Probe(entry, f"{field.name}={_short(value)}", lambda kw=kwargs: cls(**kw), bad=True,
                         parameter=field.name)
-    yield from _keyword_probes(entry, cls, example)
+    yield from _keyword_probes(entry, cls, example, constructor=True)
 
 
-def _keyword_probes(entry, target, good, args=(), label=""):
+def _keyword_probes(entry, target, good, args=(), label="", constructor=False):
     """Wrong and missing keywords of a call ``target(*args, **good)``: a misspelt keyword (its last
     letter dropped, or doubled), a keyword no callable has, and each required keyword left out
     must each raise :class:`~tubefsi.KeywordError` (a ``TypeError`` too) naming it, with the
-    intended keyword suggested and the valid ones listed."""
+    intended keyword suggested and the valid ones listed. A ``constructor`` (a model, coupler or
+    ``Tube`` class) may raise Python's own ``TypeError`` naming it instead."""
     import inspect
 
     params = [p for p in inspect.signature(target).parameters.values()
@@ -321,14 +330,14 @@ def _keyword_probes(entry, target, good, args=(), label=""):
             kwargs = {**good, typo: good.get(first, 1.0)}
             kwargs.pop(first, None)
             yield Probe(entry, f"{tag}keyword {typo}=", lambda kw=kwargs: target(*args, **kw), bad=True,
-                        parameter=typo, words=words(intended=first))
+                        parameter=typo, words=words(intended=first), type_error=constructor)
     yield Probe(entry, f"{tag}keyword no_such_keyword=", lambda: target(*args, **good, no_such_keyword=1.0), bad=True,
-                parameter="no_such_keyword", words=words())
+                parameter="no_such_keyword", words=words(), type_error=constructor)
     for p in params:
         if p.default is p.empty:
             kwargs = {k: v for k, v in good.items() if k != p.name}
             yield Probe(entry, f"{tag}without {p.name}=", lambda kw=kwargs: target(*args, **kw), bad=True,
-                        parameter=p.name, words=words(missing=p.name))
+                        parameter=p.name, words=words(missing=p.name), type_error=constructor)
 
 
 def _entry_keyword_probes():
@@ -338,7 +347,7 @@ def _entry_keyword_probes():
     fluid = R["power-law"](consistency=0.017, index=0.7) if "power-law" in R else None
     wall = W["thick-neo-hookean"](shear_modulus=2e3) if "thick-neo-hookean" in W else None
     tube = Tube(**_TUBE)
-    yield from _keyword_probes("Tube", Tube, dict(_TUBE))
+    yield from _keyword_probes("Tube", Tube, dict(_TUBE), constructor=True)
     yield from _keyword_probes("Network", Network, dict(rheology=fluid))
     net = Network(rheology=fluid)
     yield from _keyword_probes("Network", net.add_tube, dict(name="t"), args=("a", "b", wall, tube), label="add_tube")

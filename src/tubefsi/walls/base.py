@@ -25,7 +25,6 @@ from typing import ClassVar
 import attrs
 import numpy as np
 
-from .._keywords import KeywordCheckedABC
 from .._lazy import lazy_module
 from ..numerics.quadrature import Integral, warn_unconverged
 from ..numerics.roots import solve_signed
@@ -47,7 +46,7 @@ def _overrides(obj, name) -> bool:
     return getattr(type(obj), name) is not getattr(WallModel, name)
 
 
-class WallModel(abc.ABC, metaclass=KeywordCheckedABC):
+class WallModel(abc.ABC):
     r"""Abstract base of every wall law (see the module docstring for the contract).
 
     Hooks (all take arrays and the reduced thickness ``tb``; implement one of the first two,
