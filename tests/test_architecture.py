@@ -18,7 +18,7 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "tubefsi"
 
 #: Lower layers first; a module may import only from its own layer or below.
 LAYERS = [
-    {"tubefsi.errors", "tubefsi.fields", "tubefsi._numerics", "tubefsi._products", "tubefsi._quadrature", "tubefsi._validation",
+    {"tubefsi.errors", "tubefsi.fields", "tubefsi.numerics", "tubefsi._validation",
      "tubefsi._progress", "tubefsi._units", "tubefsi._lazy", "tubefsi.profiles", "tubefsi._keywords",
      "tubefsi.registry"},
     {"tubefsi.geometry", "tubefsi.rheology", "tubefsi.walls"},

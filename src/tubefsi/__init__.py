@@ -30,7 +30,7 @@ __all__ = [
     "dimensionless", "fields", "Tube", "solve", "max_flow_rate", "select_coupler", "Solution", "registry",
     "advise", "Advice", "Diagnostics", "ModelValidityWarning", "fit", "FitResult", "Network", "NetworkSolution",
     "TubefsiError", "InvalidParameterError", "KeywordError", "NoSteadyStateError", "ConvergenceError", "AccuracyWarning",
-    "StretchRangeError", "BucklingError", "Profile", "sampled",
+    "StretchRangeError", "BucklingError", "Profile", "sampled", "Problem", "cache_clear", "cache_info",
 ]
 
 __version__ = "0.1.0"
@@ -39,7 +39,8 @@ __version__ = "0.1.0"
 _LAZY = {
     "dimensionless": None, "fields": None, "registry": None,
     "Tube": "geometry", "Solution": "solution", "Profile": "profiles", "sampled": "profiles",
-    "solve": "solve", "max_flow_rate": "solve", "select_coupler": "solve",
+    "solve": "solve", "max_flow_rate": "solve", "select_coupler": "solve", "Problem": "solve",
+    "cache_clear": "couplers.tables", "cache_info": "couplers.tables",
     "advise": "advise", "Advice": "advise", "Diagnostics": "advise",
     "fit": "fit", "FitResult": "fit",
     "Network": "network", "NetworkSolution": "network",

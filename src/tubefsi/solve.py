@@ -24,7 +24,7 @@ from .couplers.base import Coupler
 from .couplers.checked import checked
 from .couplers.graded import Graded
 from .couplers.rescaled import Rescaled, in_units
-from .errors import InvalidParameterError
+from .errors import InvalidParameterError, NoSteadyStateError
 from .geometry import Tube
 from .rheology.power_law import FactorRangeError
 from .scene import Scene, State, _resolve, make_scene
@@ -197,7 +197,8 @@ def _solve_scene(scene, chosen, name, controlled, load, on_infeasible, density, 
     if shape == () and scene.size == 1:             # one point: one coupler call
         values = np.array([load], dtype=float)
         state, feasible = _run(runner, scene, controlled, values, on_infeasible)
-        state = State(*(float(np.ravel(getattr(state, f))[0]) for f in _STATE_FIELDS))
+        if type(state.pressure_drop) is not float:     # (the engine's route for one point gives floats)
+            state = State(*(float(np.ravel(getattr(state, f))[0]) for f in _STATE_FIELDS))
         feasible = None if feasible is None else bool(np.ravel(feasible)[0])
     else:
         state, feasible = _solve_points(runner, scene, controlled, load, shape, on_infeasible, progress)
@@ -229,10 +230,27 @@ def _run(runner, scene, controlled, values, on_infeasible):
     try:
         if on_infeasible == "nan":
             return runner.solve_feasible(scene, values, controlled)
-        method = runner.flow_controlled if controlled == "flow_rate" else runner.pressure_controlled
-        return method(scene, values), None
+        if controlled == "flow_rate":          # (the coupler sees a point beyond the limit itself)
+            return runner.flow_controlled(scene, values), None
+        _below_limit_pressure(runner, scene, values)
+        return runner.pressure_controlled(scene, values), None
     except OverflowError:                  # a scene beyond double precision: a typed error
         raise _beyond_range(controlled, values, "an intermediate quantity overflows") from None
+
+
+def _below_limit_pressure(runner, scene, drop):
+    """Raise the NoSteadyStateError of the first pressure drop whose inlet pressure reaches the
+    largest one with a steady state (the coupler's :meth:`~tubefsi.couplers.Coupler.limit_pressure`)."""
+    limit = np.asarray(runner.limit_pressure(scene), dtype=float)
+    if not np.any(np.isfinite(limit)):
+        return
+    outlet = np.broadcast_to(np.asarray(scene.outlet_pressure, dtype=float), drop.shape)
+    beyond = drop >= np.broadcast_to(limit, drop.shape) - outlet
+    if np.any(beyond):
+        i = int(np.argmax(beyond))
+        raise NoSteadyStateError("pressure", float(np.broadcast_to(limit, drop.shape)[i]), float(outlet[i] + drop[i]),
+                                 "the inlet pressure is the outlet pressure plus the pressure drop",
+                                 name="the inlet pressure")
 
 
 def _solve_points(runner, scene, controlled, load, shape, on_infeasible, progress):
@@ -337,11 +355,13 @@ class Problem:
     coupler: Coupler
     coupler_name: str
 
+    @checked_keywords
     def __init__(self, rheology, wall, tube, *, coupler="auto", outlet_pressure=0.0, external_pressure=0.0):
         scene = make_scene(rheology, wall, tube, outlet_pressure=outlet_pressure, external_pressure=external_pressure)
         chosen, name = _choose(scene, coupler)
         self.__attrs_init__(scene=scene, coupler=chosen, coupler_name=name)
 
+    @checked_keywords
     def solve(self, *, flow_rate=None, pressure_drop=None, on_infeasible="raise", density=None,
               progress=False) -> Solution:
         """:func:`tubefsi.solve` of this problem at the given load (see there)."""
@@ -353,10 +373,6 @@ class Problem:
     def max_flow_rate(self):
         """:func:`tubefsi.max_flow_rate` of this problem (m^3/s; ``inf`` where there is none)."""
         return _max_flow_rate(self.scene, self.coupler)
-
-
-Problem.solve = checked_keywords(Problem.solve, method=True)
-Problem.__init__ = checked_keywords(Problem.__init__, method=True)
 
 
 def _radius_units(function, args, kwargs):

@@ -349,7 +349,7 @@ def _max_flow_rate_point(engine, scene, i):
 
 
 def classify_runaway(engine, scene, q, bad, v, final, *, raise_):
-    """What the points ``bad`` (positions) whose solve found no root are. Where the solve found the
+    r"""What the points ``bad`` (positions) whose solve found no root are. Where the solve found the
     target at or beyond :math:`J(\infty)` (``v = inf``, ``final.value`` the integral there) the
     point is beyond its maximum flow rate; elsewhere (the iteration ran away) the maximum flow
     rate decides (to its accuracy, :data:`AT_THE_LIMIT`). Points beyond it are returned (with
@@ -359,7 +359,7 @@ def classify_runaway(engine, scene, q, bad, v, final, *, raise_):
     bad = np.asarray(bad)
     q_bad = q[bad]
     q_max = np.full(bad.size, np.nan)
-    known = np.isinf(v[bad])
+    known = np.isinf(v[bad])          # (a root beyond J(inf): v = inf)
     if np.any(known) and scene.rheology.separable:     # beyond J(inf): the limit follows from it
         sp = scene.at(bad[known])
         with np.errstate(over="ignore"):

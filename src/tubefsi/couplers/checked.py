@@ -56,6 +56,9 @@ class Checked(Coupler):
     def max_flow_rate(self, scene) -> float:
         return self.inner.max_flow_rate(scene)
 
+    def limit_pressure(self, scene):
+        return self.inner.limit_pressure(scene)
+
     def profile(self, scene, state, z):
         return self.inner.profile(scene, state, z)
 

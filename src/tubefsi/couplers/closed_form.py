@@ -65,5 +65,11 @@ class ClosedForm(SeparatedVariables):
         if upper is not None:
             v = np.minimum(v, upper)
         ok = v <= _inverse.MAX_LOG_STRETCH
-        value = np.where(ok, target, self._J_infinity(scene, index).value)
-        return v, ok, exact(value)
+        if np.all(ok):
+            return v, ok, exact(target)
+        # no root below the solver's range: beyond J(inf) (v = inf, J(inf) its integral), or a
+        # steady state beyond the range (the largest log-stretch, for the error to say)
+        j_inf = self._J_infinity(scene, index).value
+        beyond = ~ok & (target >= j_inf * (1.0 - _inverse.AT_THE_LIMIT))
+        v = np.where(beyond, np.inf, np.where(ok, v, _inverse.MAX_LOG_STRETCH))
+        return v, ok, exact(np.where(beyond, j_inf, target))

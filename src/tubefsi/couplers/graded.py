@@ -209,7 +209,18 @@ class Graded(Coupler):
         state = self._on_uniform(scene, "flow_controlled", q)
         if state is not None:
             return state
-        rise = self._checked_rise(scene, q, np.zeros(q.shape))
+        try:
+            rise = self._checked_rise(scene, q, np.zeros(q.shape))
+        except (NoSteadyStateError, StretchRangeError) as error:
+            # an integration that cannot advance: the maximum flow rate (a dozen integrations, only
+            # now) says whether the point is beyond it, and the error gives it
+            limit = np.broadcast_to(np.asarray(self.max_flow_rate(scene), dtype=float), q.shape)
+            beyond = (q > 0) & (q >= limit)
+            if not np.any(beyond):
+                raise
+            i = int(np.argmax(beyond))
+            raise NoSteadyStateError("flow_rate", float(limit[i]), float(q[i]), "the tube inflates without bound") \
+                from error
         return self._state(scene, q, rise)
 
     def _state(self, scene, q, rise):

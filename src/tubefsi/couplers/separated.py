@@ -260,10 +260,10 @@ class SeparatedVariables(Coupler):
         return k * np.log(points.radius) + np.log(points.wall._pressure_scale())
 
     def _table_point(self, scene: Scene, table, q: float):
-        """``(v, strain, rise)`` of one flow rate through a scene of scalars from its table, in plain
-        Python, or None beyond the table's range."""
+        """``(q, rise, strain, v)`` of one flow rate through a scene of scalars from its table, in
+        plain Python (floats), or None beyond the table's range."""
         if not q > 0.0:
-            return 0.0, scene.outlet_strain, 0.0
+            return q, 0.0, scene.outlet_strain, 0.0
         rheology, tube, wall = scene.rheology, scene.tube, scene.wall
         x = (rheology._log_flow_factor(q) + math.log(tube.length) - rheology.radius_exponent * math.log(tube.radius)
              - math.log(wall._pressure_scale()))
@@ -271,7 +271,7 @@ class SeparatedVariables(Coupler):
             return None
         y, w = table.inverse.scalar(x)
         v = math.exp(y)
-        return v, math.expm1(v), wall._pressure_scale() * math.exp(w)
+        return q, wall._pressure_scale() * math.exp(w), math.expm1(v), v
 
     def _from_table(self, table, pts: Points, target):
         """``(v, rise, served)`` of the positive ``target`` s the table's range holds (arrays)."""
@@ -307,36 +307,41 @@ class SeparatedVariables(Coupler):
         if table is not None and q.size == 1 and scene.size == 1:
             answer = self._table_point(scene, table, float(q.reshape(-1)[0]))
             if answer is not None:
-                v, strain, rise = answer
-                return State(q.reshape(-1), np.array([rise]), np.array([strain]), np.array([v])), None
+                return State(*answer), None
         index = np.arange(q.size)
         pts = scene.at(index)
         target = np.where(q == 0, 0.0, self.target(pts, q))
         v, rise = np.zeros(q.shape), np.zeros(q.shape)
         direct = target > 0
+        # what the direct solve found at the points without a root: J at the answer, or J(inf)
+        found = Integral(value=np.zeros(q.shape), error=np.zeros(q.shape), converged=np.ones(q.shape, dtype=bool),
+                         panels=np.zeros(q.shape, dtype=int))
+        ok = np.ones(q.shape, dtype=bool)
         if table is not None:
             v_t, rise_t, served = self._from_table(table, pts, np.where(direct, target, 1.0))
             served &= direct
             v[served], rise[served] = v_t[served], rise_t[served]
             direct &= ~served
-        feasible = None
+            if np.any(direct) and math.isfinite(table.j_infinity):
+                # at or beyond the table's J(inf) (what max_flow_rate reports): no steady state
+                j_inf = table.j_infinity * np.exp(self._log_norm(pts)) + np.zeros(q.shape)
+                beyond = direct & (target >= j_inf * (1.0 - _inverse.AT_THE_LIMIT))
+                v[beyond], ok[beyond], found.value[beyond] = np.inf, False, j_inf[beyond]
+                direct &= ~beyond
         if np.any(direct):
             sub = np.flatnonzero(direct)
-            qq = None if scene.rheology.separable else q[sub]
-            v_d, ok, final = self._solve_J(scene, target[sub], sub, qq)
-            if not np.all(ok):
-                v_all = np.zeros(q.shape)
-                v_all[sub] = v_d
-                j_all = Integral(value=np.zeros(q.shape), error=np.zeros(q.shape), converged=np.ones(q.shape, bool),
-                                 panels=np.zeros(q.shape, int))
-                j_all.value[sub] = final.value
-                beyond = _inverse.classify_runaway(self, scene, q, sub[~ok], v_all, j_all, raise_=raise_)
-                feasible = np.ones(q.shape, dtype=bool)
-                feasible[beyond] = False
-                v_d = np.where(ok, v_d, 0.0)
-            warn_unconverged("the separated-variables integral", final, where=ok)
-            v[sub] = v_d
-            rise[sub] = self.pressure_rise(scene, v_d, sub)
+            v[sub], ok[sub], final = self._solve_J(scene, target[sub], sub, None if scene.rheology.separable else q[sub])
+            found = found.replaced(sub, final)
+            warn_unconverged("the separated-variables integral", final, where=ok[sub])
+        feasible = None
+        if not np.all(ok):
+            beyond = _inverse.classify_runaway(self, scene, q, np.flatnonzero(~ok), v, found, raise_=raise_)
+            feasible = np.ones(q.shape, dtype=bool)
+            feasible[beyond] = False
+            v[~ok] = 0.0
+        solved = np.flatnonzero(direct & ok)
+        if solved.size:
+            rise[solved] = self.pressure_rise(scene, v[solved], solved)
         rise[target == 0] = 0.0
         strain = self.strain_at(pts, v) + 0.0 * v
         if feasible is not None:

@@ -45,7 +45,8 @@ from ..geometry import Tube
 from ..numerics.chebyshev import PiecewisePolynomial, fit_piecewise
 from ..scene import Scene
 
-__all__ = ["SeparatedTable", "TableCache", "TABLES", "CacheInfo", "table_key", "build_table"]
+__all__ = ["SeparatedTable", "TableCache", "TABLES", "CacheInfo", "table_key", "build_table", "cache_clear",
+           "cache_info"]
 
 #: The range of inlet log-stretches a table covers: from 1e-9 to ln(1e4) (stretch 1e4, R/L far beyond
 #: the model) or just short of a maximum stretch.
@@ -240,3 +241,14 @@ class TableCache:
 
 #: The one cache behind :func:`tubefsi.solve`: at most 64 tables (a few hundred kB each).
 TABLES = TableCache(maxsize=64)
+
+
+def cache_clear() -> None:
+    """Forget every table of the one cache behind :func:`tubefsi.solve` (answers do not change:
+    the next solve that needs a table builds it again, to the same bits)."""
+    TABLES.clear()
+
+
+def cache_info() -> CacheInfo:
+    """The hits, misses, size and bound of the one cache behind :func:`tubefsi.solve`."""
+    return TABLES.info()

@@ -6,7 +6,6 @@ Everything here works on whole arrays at once: no Python loop runs per point.
 from __future__ import annotations
 
 import functools
-import math
 
 import numpy as np
 
@@ -75,25 +74,24 @@ def rows_dot(y, w):
     return np.einsum("pm,m->p" if np.ndim(w) == 1 else "pm,mr->pr", y, w)
 
 
-#: Columns per BLAS call in :func:`blocked_matmul`: OpenBLAS runs a product above ~2.6e5
-#: multiply-adds on several threads, which on a loaded machine costs more than the arithmetic.
+#: Columns per BLAS call in :func:`blocked_matmul`.
 _BLOCK = 256
 
 
 def blocked_matmul(a, b):
-    """``a @ b`` (``a`` of shape ``(r, m)``, ``b`` of shape ``(m, P)``) in blocks of at most 256
-    columns, each one single-threaded BLAS call."""
+    """``a @ b`` (``a`` of shape ``(r, m)``, ``b`` of shape ``(m, P)``) by BLAS on blocks of exactly
+    256 columns (the last one padded with zeros). Why: OpenBLAS picks its kernel by the problem's
+    shape and the CPU, so a column's sum could be taken in another order in a batch of another size
+    (a point solved in a batch of three differed in its last bit from the same point alone, on an
+    AVX-512 machine); one problem shape for every column makes a point's result independent of its
+    batch. Small blocks also stay below OpenBLAS's threading threshold."""
     rows, size = a.shape[0], b.shape[1]
-    if size <= _BLOCK:
-        return a @ b
     out = np.empty((rows, size))
+    block = np.zeros((b.shape[0], _BLOCK))
     for start in range(0, size, _BLOCK):
-        np.matmul(a, b[:, start:start + _BLOCK], out=out[:, start:start + _BLOCK])
+        count = min(_BLOCK, size - start)
+        block[:, :count] = b[:, start:start + count]
+        if count < _BLOCK:
+            block[:, count:] = 0.0
+        out[:, start:start + count] = (a @ block)[:, :count]
     return out
-
-
-def log_or_inf(x: float) -> float:
-    """``math.log`` of a float, ``-inf`` at 0 and ``inf`` at ``inf`` (no exception)."""
-    if x > 0.0:
-        return math.log(x) if x < math.inf else math.inf
-    return -math.inf
