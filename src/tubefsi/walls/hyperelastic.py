@@ -42,16 +42,19 @@ A new material is a dozen lines::
 from __future__ import annotations
 
 import abc
+import functools
 import math
 
 import attrs
 import numpy as np
 
 from .._lazy import lazy_module
-from ..numerics.quadrature import Integral, adaptive, adaptive_to_pole, warn_unconverged
+from ..numerics.kernels import rows_dot
+from ..numerics.quadrature import (GAUSS_WEIGHTS, KRONROD_NODES, KRONROD_WEIGHTS, Integral, adaptive, adaptive_to_pole,
+                                   warn_unconverged)
 from ..errors import InvalidParameterError
 from ..geometry import Tube
-from ..fields import choice, evaluate, flat_points, model_at, positive, take
+from ..fields import choice, evaluate, flat_points, model_at, parameter_shape, positive, take
 from .base import WallModel
 
 # SciPy on first use (tubefsi._lazy): listing the models must not import it
@@ -68,6 +71,121 @@ THICKNESS_CONVENTIONS = ("reference", "current")
 def _quartic(s):
     r""":math:`s - s^{-3} = (s-1)(s+1)(s^2+1)/s^3`, free of cancellation near 1."""
     return (s - 1.0) * (s + 1.0) * (s * s + 1.0) / s**3
+
+
+#: Within this distance of stretch 1 the thick integrand :math:`D(s)/(s^2-1)` of a material that
+#: gives only ``_dW`` is formed from its slope (:func:`_secant_slope`) instead of the ratio, whose
+#: cancellation costs up to :math:`\epsilon_{mach}/(2|s-1|)` relative for :math:`D = \mu(s - s^{-3})`
+#: (measured: 1.2e-14 at :math:`|s-1| = 1/256`, 8e-16 at 1/16): with an exact ``_d2W`` (the material's)
+#: to 1/8, where both are good to 2e-16; with ``scipy.differentiate``'s (good to 1e-14..1e-13 at a
+#: point; its interpolant, 1e-14..5e-14) to 1/256, where the two meet at about 1e-14.
+_SECANT_REACH = 0.125
+_SECANT_REACH_NUMERICAL = 1.0 / 256.0
+#: The fixed rule's embedded 10-point Gauss value must agree with its 21-point Kronrod value to
+#: this: then the Kronrod value (exact for degree 31) is good to rounding; else the point keeps
+#: the caller's other path (a slope too steep for a fixed rule over that interval).
+_SECANT_CHECK = 1e-10
+#: A numerical slope is interpolated from ``_CHEB`` Chebyshev points (first kind) on
+#: :math:`[1 - r, 1 + r]` (its singularities at least 16 r away: coefficients fall like
+#: :math:`32^{-k}`), and its interpolant integrated by the ``_CHEB // 2``-point Gauss–Legendre rule
+#: (exact for it); the last two coefficients must be below ``_CHEB_TAIL`` of the largest.
+_CHEB = 12
+_CHEB_TAIL = 1e-12
+
+
+@functools.cache
+def _chebyshev_rule():
+    """``(points, analysis, nodes, weights)``: the Chebyshev points on [-1, 1], the matrix from values
+    there to Chebyshev coefficients, and the Gauss–Legendre rule on [0, 1]."""
+    j = np.arange(_CHEB) + 0.5
+    points = np.cos(np.pi * j / _CHEB)
+    analysis = (2.0 / _CHEB) * np.cos(np.pi * np.outer(np.arange(_CHEB), j) / _CHEB)
+    analysis[0] *= 0.5
+    x, w = np.polynomial.legendre.leggauss(_CHEB // 2)
+    return points, analysis, 0.5 * (1.0 + x), 0.5 * w
+
+
+def _fixed_sum(w, y):
+    """``sum_i w[i] y[i]`` over the leading axis of ``y``, accumulated in the order of ``i`` for every
+    entry alike (so an entry's bits do not depend on the others)."""
+    acc = w[0] * y[0]
+    for i in range(1, len(w)):
+        acc = acc + w[i] * y[i]
+    return acc
+
+
+def _secant_slope(wall, h, reach):
+    r"""``(m, ok)``: :math:`m = \int_0^1 D'(1 + t h)\,dt = (D(1+h) - D(1))/h` at the strains ``h``
+    (broadcast with ``wall``'s array parameters), free of the cancellation of :math:`D(1+h) - D(1)`
+    at small :math:`h`: :math:`D'` is smooth and non-zero at 1, so rounding its argument costs nothing.
+
+    Where ``ok`` (else ``m`` is NaN and the caller keeps its other path):
+
+    * an exact ``_d2W`` (``wall._slope_given()``): the 21-point Gauss–Kronrod rule on
+      :math:`t \in [0, 1]` (the constants of :mod:`tubefsi.numerics.quadrature`), for :math:`|h| \le` ``reach``
+      and at most a quarter of the way to a locking stretch (below 1, to its inverse: the
+      plane-strain invariants are symmetric in :math:`\lambda \leftrightarrow 1/\lambda`), which keeps
+      :math:`D'`'s singularities seven half-widths from the interval's middle (the embedded Gauss
+      rule converges like :math:`13.9^{-20}` there), and where that Gauss value agrees to
+      ``_SECANT_CHECK``;
+    * a numerical ``_d2W`` (``scipy.differentiate``, whose rounding differs from one argument to the
+      next by 1e-14): the Chebyshev interpolant of :math:`D'` on :math:`[1 - r, 1 + r]`,
+      :math:`r = \min(` ``reach``, ``_SECANT_REACH_NUMERICAL``, a sixteenth of the way to a locking
+      stretch or its inverse), from its values at ``_CHEB`` fixed points per parameter set,
+      integrated exactly by Gauss–Legendre: smooth in :math:`h` (the quadrature that integrates it
+      sees no noise), as accurate as the numerical slope; for :math:`|h| \le r`, where the
+      interpolant's last coefficients are below ``_CHEB_TAIL``.
+
+    Shared by the thick wall's integrand near stretch 1 and, with an exact slope, the thin wall's
+    law at small strain.
+    """
+    h = np.asarray(h, dtype=float)
+    params = parameter_shape(wall)
+    shape = np.broadcast_shapes(h.shape, params)
+    lock = np.asarray(wall._locking_stretch(), dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        up, down = lock - 1.0, 1.0 - 1.0 / lock                 # room to the lock and to its inverse
+    m = np.full(shape, np.nan)
+    if wall._slope_given():
+        with np.errstate(invalid="ignore"):
+            limit = np.where(h >= 0, np.minimum(reach, 0.25 * up), np.minimum(reach, 0.25 * down))
+            near = np.abs(h) <= limit
+        if not np.any(near):
+            return m, np.zeros(shape, dtype=bool)
+        _, flat, (hf, near) = flat_points(wall, h, near)
+        hf, near = np.broadcast_to(hf, m.size), np.flatnonzero(np.broadcast_to(near, m.size))
+        hn = hf[near]
+        with np.errstate(over="ignore", invalid="ignore"):
+            slope = model_at(flat, near, column=True)._d2W(1.0 + hn[:, None] * KRONROD_NODES)
+            slope = np.broadcast_to(np.asarray(slope, dtype=float), (near.size, KRONROD_NODES.size))
+            kronrod = rows_dot(slope, KRONROD_WEIGHTS)          # (no BLAS: a point's bits do not depend on its batch)
+            gauss = rows_dot(slope[:, 1::2], GAUSS_WEIGHTS)
+            good = np.isfinite(kronrod) & (np.abs(kronrod - gauss) <= _SECANT_CHECK * np.abs(kronrod))
+        m.reshape(-1)[near] = np.where(good, kronrod, np.nan)
+        return m, np.isfinite(m)
+    with np.errstate(invalid="ignore"):
+        r = np.minimum(np.minimum(reach, _SECANT_REACH_NUMERICAL), np.minimum(up, down) / 16.0)
+        y = h / r                                               # the strain in units of the table's reach
+        near = np.abs(y) <= 1.0
+    if not np.any(near):
+        return m, np.zeros(shape, dtype=bool)
+    points, analysis, nodes, weights = _chebyshev_rule()
+    lead = (_CHEB,) + (1,) * len(params)                # the points ahead of the parameters' axes
+    with np.errstate(over="ignore", invalid="ignore"):
+        values = np.asarray(wall._d2W(1.0 + r * points.reshape(lead)), dtype=float)   # (_CHEB, *parameters)
+        values = np.broadcast_to(values, (_CHEB,) + np.broadcast_shapes(values.shape[1:], np.shape(r)))
+        # every sum below runs over its short axis in one fixed order, elementwise over the points
+        # (a reduction by einsum or BLAS may change its order with the batch: tubefsi.numerics.kernels.blocked_matmul)
+        coef = [_fixed_sum(analysis[k], values) for k in range(_CHEB)]
+        tail = np.abs(coef[-1]) + np.abs(coef[-2])
+        ok = near & np.isfinite(tail) & (tail <= _CHEB_TAIL * np.max(np.abs(coef), axis=0))
+        # Clenshaw at z = t y for the Gauss nodes t (|z| <= 1), then the rule
+        z = nodes.reshape((-1,) + (1,) * len(shape)) * np.where(ok, y, 0.0)
+        b1 = b2 = 0.0
+        for k in range(_CHEB - 1, 0, -1):
+            b1, b2 = coef[k] + 2.0 * z * b1 - b2, b1
+        m = np.where(ok, _fixed_sum(weights, coef[0] + z * b1 - b2), np.nan)
+    return np.array(np.broadcast_to(m, shape)), np.array(np.broadcast_to(ok, shape))
 
 
 def axial_stretch():
@@ -101,8 +219,9 @@ class HyperelasticWall(WallModel):
     ``_d2W(stretch)``                 :math:`D'(\lambda)`: from the invariants, else by ``scipy.differentiate``
     ``_current_slope(stretch)``       :math:`d(D/\lambda)/d\lambda` (thin wall, current thickness)
     ``_locking_stretch()``            ``inf``; the stretch where :math:`D` blows up (Gent)
-    ``_thick_integrand(s)``           :math:`D(s)/(s^2-1)`, with the removable singularity at
-                                      :math:`s = 1` taken from ``_d2W``; override with a form free of it
+    ``_thick_integrand(s)``           :math:`D(s)/(s^2-1)`, near :math:`s = 1` (where the ratio cancels)
+                                      the mean of ``_d2W`` over :math:`[1, s]` over :math:`s + 1`;
+                                      override with a form free of the removable singularity
     ``_installed_cross_section``      ``(radius, thickness)`` of the installed tube at rest: the
                                       stress-free ones over :math:`\sqrt{\lambda_z}` (a homogeneous rest state)
     ``_homogeneous_rest()``           True; False where the rest state is solved for (fibres)
@@ -277,16 +396,40 @@ class HyperelasticWall(WallModel):
         return 0.25 * np.asarray(self._d2W(np.ones(np.shape(tb))), dtype=float)
 
     def _thick_integrand(self, s):
-        r""":math:`\hat W'(s)/(s^2-1)`; override with a form free of the removable singularity."""
+        r""":math:`g(s) = \hat W'(s)/(s^2-1)`; override with a form free of the removable singularity.
+
+        Near :math:`s = 1` the ratio cancels (:math:`D(s)` is a difference of terms of order 1 that
+        vanishes at 1: relative rounding :math:`\epsilon_{mach}/(2|s-1|)` for :math:`\mu(s - s^{-3})`), so
+        there, with :math:`D(1) = 0` (a homogeneous rest state), it is formed from the slope:
+        :math:`g(s) = \int_0^1 D'(1 + t(s-1))\,dt\,/\,(s+1)` (:func:`_secant_slope`), within
+        ``_SECANT_REACH`` of 1, where it meets the ratio to 2e-16 (``_SECANT_REACH_NUMERICAL`` with a
+        numerical ``_d2W``, to about 1e-14: the numerical slope's own accuracy)."""
         s = np.asarray(s, dtype=float)
         if self._uses_invariants():               # D(s)/(s^2 - 1) = F(s) (s^2 + 1)/s^3: no singularity
             return self._invariant_factor(s)[0] * (s * s + 1.0) / s**3
-        near = np.abs(s - 1.0) < 1e-7
         with np.errstate(invalid="ignore", divide="ignore"):
             g = self._dW(s) / ((s - 1.0) * (s + 1.0))
-        if np.any(near):
-            g = np.where(near, 0.5 * self._d2W(np.ones_like(s)), g)
-        return g
+        if not self._homogeneous_rest():          # D(1) != 0 in general: no secant through (1, 0)
+            near = np.abs(s - 1.0) < 1e-7
+            if np.any(near):
+                g = np.where(near, 0.5 * self._d2W(np.ones_like(s)), g)
+            return g
+        reach = _SECANT_REACH if self._slope_given() else _SECANT_REACH_NUMERICAL
+        h = s - 1.0
+        if not np.any(np.abs(h) <= reach):        # (the common case far from rest: one reduction)
+            return g
+        m, ok = _secant_slope(self, h, reach)
+        if not np.any(ok):
+            return g
+        with np.errstate(invalid="ignore"):
+            return np.where(ok, m / (s + 1.0), g)
+
+    def _slope_given(self) -> bool:
+        """Whether :math:`D'` is exact (``_d2W`` overridden, or from the invariants' second derivatives),
+        rather than ``scipy.differentiate``'s."""
+        if type(self)._d2W is not HyperelasticWall._d2W:
+            return True
+        return self._uses_invariants() and type(self)._W_second is not HyperelasticWall._W_second
 
     @abc.abstractmethod
     def _pressure_at_strain(self, strain, tb): ...
@@ -337,9 +480,13 @@ class ThinWall(HyperelasticWall):
         Forming the stretch :math:`1 + \varepsilon` rounds the strain to the spacing of doubles
         near 1, a relative error :math:`\epsilon_{mach}/\varepsilon` in :math:`\hat W'` (which
         vanishes at 1). Below ``_SMALL_STRAIN`` the derivative is therefore integrated,
-        :math:`\hat W'(1+\varepsilon) = \varepsilon\int_0^1 \hat W''(1+t\varepsilon)\,dt`, by adaptive
-        Gauss–Kronrod quadrature (``_d2W`` is smooth and non-zero at 1, so rounding its argument
-        costs nothing).
+        :math:`\hat W'(1+\varepsilon) = \varepsilon\int_0^1 \hat W''(1+t\varepsilon)\,dt`: with an exact
+        ``_d2W`` by the fixed Gauss–Kronrod rule of :func:`_secant_slope` (shared with the thick wall's
+        integrand), else, or where that rule does not apply (a locking stretch nearer than four
+        strains, a slope too steep for it), by adaptive Gauss–Kronrod quadrature, which averages a
+        numerical slope's rounding (1e-14, where the thick wall's table of it is good to 5e-14: the
+        thick wall needs a smooth integrand, this one does not). ``_d2W`` is smooth and non-zero at 1,
+        so rounding its argument costs nothing.
         """
         shape, wall, (e,) = flat_points(self, strain)
         e = np.broadcast_to(e, (max(1, math.prod(shape)),))   # with the parameters: a scalar strain too
@@ -349,14 +496,22 @@ class ThinWall(HyperelasticWall):
         small = np.flatnonzero(np.abs(e) < self._SMALL_STRAIN)
         if small.size:
             es = e[small]
+            if self._slope_given():
+                mean, ok = _secant_slope(model_at(wall, small), es, self._SMALL_STRAIN)
+            else:       # a numerical slope: adaptive quadrature averages its rounding (1e-14; the table, 5e-14)
+                mean, ok = np.full(es.shape, np.nan), np.zeros(es.shape, dtype=bool)
+            rest = np.flatnonzero(~ok)
+            if rest.size:
+                er = es[rest]
 
-            def f(t, i):
-                return model_at(wall, small[i], column=True)._d2W(1.0 + t * es[i, None])
+                def f(t, i):
+                    return model_at(wall, small[rest[i]], column=True)._d2W(1.0 + t * er[i, None])
 
-            result = adaptive(f, 0.0, 1.0 + 0.0 * es, rtol=1e-14)
-            out[small] = es * result.value
-            error[small] = np.abs(es) * result.error
-            converged[small] = result.converged
+                result = adaptive(f, 0.0, 1.0 + 0.0 * er, rtol=1e-14)
+                mean[rest] = result.value
+                error[small[rest]] = np.abs(er) * result.error
+                converged[small[rest]] = result.converged
+            out[small] = es * mean
         return Integral(value=out.reshape(shape), error=error.reshape(shape), converged=converged.reshape(shape),
                         panels=np.zeros(shape, dtype=int))
 

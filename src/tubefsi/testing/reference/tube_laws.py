@@ -9,8 +9,8 @@ Materials
 ---------
 A hyperelastic material is its three-dimensional strain energy :math:`W(\lambda_1, \lambda_2,
 \lambda_3)` (:class:`NeoHookean`, :class:`MooneyRivlin`, :class:`Gent`, :class:`Fung`,
-:class:`Yeoh`, :class:`Ogden`; :class:`HoopFibre`, an anisotropic one: a neo-Hookean matrix with
-exponential fibres along the hoop direction). In the clamped (plane-strain) tube a point at the hoop stretch
+:class:`Yeoh`, :class:`Ogden`, :class:`ArrudaBoyce` (the wall-law tutorial's); :class:`HoopFibre`, an
+anisotropic one: a neo-Hookean matrix with exponential fibres along the hoop direction). In the clamped (plane-strain) tube a point at the hoop stretch
 :math:`s` has principal stretches :math:`(1/s, s, 1)`, so :math:`\hat W(s) = W(1/s, s, 1)`
 (:meth:`Material.W_hat`), and the reduced derivative :math:`\hat W'(s)` (:meth:`Material.dW`) is
 written by hand from it (checked against ``mpmath.diff`` of :math:`\hat W` by the tests).
@@ -54,7 +54,8 @@ from collections.abc import Mapping
 from mpmath import mp, mpf
 
 __all__ = [
-    "Material", "NeoHookean", "MooneyRivlin", "Gent", "Fung", "HoopFibre", "Yeoh", "Ogden", "Linear", "Installed",
+    "Material", "NeoHookean", "MooneyRivlin", "Gent", "Fung", "HoopFibre", "Yeoh", "Ogden", "ArrudaBoyce", "Linear",
+    "Installed",
     "material_from_params", "RefWall", "KINDS", "LIMIT_KINDS", "WALLS", "stretch_at_pressure",
 ]
 
@@ -246,6 +247,27 @@ class Ogden(Material):
 
     def dW_axial(self, s, lz):   # d/ds [(s lz)^-a + s^a + lz^a]
         return mp.fsum(2 * m / a * (s ** (a - 1) - s ** (-a - 1) * lz ** (-a)) for m, a in self.terms)
+
+
+class ArrudaBoyce(Material):
+    """The Arruda–Boyce (eight-chain) rubber in its five-term series, the material of the wall-law
+    tutorial (``docs/tutorials/wall-law-in-a-script.md``):
+    W = mu sum_i C_i / lm^(2i-2) (I1^i - 3^i), C = (1/2, 1/20, 11/1050, 19/7000, 519/673750)."""
+
+    C = (mpf(1) / 2, mpf(1) / 20, mpf(11) / 1050, mpf(19) / 7000, mpf(519) / 673750)
+
+    def __init__(self, shear_modulus, chain_stretch):
+        self.mu, self.lm = mpf(shear_modulus), mpf(chain_stretch)
+        self._repr = f"ArrudaBoyce({shear_modulus!r}, {chain_stretch!r})"
+
+    def W(self, l1, l2, l3):
+        i1 = l1**2 + l2**2 + l3**2
+        return self.mu * mp.fsum(c / self.lm ** (2 * i - 2) * (i1**i - 3**i) for i, c in enumerate(self.C, start=1))
+
+    def dW(self, s):   # I1 = s^2 + s^-2 + 1, dI1/ds = 2 (s - s^-3)
+        i1 = s * s + s**-2 + 1
+        return 2 * self.mu * mp.fsum(c * i * i1 ** (i - 1) / self.lm ** (2 * i - 2)
+                                     for i, c in enumerate(self.C, start=1)) * (s - s**-3)
 
 
 class Linear:
