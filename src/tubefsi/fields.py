@@ -244,12 +244,14 @@ def parameters(model) -> tuple[Parameter, ...]:
 
 
 # ------------------------------------------------------------------------- arrays of parameters
-@functools.cache
 def _array_fields(cls) -> tuple[str, ...]:
-    """The names of the fields of ``cls`` that may hold arrays (declared with :func:`real`)."""
-    if not attrs.has(cls):
+    """The names of the fields of ``cls`` that may hold arrays (declared with :func:`real`): read
+    off attrs' field list, which attrs keeps on the class itself (no cache that would keep a class
+    made at run time alive)."""
+    fields = getattr(cls, "__attrs_attrs__", None)
+    if fields is None:
         return ()
-    return tuple(f.name for f in attrs.fields(cls) if f.metadata.get("array"))
+    return tuple(f.name for f in fields if f.metadata.get("array"))
 
 
 def parameter_shape(model) -> tuple[int, ...]:

@@ -390,7 +390,6 @@ def _fixed(model):
     return tuple(getattr(model, name) for name in _scalar_fields(type(model)))
 
 
-@functools.cache
 def _scalar_fields(cls):
     arrays = set(_array_fields(cls))
     return tuple(f.name for f in attrs.fields(cls) if f.init and f.name not in arrays) if attrs.has(cls) else ()

@@ -124,7 +124,9 @@ def newton(engine, scene, target, index, q=None, upper=None):
     v, ok = np.zeros(n), np.ones(n, dtype=bool)
     value, error, converged = np.array(target), np.zeros(n), np.ones(n, dtype=bool)
     todo = np.flatnonzero(target > 0)
-    if upper is None and todo.size:
+    # (a non-separable fluid's J(inf) depends on q and costs the flow law far from the tube: asked
+    # for only where an iteration runs away, classify_runaway)
+    if upper is None and todo.size and qflat is None:
         pts = scene.at(index[todo])
         limited = np.isfinite(np.asarray(pts.wall._limit_pressure(pts.tb)) + np.zeros(todo.size))
         if np.any(limited):

@@ -40,6 +40,7 @@ import math
 import numpy as np
 
 from ..errors import NoSteadyStateError, StretchRangeError
+from ..numerics.chebyshev import fit_piecewise
 from ..numerics.kernels import EPS
 from ..numerics.quadrature import Integral, adaptive_to_pole, integrate_graded, warn_unconverged
 from ..scene import Points, Scene, State
@@ -55,6 +56,12 @@ _LOG_RANGE = 0.5 * -math.log(np.finfo(float).tiny)
 #: limit (``max_flow_rate`` is the one limit): beyond it ``StretchRangeError``.
 MAX_LOG_STRETCH = _inverse.MAX_LOG_STRETCH
 
+
+#: A curve of at least this many flow rates through one scene of a non-separable fluid is
+#: interpolated between direct solves (:meth:`SeparatedVariables._curve`).
+_CURVE_MIN_POINTS = 64
+#: Tolerance of such a curve, in ln v: the direct solves' own accuracy, not tighter.
+_CURVE_TOL = 1e-13
 
 #: An :class:`~tubefsi.numerics.quadrature.Integral` of values known exactly (a closed form).
 exact = Integral.exact
@@ -313,6 +320,7 @@ class SeparatedVariables(Coupler):
         target = np.where(q == 0, 0.0, self.target(pts, q))
         v, rise = np.zeros(q.shape), np.zeros(q.shape)
         direct = target > 0
+        solved_by_curve = None
         # what the direct solve found at the points without a root: J at the answer, or J(inf)
         found = Integral(value=np.zeros(q.shape), error=np.zeros(q.shape), converged=np.ones(q.shape, dtype=bool),
                          panels=np.zeros(q.shape, dtype=int))
@@ -328,6 +336,13 @@ class SeparatedVariables(Coupler):
                 beyond = direct & (target >= j_inf * (1.0 - _inverse.AT_THE_LIMIT))
                 v[beyond], ok[beyond], found.value[beyond] = np.inf, False, j_inf[beyond]
                 direct &= ~beyond
+        if np.count_nonzero(direct) >= _CURVE_MIN_POINTS and scene.size == 1 and not scene.rheology.separable:
+            sub = np.flatnonzero(direct)
+            curve = self._curve(scene, q[sub])
+            if curve is not None:
+                v[sub] = curve
+                direct[sub] = False
+                solved_by_curve = sub
         if np.any(direct):
             sub = np.flatnonzero(direct)
             v[sub], ok[sub], final = self._solve_J(scene, target[sub], sub, None if scene.rheology.separable else q[sub])
@@ -340,6 +355,8 @@ class SeparatedVariables(Coupler):
             feasible[beyond] = False
             v[~ok] = 0.0
         solved = np.flatnonzero(direct & ok)
+        if solved_by_curve is not None:
+            solved = np.union1d(solved, solved_by_curve)
         if solved.size:
             rise[solved] = self.pressure_rise(scene, v[solved], solved)
         rise[target == 0] = 0.0
@@ -348,6 +365,33 @@ class SeparatedVariables(Coupler):
             for values in (rise, strain, v):
                 values[~feasible] = np.nan
         return State(q, rise, strain, v), feasible
+
+    def _curve(self, scene: Scene, q):
+        r"""The inlet log-stretches of a long curve through one scene without a table (a non-separable
+        fluid): :math:`\ln v` as a function of :math:`\ln q` is smooth, so it is interpolated
+        (:func:`~tubefsi.numerics.chebyshev.fit_piecewise`) from direct solves at the nodes, each
+        panel accepted where its tail and its check points (direct solves between the nodes) agree
+        to 1e-13 in :math:`\ln v`: a few hundred direct solves serve the whole curve. None where it
+        cannot be accepted (the direct path then serves every point). Which route a point takes
+        depends on the call's flow rates alone."""
+        log_q = np.log(q)
+        lo, hi = float(log_q.min()), float(log_q.max())
+        if not hi > lo:
+            return None
+        length = np.full(1, float(scene.tube.length))
+
+        def log_v(x):
+            flow = np.exp(x)
+            ids = np.zeros(flow.size, dtype=int)
+            v, ok, final = self._solve_J(scene, np.broadcast_to(length, flow.shape), ids, flow)
+            good = ok & np.asarray(final.converged) & (v > 0)
+            return np.where(good, np.log(np.where(v > 0, v, 1.0)), np.nan)
+
+        with np.errstate(all="ignore"):
+            interpolant, error = fit_piecewise(log_v, lo, hi, degree=16, tol=_CURVE_TOL, panels=2, max_panels=64)
+        if interpolant is None:
+            return None
+        return np.exp(interpolant(np.clip(log_q, lo, hi)))
 
     def pressure_controlled(self, scene: Scene, pressure_drop) -> State:
         """Solve for the flow rate at each pressure drop (flat array, one per point)."""

@@ -25,28 +25,26 @@ error-controlled :math:`J`, the inverse against Newton's method on the forward m
 chain is checked once more against fresh evaluations of :math:`J` at 64 targets that were not
 interpolated. A table whose checks fail is not published (its scenes take the direct path).
 
-Tables are immutable and owned by a :class:`TableCache`: bounded (least recently used first out),
-thread-safe, keyed by value (weak references to the classes, the shape's plain values, never a
-model), so it keeps no model or class alive. :data:`TABLES` is the one cache behind
-:func:`tubefsi.solve` (:func:`tubefsi.cache_clear`, :func:`tubefsi.cache_info`).
+Tables are immutable and live in the one cache behind :func:`tubefsi.solve`
+(:data:`tubefsi.numerics.cache.TABLES`: bounded, thread-safe, keyed by value: weak references to the
+classes and the shape's plain values, never a model; :func:`tubefsi.cache_clear`,
+:func:`tubefsi.cache_info`).
 """
 
 from __future__ import annotations
 
-import collections
 import math
-import threading
 import weakref
 
 import attrs
 import numpy as np
 
 from ..geometry import Tube
+from ..numerics.cache import TABLES, CacheInfo, plain
 from ..numerics.chebyshev import PiecewisePolynomial, fit_piecewise
 from ..scene import Scene
 
-__all__ = ["SeparatedTable", "TableCache", "TABLES", "CacheInfo", "table_key", "build_table", "cache_clear",
-           "cache_info"]
+__all__ = ["SeparatedTable", "TABLES", "table_key", "build_table", "cache_clear", "cache_info"]
 
 #: The range of inlet log-stretches a table covers: from 1e-9 to ln(1e4) (stretch 1e4, R/L far beyond
 #: the model) or just short of a maximum stretch.
@@ -56,14 +54,6 @@ _V_LOW, _V_HIGH = 1e-9, math.log(1e4)
 _TOL_INVERSE, _TOL_FORWARD = 2e-14, 1e-14
 #: The largest accepted a-posteriori error of the whole chain (of ln v and of ln P).
 _ACCEPT = 1e-13
-_PLAIN = (float, int, str, bool, type(None))
-
-
-def _plain(value) -> bool:
-    """Whether ``value`` is a plain value (or a tuple of them): what a key may hold."""
-    if type(value) is tuple:
-        return all(_plain(item) for item in value)
-    return type(value) in _PLAIN
 
 
 def table_key(coupler, scene):
@@ -86,7 +76,7 @@ def table_key(coupler, scene):
     if type(outlet) is not float or outlet != 0.0:
         return None
     shape = wall._shape_key()
-    if shape is None or not _plain(shape):
+    if shape is None or not plain(shape):
         return None
     options = coupler._table_options()
     if options is None:
@@ -181,66 +171,6 @@ def _invert(forward, slope, x, grid_x, grid_y, lo, hi):
         if np.all(np.abs(step) <= 4e-16 * np.maximum(1.0, np.abs(y))):
             break
     return y
-
-
-@attrs.frozen
-class CacheInfo:
-    """What :meth:`TableCache.info` reports."""
-
-    hits: int
-    misses: int
-    size: int
-    maxsize: int
-
-
-class TableCache:
-    """A bounded, thread-safe cache of tables, keyed by value (:func:`table_key`).
-
-    ``get(key, build)`` returns the table of ``key``, building it with ``build()`` on a miss (a
-    failed build, None, is remembered as such). The least recently used entry leaves first beyond
-    ``maxsize``. Two threads that miss the same key at once may both build it: the tables are
-    equal to the bit, and one of them is kept. Clearing changes the time of later calls, never
-    their answers.
-    """
-
-    def __init__(self, maxsize: int = 64):
-        self.maxsize = int(maxsize)
-        self._entries = collections.OrderedDict()
-        self._lock = threading.Lock()
-        self._hits = self._misses = 0
-
-    def get(self, key, build):
-        with self._lock:
-            found = self._entries.get(key, self)
-            if found is not self:
-                self._entries.move_to_end(key)
-                self._hits += 1
-                return found
-            self._misses += 1
-        table = build()
-        with self._lock:
-            table = self._entries.setdefault(key, table)
-            self._entries.move_to_end(key)
-            while len(self._entries) > self.maxsize:
-                self._entries.popitem(last=False)
-        return table
-
-    def clear(self) -> None:
-        """Forget every table (and the counts)."""
-        with self._lock:
-            self._entries.clear()
-            self._hits = self._misses = 0
-
-    def info(self) -> CacheInfo:
-        with self._lock:
-            return CacheInfo(self._hits, self._misses, len(self._entries), self.maxsize)
-
-    def __len__(self) -> int:
-        return len(self._entries)
-
-
-#: The one cache behind :func:`tubefsi.solve`: at most 64 tables (a few hundred kB each).
-TABLES = TableCache(maxsize=64)
 
 
 def cache_clear() -> None:

@@ -38,7 +38,8 @@ from ..numerics.kernels import as_output
 from .._validation import as_array
 from ..errors import InvalidParameterError
 from ..fields import _array_fields, evaluate, model_at
-from ._flow_table import check, flow_table, rate_natural_rate, stress_natural_rate, unit_integral
+from ..numerics.quadrature import unit_integral
+from .flow_law import check, flow_table, rate_natural_rate, stress_natural_rate
 
 __all__ = ["Rheology"]
 
@@ -194,7 +195,7 @@ class Rheology(abc.ABC):
         With a yield stress the first runs over the yielded part
         :math:`\tau_y/\tau_w < t < 1` only (0 when :math:`\tau_w \le \tau_y`). Both by adaptive
         Gauss–Kronrod quadrature graded toward :math:`t = 0`
-        (:func:`tubefsi.rheology._flow_table.unit_integral`), to a relative error estimate of 1e-14
+        (:func:`tubefsi.numerics.quadrature.unit_integral`), to a relative error estimate of 1e-14
         per point: a kinked law is resolved by bisection at its kink; a point that misses the
         tolerance is an ``AccuracyWarning`` stating its estimate. Closed forms (Buckingham–Reiner
         for Bingham, ...) may override it.
@@ -225,7 +226,7 @@ class Rheology(abc.ABC):
         else:
             rate = q / rate
         rate *= 4.0 / math.pi
-        out = flow_table(self).wall_stress(rate)
+        out = flow_table(self).wall_stress(self, rate)
         out *= 2.0
         out /= r
         return out

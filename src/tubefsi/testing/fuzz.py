@@ -61,6 +61,7 @@ import collections
 import contextlib
 import dataclasses
 import math
+import types
 import signal
 import sys
 import threading
@@ -93,7 +94,7 @@ BREACHES = ("nan", "wrong", "accepted", "untyped", "hang")
 #: Seconds a single public call may take before it counts as a hang.
 TIME_LIMIT = 5.0
 
-_TUBE = dict(radius=1e-4, thickness=3e-5, length=1e-2)
+_TUBE = types.MappingProxyType({"radius": 1e-4, "thickness": 3e-5, "length": 1e-2})
 
 #: Bad values for any real parameter, whatever its range (NaN, infinities, non-numbers).
 _ALWAYS_BAD = (math.nan, -math.inf, "1", "x", True, 1e-9 + 1e-12j, None, [1.0, math.nan], object())

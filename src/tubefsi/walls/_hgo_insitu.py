@@ -24,6 +24,8 @@ from __future__ import annotations
 
 import functools
 
+import types
+
 import numpy as np
 
 from .._lazy import lazy_module
@@ -36,7 +38,7 @@ elementwise = lazy_module("scipy.optimize.elementwise", globals(), "elementwise"
 RTOL = 1e-14
 #: k2 x^2 beyond which exp(k2 x^2) would come near overflow: the maximum fibre strain
 OVERFLOW = 600.0
-_TOL = dict(xrtol=4 * np.finfo(float).eps, xatol=1e-300)
+_TOL = types.MappingProxyType({"xrtol": 4 * np.finfo(float).eps, "xatol": 1e-300})
 
 
 class Law:

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import abc
 import math
+import types
 from typing import ClassVar
 
 import attrs
@@ -37,7 +38,7 @@ differentiate = lazy_module("scipy.differentiate", globals(), "differentiate")
 elementwise = lazy_module("scipy.optimize.elementwise", globals(), "elementwise")
 
 #: scipy.differentiate tolerances: as tight as the error estimate allows
-_DIFF_TOL = dict(rtol=1e-12, atol=0.0)
+_DIFF_TOL = types.MappingProxyType({"rtol": 1e-12, "atol": 0.0})
 
 __all__ = ["WallModel"]
 

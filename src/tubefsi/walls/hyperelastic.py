@@ -44,6 +44,7 @@ from __future__ import annotations
 import abc
 import functools
 import math
+import types
 
 import attrs
 import numpy as np
@@ -61,7 +62,7 @@ from .base import WallModel
 differentiate = lazy_module("scipy.differentiate", globals(), "differentiate")
 
 #: scipy.differentiate tolerances: as tight as the error estimate allows
-_DIFF_TOL = dict(rtol=1e-12, atol=0.0)
+_DIFF_TOL = types.MappingProxyType({"rtol": 1e-12, "atol": 0.0})
 
 __all__ = ["HyperelasticWall", "ThinWall", "ThickWall", "THICKNESS_CONVENTIONS", "axial_stretch", "InstalledTube"]
 

@@ -1,0 +1,89 @@
+"""The one cache behind :func:`tubefsi.solve`: an explicit, bounded, thread-safe object.
+
+Tables (the separated identity's, :mod:`tubefsi.couplers.tables`; a fluid's flow law,
+:mod:`tubefsi.rheology.flow_law`) are accelerators: a table changes the time a solve takes, never
+its answer, because what a table holds depends only on its key, and the key describes everything
+it depends on by value (plain numbers and strings, weak references to classes: never a model, so
+the cache keeps no model or class alive). :data:`TABLES` holds at most 64 of them, the least
+recently used leaving first; :func:`tubefsi.cache_clear` empties it and :func:`tubefsi.cache_info`
+reports it.
+"""
+
+from __future__ import annotations
+
+import collections
+import threading
+
+import attrs
+
+__all__ = ["TableCache", "CacheInfo", "TABLES", "plain"]
+
+_PLAIN = (float, int, str, bool, type(None))
+
+
+def plain(value) -> bool:
+    """Whether ``value`` is a plain value (a float, int, string, bool, None, or a tuple of them):
+    what a key may hold, since it cannot change in place."""
+    if type(value) is tuple:
+        return all(plain(item) for item in value)
+    return type(value) in _PLAIN
+
+
+@attrs.frozen
+class CacheInfo:
+    """What :meth:`TableCache.info` reports."""
+
+    hits: int
+    misses: int
+    size: int
+    maxsize: int
+
+
+class TableCache:
+    """A bounded, thread-safe cache of tables, keyed by value (:func:`table_key`).
+
+    ``get(key, build)`` returns the table of ``key``, building it with ``build()`` on a miss (a
+    failed build, None, is remembered as such). The least recently used entry leaves first beyond
+    ``maxsize``. Two threads that miss the same key at once may both build it: the tables are
+    equal to the bit, and one of them is kept. Clearing changes the time of later calls, never
+    their answers.
+    """
+
+    def __init__(self, maxsize: int = 64):
+        self.maxsize = int(maxsize)
+        self._entries = collections.OrderedDict()
+        self._lock = threading.Lock()
+        self._hits = self._misses = 0
+
+    def get(self, key, build):
+        with self._lock:
+            found = self._entries.get(key, self)
+            if found is not self:
+                self._entries.move_to_end(key)
+                self._hits += 1
+                return found
+            self._misses += 1
+        table = build()
+        with self._lock:
+            table = self._entries.setdefault(key, table)
+            self._entries.move_to_end(key)
+            while len(self._entries) > self.maxsize:
+                self._entries.popitem(last=False)
+        return table
+
+    def clear(self) -> None:
+        """Forget every table (and the counts)."""
+        with self._lock:
+            self._entries.clear()
+            self._hits = self._misses = 0
+
+    def info(self) -> CacheInfo:
+        with self._lock:
+            return CacheInfo(self._hits, self._misses, len(self._entries), self.maxsize)
+
+    def __len__(self) -> int:
+        return len(self._entries)
+
+
+#: The one cache behind :func:`tubefsi.solve`: at most 64 tables (a few hundred kB each).
+TABLES = TableCache(maxsize=64)
