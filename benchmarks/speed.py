@@ -24,10 +24,15 @@ thick neo-Hookean wall, mu = 2 kPa.
 3. ``monte carlo``: one scalar solve with a fresh wall each call
    (``walls["thick-neo-hookean"](shear_modulus=mu_i)``, then ``solve(...).pressure_drop``)
    against one baseline ODE, per call;
+3b. ``numpy loop``: the loop everyone writes, ``for q in np.linspace(...): solve(..., flow_rate=q)``
+   (NumPy scalars) through one scene, against one baseline ODE per flow rate;
 4. ``random scenes``: 10^4 scenes with every parameter random (mu, m, n, a, t, L, q), one
    broadcast ``solve`` (model parameters and ``Tube`` fields as arrays) against the baseline per
    scene. If the broadcast call raises, a Python loop of scalar solves (models built in the
    loop) is timed instead and the row says "loop";
+4b. ``infeasible scenes``: the same, with 10 % of the scenes given 1.1-2 times their maximum flow
+   rate and ``on_infeasible="nan"`` (the baseline per feasible scene: it has no answer for the
+   others);
 5. ``carreau curve``: a 10^4-point Carreau-Yasuda curve (blood, Cho & Kensey constants) in the
    thick wall against the power-law baseline at the same flow rates, per point;
 6. ``carreau scalar``: one scalar Carreau-Yasuda solve with fresh fluid parameters each call
@@ -237,6 +242,30 @@ def monte_carlo(row, sizes, rng):
     row.note = f"q = {Q_MC:g} m^3/s, mu ~ U(1, 4) kPa; {sizes.calls} calls per pass"
 
 
+def numpy_loop(row, sizes, rng):
+    """``for q in np.linspace(...)``: a scalar solve per NumPy scalar, against one baseline call each."""
+    fluid, wall = power_law(), thick()
+    qs = [np.linspace(0.1, 1.0, sizes.calls) * Q_MC * rng.uniform(0.9, 1.1) for _ in range(sizes.repeats + 1)]
+    got = {}
+
+    def ours(r):
+        got["tubefsi"] = [tubefsi.solve(fluid, wall, TUBE, flow_rate=q).pressure_drop for q in qs[r]]
+
+    def theirs(r):
+        got["baseline"] = [chapter_thick(float(q), N, M, MU, TUBE) for q in qs[r]]
+
+    ours(sizes.repeats)                                                 # warm-up on the spare set
+    times = interleaved({"tubefsi": (ours, sizes.calls), "baseline": (theirs, sizes.calls)}, sizes.repeats)
+    fill_ratio(row, times["tubefsi"], times["baseline"])
+    last = qs[sizes.repeats - 1]
+    sol = tubefsi.solve(fluid, wall, TUBE, flow_rate=last)
+    dp, u = zip(*got["baseline"])
+    row.err_baseline = rel_diff(dp, u, sol.pressure_drop, sol.inlet_displacement)
+    row.err_tubefsi = rel_diff(got["tubefsi"], sol.inlet_displacement, sol.pressure_drop, sol.inlet_displacement)
+    row.note = (f"q = 0.1-1 x {Q_MC:g} m^3/s as np.float64, one scene; {sizes.calls} calls per pass; "
+                "err tfsi: the loop against one broadcast call")
+
+
 def random_scenes(count, rng):
     """``count`` scenes with every parameter random; q loads the rigid tube to 5-90 % of the limit pressure.
 
@@ -333,6 +362,51 @@ def random_row(row, sizes, rng):
         "q: rigid drop 5-90 % of the limit pressure", f"strain up to ~{strain:.2g}", faults]))
 
 
+def infeasible_row(row, sizes, rng):
+    """Random scenes, 10 % of them beyond their maximum flow rate, ``on_infeasible="nan"``: one
+    broadcast call against the baseline per feasible scene."""
+    sets = []
+    for _ in range(sizes.repeats + 1):
+        s = random_scenes(sizes.points, rng)
+        beyond = rng.random(sizes.points) < 0.1
+        tube = tubefsi.Tube(radius=s["a"], thickness=s["t"], length=s["length"])
+        q_max = tubefsi.max_flow_rate(power_law(s["m"], s["n"]), thick(s["mu"]), tube)
+        s["q"] = np.where(beyond, q_max * rng.uniform(1.1, 2.0, sizes.points), s["q"])
+        s["beyond"] = beyond
+        sets.append(s)
+    count = sizes.sample
+    got = {}
+
+    def call(s):
+        tube = tubefsi.Tube(radius=s["a"], thickness=s["t"], length=s["length"])
+        return tubefsi.solve(power_law(s["m"], s["n"]), thick(s["mu"]), tube, flow_rate=s["q"], on_infeasible="nan")
+
+    def ours(r):
+        got["tubefsi"] = call(sets[r])
+
+    feasible = [np.flatnonzero(~s["beyond"])[:count] for s in sets]
+    tubes = [[_Tube(float(s["a"][i]), float(s["t"][i]), float(s["length"][i])) for i in f] for s, f in zip(sets, feasible)]
+
+    def theirs(r):
+        s = sets[r]
+        got["baseline"] = [chapter_thick(float(s["q"][i]), float(s["n"][i]), float(s["m"][i]), float(s["mu"][i]),
+                                         tube) for i, tube in zip(feasible[r], tubes[r])]
+
+    times = interleaved({"tubefsi": (ours, sizes.points), "baseline": (theirs, count)}, sizes.repeats)
+    fill_ratio(row, times["tubefsi"], times["baseline"])
+    s, idx = sets[sizes.repeats - 1], feasible[sizes.repeats - 1]
+    sol = got["tubefsi"] if sizes.repeats % 2 else call(s)
+    marked = np.array_equal(~np.asarray(sol.feasible), s["beyond"]) if sol.feasible is not None else False
+    default = [scalar_solve(s, i) for i in idx]
+    dp, u = zip(*got["baseline"]) if sizes.repeats % 2 == 0 else zip(*[chapter_thick(
+        float(s["q"][i]), float(s["n"][i]), float(s["m"][i]), float(s["mu"][i]), t) for i, t in zip(idx, tubes[-2])])
+    row.err_baseline = rel_diff(dp, u, [d.pressure_drop for d in default], [d.inlet_displacement for d in default])
+    row.err_tubefsi = rel_diff(sol.pressure_drop[idx], sol.inlet_displacement[idx], [d.pressure_drop for d in default],
+                               [d.inlet_displacement for d in default])
+    row.note = (f"{sizes.points} scenes per tubefsi pass, {count} feasible ones per baseline pass; "
+                f"{int(s['beyond'].sum())} beyond q_max marked infeasible: {marked}")
+
+
 def carreau_yasuda(**changes):
     """Blood as a Carreau-Yasuda fluid (Cho & Kensey's constants, a = 2)."""
     try:
@@ -413,7 +487,9 @@ ROWS = [
     ("thick curve", "{N}-pt flow curve, thick neo-Hookean + power law", "ratio", "point", 300),
     ("thin curve", "{N}-pt flow curve, thin neo-Hookean (closed form)", "ratio", "point", 1000),
     ("monte carlo", "scalar solve, fresh wall each call (Monte Carlo)", "ratio", "call", 5),
+    ("numpy loop", "for q in np.linspace(...): solve (NumPy scalars)", "ratio", "call", 5),
     ("random scenes", "{N} random scenes, one broadcast call", "ratio", "scene", 30),
+    ("infeasible scenes", "{N} random scenes, 10 % beyond q_max, on_infeasible='nan'", "ratio", "scene", 30),
     ("carreau curve", "{N}-pt Carreau-Yasuda curve, thick wall", "ratio", "point", 10),
     ("carreau scalar", "scalar Carreau-Yasuda solve, fresh fluid", "absolute", "call", 10e-3),
     ("fit", "tubefsi.fit, 20 points, 3 parameters", "absolute", "fit", 30e-3),
@@ -433,7 +509,9 @@ def measure(sizes, only=None):
             row, fluid, walls["thin-neo-hookean"](shear_modulus=MU, thickness_convention="reference"), q,
             chapter_thin, sizes),
         "monte carlo": lambda row: monte_carlo(row, sizes, rng),
+        "numpy loop": lambda row: numpy_loop(row, sizes, rng),
         "random scenes": lambda row: random_row(row, sizes, rng),
+        "infeasible scenes": lambda row: infeasible_row(row, sizes, rng),
         "carreau curve": lambda row: flow_curve(row, carreau_yasuda(), wall, q_cy, chapter_thick, sizes,
                                                 baseline_fluid=fluid),
         "carreau scalar": lambda row: carreau_scalar(row, sizes, rng),

@@ -245,22 +245,30 @@ def parameters(model) -> tuple[Parameter, ...]:
 
 # ------------------------------------------------------------------------- arrays of parameters
 def _array_fields(cls) -> tuple[str, ...]:
-    """The names of the fields of ``cls`` that may hold arrays (declared with :func:`real`): read
-    off attrs' field list, which attrs keeps on the class itself (no cache that would keep a class
-    made at run time alive)."""
-    fields = getattr(cls, "__attrs_attrs__", None)
-    if fields is None:
-        return ()
-    return tuple(f.name for f in fields if f.metadata.get("array"))
+    """The names of the fields of ``cls`` that may hold arrays (declared with :func:`real`), read
+    off attrs' field list once and kept on the class itself, as attrs keeps that list (no
+    module-level cache, which would keep a class made at run time alive)."""
+    found = cls.__dict__.get("_tubefsi_array_fields")
+    if found is None:
+        fields = getattr(cls, "__attrs_attrs__", None)
+        found = () if fields is None else tuple(f.name for f in fields if f.metadata.get("array"))
+        try:
+            type.__setattr__(cls, "_tubefsi_array_fields", found)
+        except TypeError:                  # a class that takes no attributes: computed each time
+            pass
+    return found
 
 
 def parameter_shape(model) -> tuple[int, ...]:
     """The broadcast shape of a model's array parameters (``()`` when all are scalars)."""
-    # scalars (the common case) broadcast with anything, and a float needs no np.shape
-    shapes = [np.shape(v) for v in (getattr(model, name) for name in _array_fields(type(model)))
-              if type(v) is not float]
-    shapes = [s for s in shapes if s != ()]
-    return np.broadcast_shapes(*shapes) if shapes else ()
+    shapes = None
+    for name in _array_fields(type(model)):
+        value = getattr(model, name)
+        if type(value) is not float:        # (a float, the common case, broadcasts with anything)
+            shape = np.shape(value)
+            if shape != ():
+                shapes = [shape] if shapes is None else shapes + [shape]
+    return () if shapes is None else np.broadcast_shapes(*shapes)
 
 
 def _replace(model, values: dict):
@@ -350,7 +358,11 @@ def flat_points(model, *values):
 
 def varies(model) -> bool:
     """Whether some parameter of ``model`` is a function of z (a :class:`~tubefsi.Profile`)."""
-    return any(isinstance(getattr(model, name), Profile) for name in _array_fields(type(model)))
+    for name in _array_fields(type(model)):
+        value = getattr(model, name)
+        if type(value) is not float and isinstance(value, Profile):
+            return True
+    return False
 
 
 def at_position(model, z, index=None):

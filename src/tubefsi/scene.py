@@ -63,12 +63,28 @@ class State:
         return State(**{name: value[index] for name, value in self.arrays(n).items()})
 
 
+_FLOATS, _ARRAYS, _ALONG_Z = 0, 1, 2
+
+
+def _kind(model) -> int:
+    """``_FLOATS`` where every parameter of ``model`` that may be an array is a float, ``_ALONG_Z``
+    where one is a function of z (a :class:`~tubefsi.Profile`), else ``_ARRAYS``."""
+    kind = _FLOATS
+    for name in _array_fields(type(model)):
+        value = getattr(model, name)
+        if type(value) is not float:
+            if isinstance(value, Profile):
+                return _ALONG_Z
+            kind = _ARRAYS
+    return kind
+
+
 def _value_eq(a, b) -> bool:
     a, b = np.asarray(a), np.asarray(b)
     return a.shape == b.shape and bool(np.all(a == b))
 
 
-@attrs.frozen(kw_only=True, slots=False)
+@attrs.frozen(kw_only=True)
 class Scene:
     r"""A rheology, a wall, a tube and an outlet pressure: everything but the load.
 
@@ -85,6 +101,8 @@ class Scene:
     ----------
     shape : tuple
         The broadcast shape of the scene's array parameters (``()`` when all are scalars).
+    graded : bool
+        Whether the tube or the wall varies along z (``docs/graded.md``).
     outlet_strain, outlet_stretch : float or ndarray
         The hoop strain and stretch at the outlet, under ``outlet_pressure``.
     log_stretch_max : float or ndarray
@@ -104,18 +122,25 @@ class Scene:
     gauge_outlet_pressure: float = attrs.field(default=None, eq=False, hash=False)
 
     shape: tuple = attrs.field(init=False, eq=False)
+    graded: bool = attrs.field(init=False, eq=False)
     outlet_strain: float = attrs.field(init=False, eq=False, hash=False)
     outlet_stretch: float = attrs.field(init=False, eq=False, hash=False)
     log_stretch_max: float = attrs.field(init=False, eq=False, hash=False)
 
     def __attrs_post_init__(self):
+        p_out, p_e = self.outlet_pressure, self.external_pressure
         if self.gauge_outlet_pressure is None:
-            gauge = np.add(self.outlet_pressure, self.external_pressure)
-            object.__setattr__(self, "gauge_outlet_pressure", float(gauge) if np.ndim(gauge) == 0 else gauge)
-        shape = np.broadcast_shapes(parameter_shape(self.rheology), parameter_shape(self.wall),
-                                    parameter_shape(self.tube), np.shape(self.outlet_pressure),
-                                    np.shape(self.external_pressure), np.shape(self.gauge_outlet_pressure))
+            if type(p_out) is float and type(p_e) is float:
+                gauge = p_out + p_e
+            else:
+                gauge = np.add(p_out, p_e)
+                gauge = float(gauge) if np.ndim(gauge) == 0 else gauge
+            object.__setattr__(self, "gauge_outlet_pressure", gauge)
+        shapes = [parameter_shape(self.rheology), parameter_shape(self.wall), parameter_shape(self.tube)]
+        shapes += [np.shape(v) for v in (p_out, p_e, self.gauge_outlet_pressure) if type(v) is not float]
+        shape = np.broadcast_shapes(*shapes) if any(shapes) else ()
         object.__setattr__(self, "shape", shape)
+        object.__setattr__(self, "graded", self.tube.graded or varies(self.wall))
         if self.graded:                     # the outlet state of the tube law at z = L
             wall, tb = self.at_outlet()
             strain = wall.strain(self.outlet_pressure, tb) if np.any(np.asarray(self.outlet_pressure) != 0) else 0.0
@@ -124,8 +149,8 @@ class Scene:
             object.__setattr__(self, "log_stretch_max", math.inf)
             return
         # the hoop strain at the outlet, once: every J evaluation needs it
-        p_out, tb = self.outlet_pressure, self.tb
-        if np.ndim(p_out) == 0 and p_out == 0:
+        tb = self.tb
+        if type(p_out) is float and p_out == 0.0 or np.ndim(p_out) == 0 and p_out == 0:
             strain = 0.0
         elif shape == ():
             strain = float(self.wall._strain(np.asarray(p_out), tb))
@@ -135,6 +160,10 @@ class Scene:
         object.__setattr__(self, "outlet_stretch", 1.0 + strain)
         if shape == ():
             lam_max = self.wall._max_stretch(tb)
+            if type(lam_max) is float and type(strain) is float:      # (a scene of scalars: no NumPy)
+                object.__setattr__(self, "log_stretch_max", math.log(lam_max / (1.0 + strain))
+                                   if lam_max < math.inf else math.inf)
+                return
         else:
             # the hook first: a wall that never locks says inf whatever its parameters (a tenth of
             # the per-point evaluation's cost); any other answer, or a hook that takes no array
@@ -149,15 +178,31 @@ class Scene:
             v_max = np.log(np.asarray(lam_max, dtype=float) / (1.0 + np.asarray(strain)))
         object.__setattr__(self, "log_stretch_max", float(v_max) if v_max.ndim == 0 else v_max)
 
+    @classmethod
+    def unloaded(cls, rheology, wall, tube) -> Scene:
+        """The scene of validated models whose parameters are all floats, in a uniform tube of float
+        fields, with an unloaded outlet: the commonest scene, whose derived fields need no
+        broadcasting (what ``__attrs_post_init__`` derives, directly)."""
+        scene = object.__new__(cls)
+        lam_max = wall._max_stretch(tube.thickness / tube.radius)
+        put = object.__setattr__
+        put(scene, "rheology", rheology)
+        put(scene, "wall", wall)
+        put(scene, "tube", tube)
+        put(scene, "outlet_pressure", 0.0)
+        put(scene, "external_pressure", 0.0)
+        put(scene, "gauge_outlet_pressure", 0.0)
+        put(scene, "shape", ())
+        put(scene, "graded", False)
+        put(scene, "outlet_strain", 0.0)
+        put(scene, "outlet_stretch", 1.0)
+        put(scene, "log_stretch_max", math.log(lam_max) if lam_max < math.inf else math.inf)
+        return scene
+
     @property
     def tb(self):
         """The reduced thickness t/a of the tube (a :class:`~tubefsi.Profile` for a graded tube)."""
         return self.tube.reduced_thickness
-
-    @property
-    def graded(self) -> bool:
-        """Whether the tube or the wall varies along z (``docs/graded.md``)."""
-        return self.tube.graded or varies(self.wall)
 
     def at_position(self, z, index=None):
         """``(wall, radius, tb)`` at the positions ``z`` (aligned with the flat points ``index`` if
@@ -267,6 +312,7 @@ def _evolve_arrays(scene, transform):
         object.__setattr__(new, name, transform(np.asarray(value)) if np.ndim(value) else value)
     probe = transform(np.zeros(scene.shape)) if scene.shape else None
     object.__setattr__(new, "shape", np.shape(probe) if probe is not None else ())
+    object.__setattr__(new, "graded", scene.graded)
     return new
 
 
@@ -397,15 +443,19 @@ def make_scene(rheology, wall, tube, *, outlet_pressure=0.0, external_pressure=0
     wall = resolve("wall", wall)
     if not isinstance(tube, Tube):
         raise InvalidParameterError("tube", "a tubefsi.Tube", tube)
-    if varies(rheology):
+    kinds = _kind(rheology), _kind(wall), _kind(tube)
+    if kinds[0] == _ALONG_Z:
         name = next(n for n in _array_fields(type(rheology)) if isinstance(getattr(rheology, n), Profile))
         raise InvalidParameterError(name, "a number or an array (a fluid's parameters do not vary along the tube)",
                                     getattr(rheology, name))
-    if tube.graded or varies(wall):
+    if kinds[1] == _ALONG_Z or kinds[2] == _ALONG_Z:
         return _graded_scene(rheology, wall, tube, outlet_pressure, external_pressure)
+    installed = tube
     tube = wall._installed_tube(tube)        # an axial pre-stretch installs the tube longer and narrower
     if (type(outlet_pressure) is float and outlet_pressure == 0.0 and type(external_pressure) is float
             and external_pressure == 0.0):   # the common case: an unloaded outlet is below every limit
+        if kinds == (_FLOATS, _FLOATS, _FLOATS) and (tube is installed or _kind(tube) == _FLOATS):
+            return Scene.unloaded(rheology, wall, tube)
         return Scene(rheology=rheology, wall=wall, tube=tube, outlet_pressure=0.0)
     p_out = as_array("outlet_pressure", outlet_pressure, "[0, inf)", lambda a: a >= 0)
     p_out = float(p_out) if p_out.ndim == 0 else p_out

@@ -29,7 +29,7 @@ from .geometry import Tube
 from .rheology.power_law import FactorRangeError
 from .scene import Scene, State, _resolve, make_scene
 from .solution import Solution
-from .validity import check, warn
+from .validity import check_and_warn
 
 __all__ = ["solve", "max_flow_rate", "select_coupler", "Problem", "CHUNK"]
 
@@ -195,11 +195,7 @@ def _solve_scene(scene, chosen, name, controlled, load, on_infeasible, density, 
     runner = checked(chosen)            # a self-checking coupler is re-solved finer (AccuracyWarning)
     shape = _result_shape(scene, controlled, load, density)
     if shape == () and scene.size == 1:             # one point: one coupler call
-        values = np.array([load], dtype=float)
-        state, feasible = _run(runner, scene, controlled, values, on_infeasible)
-        if type(state.pressure_drop) is not float:     # (the engine's route for one point gives floats)
-            state = State(*(float(np.ravel(getattr(state, f))[0]) for f in _STATE_FIELDS))
-        feasible = None if feasible is None else bool(np.ravel(feasible)[0])
+        state, feasible = _solve_point(runner, scene, controlled, load, on_infeasible)
     else:
         state, feasible = _solve_points(runner, scene, controlled, load, shape, on_infeasible, progress)
     flat = scene.flat(shape) if shape != () else scene
@@ -207,14 +203,32 @@ def _solve_scene(scene, chosen, name, controlled, load, on_infeasible, density, 
     if density is not None:
         density = float(density) if density.ndim == 0 else np.broadcast_to(density, shape).ravel()
     if validity:
-        warn(check(flat.uniform_at(0.0) if scene.graded else flat, np.ravel(state.flow_rate),
-                   np.ravel(state.inlet_strain), density=density))
+        if shape == ():
+            check_and_warn(scene.uniform_at(0.0) if scene.graded else scene, state.flow_rate, state.inlet_strain,
+                           density=density)
+        else:
+            check_and_warn(flat.uniform_at(0.0) if scene.graded else flat, np.ravel(state.flow_rate),
+                           np.ravel(state.inlet_strain), density=density)
     return Solution(scene=scene, coupler=chosen, state=state, scalar=shape == (), coupler_name=name,
                     feasible=None if feasible is None or np.all(feasible) else np.asarray(feasible).reshape(shape),
                     density=density, controlled=controlled)
 
 
+def _solve_point(runner, scene, controlled, load, on_infeasible):
+    """One load (a float) through a scene of scalars: ``(State of floats, feasible or None)``."""
+    if controlled == "flow_rate" and on_infeasible == "raise":
+        try:
+            return runner.flow_controlled_point(scene, load), None
+        except OverflowError:              # a scene beyond double precision: a typed error
+            raise _beyond_range(controlled, load, "an intermediate quantity overflows") from None
+    state, feasible = _run(runner, scene, controlled, np.array([load], dtype=float), on_infeasible)
+    state = State(*(float(np.ravel(getattr(state, f))[0]) for f in _STATE_FIELDS))
+    return state, (None if feasible is None else bool(np.ravel(feasible)[0]))
+
+
 def _result_shape(scene, controlled, load, density):
+    if scene.shape == () and type(load) is float and density is None:      # (one point)
+        return ()
     try:
         shape = np.broadcast_shapes(scene.shape, np.shape(load))
     except ValueError:
@@ -280,6 +294,8 @@ def _solve_points(runner, scene, controlled, load, shape, on_infeasible, progres
 def _check_finite(state, feasible, controlled, load):
     """A typed error where a feasible point's result is not a finite double."""
     computed = "pressure_drop" if controlled == "flow_rate" else "flow_rate"
+    if type(state.inlet_strain) is float and math.isfinite(getattr(state, computed) + state.inlet_strain):
+        return                              # (one point)
     with np.errstate(over="ignore", invalid="ignore"):
         if math.isfinite(float(np.sum(getattr(state, computed)) + np.sum(state.inlet_strain))):
             return

@@ -31,7 +31,8 @@ import numpy as np
 from .errors import ModelValidityWarning, warn_user
 from .walls.linear import ThickLinear, ThinLinear
 
-__all__ = ["SLENDERNESS", "REDUCED_REYNOLDS", "END_LAYER", "Validity", "check", "end_effect_error", "warn"]
+__all__ = ["SLENDERNESS", "REDUCED_REYNOLDS", "END_LAYER", "Validity", "check", "check_and_warn", "end_effect_error",
+           "warn"]
 
 #: Largest deformed slenderness :math:`R/L` for lubrication theory.
 SLENDERNESS = 0.1
@@ -153,6 +154,18 @@ def check(scene, flow_rate, inlet_strain, *, density=None) -> Validity:
     return Validity(deformed_slenderness=max(worst, 0.0) if math.isfinite(worst) else math.nan,
                     max_strain=max_strain if math.isfinite(max_strain) else math.nan,
                     reduced_reynolds_number=rre, reynolds_number=re_at, messages=tuple(messages))
+
+
+def check_and_warn(scene, flow_rate, inlet_strain, *, density=None) -> None:
+    """:func:`warn` of :func:`check`, for :func:`tubefsi.solve`: one point of a uniform tube is
+    tested in floats first (slender and within the calibrated strain: nothing to say)."""
+    if density is None and type(inlet_strain) is float:
+        a, length = scene.tube.radius, scene.tube.length
+        limit = getattr(scene.wall, "calibrated_strain", math.inf)
+        if type(a) is float and type(length) is float and type(limit) is float:
+            if not (a * (1.0 + inlet_strain) / length > SLENDERNESS or inlet_strain > limit):
+                return
+    warn(check(scene, flow_rate, inlet_strain, density=density))
 
 
 def warn(validity: Validity) -> None:

@@ -15,11 +15,23 @@ hook                                           returns
 ``profile(scene, state, z)``                   the hoop strain and pressure rise at positions z
 =============================================  ===================================================
 
-and, optionally, ``length_integral(scene, state, weight)`` (:math:`\int_0^L w\,dz` of a
-weight along the tube, from which :meth:`Coupler.sensitivities` and :func:`tubefsi.fit` build
-the derivatives of a solve; the default integrates it over the coupler's own profile). Class attributes ``cost_rank`` (lower is cheaper; ``coupler="auto"`` takes the
-cheapest that supports the pair) and ``meets_accuracy_contract`` (whether ``auto`` may pick
-it). A coupler that can estimate its own error by solving again at a finer setting returns
+and, optionally (each has a default built on the hooks above):
+
+=============================================  ===================================================
+hook                                           default
+=============================================  ===================================================
+``flow_controlled_point(scene, flow_rate)``    one float: ``flow_controlled`` of a one-point array
+``solve_feasible(scene, load, controlled)``    the limit first, then the points below it (NaN and
+                                               ``False`` beyond: ``on_infeasible="nan"``)
+``limit_pressure(scene)``                      the wall's limit pressure
+``length_integral(scene, state, weight)``      :math:`\int_0^L w\,dz` over the coupler's profile
+                                               (the derivatives of :meth:`sensitivities` and
+                                               :func:`tubefsi.fit`)
+=============================================  ===================================================
+
+Class attributes ``cost_rank`` (lower is cheaper; ``coupler="auto"`` takes the cheapest that
+supports the pair) and ``meets_accuracy_contract`` (whether ``auto`` may pick it). Every solve
+that ``auto`` gives a coupler is answered by that coupler alone. A coupler that can estimate its own error by solving again at a finer setting returns
 that finer version from :meth:`Coupler.refined`; :class:`~tubefsi.couplers.Checked` then
 compares the two and warns (``AccuracyWarning``) — one wrapper for every such coupler.
 
@@ -40,6 +52,8 @@ from ..numerics.quadrature import adaptive, warn_unconverged
 from ..scene import State
 
 __all__ = ["Coupler"]
+
+_STATE_FIELDS = ("flow_rate", "pressure_drop", "inlet_strain", "log_stretch")
 
 
 def _flow_index(rheology, flow_rate, radius):
@@ -70,6 +84,13 @@ class Coupler(abc.ABC):
     @abc.abstractmethod
     def flow_controlled(self, scene, flow_rate):
         """Solve for the pressure drop at each flow rate (float array, m^3/s); a ``State``."""
+
+    def flow_controlled_point(self, scene, flow_rate: float):
+        """One flow rate (a float) through a scene of scalars: a ``State`` of floats. The default is
+        :meth:`flow_controlled` of a one-point array; a coupler with a cheaper way for one point
+        overrides it (it must give the bits :meth:`flow_controlled` gives a one-point array)."""
+        state = self.flow_controlled(scene, np.array([flow_rate], dtype=float))
+        return State(*(float(np.ravel(getattr(state, name))[0]) for name in _STATE_FIELDS))
 
     @abc.abstractmethod
     def pressure_controlled(self, scene, pressure_drop):

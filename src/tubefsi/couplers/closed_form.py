@@ -48,9 +48,9 @@ class ClosedForm(SeparatedVariables):
         index = np.asarray(index)
         return exact(self._J(scene, np.full(index.shape, np.inf), index).value + np.zeros(index.shape))
 
-    def _table(self, scene):
+    def _table(self, scene, points):
         # a wall with an explicit inverse needs no table: the closed form answers every point
-        return None if scene.wall._has_power_law_integral_inverse() else super()._table(scene)
+        return None if scene.wall._has_power_law_integral_inverse() else super()._table(scene, points)
 
     def _solve_J(self, scene, target, index, q=None, upper=None):
         """The wall's explicit inverse where it has one, else Newton's method on the closed form."""

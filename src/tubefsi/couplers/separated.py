@@ -46,7 +46,8 @@ from ..numerics.quadrature import Integral, adaptive_to_pole, integrate_graded, 
 from ..scene import Points, Scene, State
 from . import _inverse
 from .base import Coupler
-from .tables import TABLES, build_table, table_key
+from ..numerics.cache import TABLES
+from .tables import SeparatedTable, table_key
 
 __all__ = ["SeparatedVariables", "MAX_LOG_STRETCH", "exact"]
 
@@ -57,6 +58,8 @@ _LOG_RANGE = 0.5 * -math.log(np.finfo(float).tiny)
 MAX_LOG_STRETCH = _inverse.MAX_LOG_STRETCH
 
 
+#: A call of at least this many points (or of one) is served by the scene's table, if it has one.
+_TABLE_MIN_POINTS = 64
 #: A curve of at least this many flow rates through one scene of a non-separable fluid is
 #: interpolated between direct solves (:meth:`SeparatedVariables._curve`).
 _CURVE_MIN_POINTS = 64
@@ -252,13 +255,17 @@ class SeparatedVariables(Coupler):
         return _inverse.log_stretch_cap(scene, index)
 
     # --------------------------------------------------------------- the table
-    def _table(self, scene: Scene):
-        """The table of ``scene`` (from :data:`~tubefsi.couplers.tables.TABLES`, built on first
-        use), or None where the scene has none or its build failed its checks."""
+    def _table(self, scene: Scene, points: int):
+        """The table of ``scene`` (from the one cache, :data:`~tubefsi.numerics.cache.TABLES`), or
+        None where the scene has none or the call is not one it serves: one point, or at least
+        ``_TABLE_MIN_POINTS`` (a panel costs about what 50 direct solves do: a short array is
+        answered directly, whatever the cache holds)."""
+        if 1 < points < _TABLE_MIN_POINTS:
+            return None
         key = table_key(self, scene)
         if key is None:
             return None
-        return TABLES.get(key, lambda: build_table(self, scene))
+        return TABLES.get(key, SeparatedTable)
 
     @staticmethod
     def _log_norm(points: Points):
@@ -268,30 +275,28 @@ class SeparatedVariables(Coupler):
 
     def _table_point(self, scene: Scene, table, q: float):
         """``(q, rise, strain, v)`` of one flow rate through a scene of scalars from its table, in
-        plain Python (floats), or None beyond the table's range."""
+        plain Python (floats), or None where the table leaves it to the direct path."""
         if not q > 0.0:
             return q, 0.0, scene.outlet_strain, 0.0
-        rheology, tube, wall = scene.rheology, scene.tube, scene.wall
+        rheology, tube = scene.rheology, scene.tube
+        scale = scene.wall._pressure_scale()
         x = (rheology._log_flow_factor(q) + math.log(tube.length) - rheology.radius_exponent * math.log(tube.radius)
-             - math.log(wall._pressure_scale()))
-        if not table.x_lo <= x <= table.x_hi:
+             - math.log(scale))
+        found = table.scalar(x, self, scene)
+        if found is None:
             return None
-        y, w = table.inverse.scalar(x)
+        y, w = found
         v = math.exp(y)
-        return q, wall._pressure_scale() * math.exp(w), math.expm1(v), v
+        return q, scale * math.exp(w), math.expm1(v), v
 
-    def _from_table(self, table, pts: Points, target):
-        """``(v, rise, served)`` of the positive ``target`` s the table's range holds (arrays)."""
+    def _from_table(self, table, scene, pts: Points, target):
+        """``(v, rise, served)`` of the positive ``target`` s the table's panels serve (arrays)."""
         with np.errstate(divide="ignore"):
             x = np.log(target) - self._log_norm(pts)
-        served = (x >= table.x_lo) & (x <= table.x_hi)
-        v = np.zeros(target.shape)
-        rise = np.full(target.shape, np.nan)
-        if np.any(served):
-            y, w = table.inverse.evaluate(x[served] if not np.all(served) else x)
-            v[served] = np.exp(y)
-            scale = pts.wall._pressure_scale()
-            rise[served] = np.exp(w) * (scale if np.ndim(scale) == 0 else scale[served])
+        y, w, served = table.evaluate(x, self, scene)
+        v = np.where(served, np.exp(y), 0.0)
+        scale = pts.wall._pressure_scale()
+        rise = np.where(served, np.exp(w) * scale, np.nan)
         return v, rise, served
 
     # --------------------------------------------------------------- problems
@@ -299,6 +304,17 @@ class SeparatedVariables(Coupler):
         """Solve for the pressure drop at each flow rate (a flat array, one per point)."""
         state, feasible = self._flow(scene, np.asarray(flow_rate, dtype=float), raise_=True)
         return state
+
+    def flow_controlled_point(self, scene: Scene, flow_rate: float) -> State:
+        """One flow rate through a scene of scalars: from its table in plain Python where it has one
+        (the operations of :meth:`flow_controlled` on a one-point array), else as that array."""
+        if not scene.wall.is_rigid:
+            table = self._table(scene, 1)
+            if table is not None:
+                answer = self._table_point(scene, table, flow_rate)
+                if answer is not None:
+                    return State(*answer)
+        return super().flow_controlled_point(scene, flow_rate)
 
     def solve_feasible(self, scene: Scene, load, controlled: str):
         if controlled == "flow_rate":
@@ -310,7 +326,7 @@ class SeparatedVariables(Coupler):
         maximum flow rate (or, with ``raise_``, a NoSteadyStateError)."""
         if scene.wall.is_rigid:
             return _rigid_state(scene, flow_rate=q), None
-        table = self._table(scene)
+        table = self._table(scene, q.size)
         if table is not None and q.size == 1 and scene.size == 1:
             answer = self._table_point(scene, table, float(q.reshape(-1)[0]))
             if answer is not None:
@@ -326,16 +342,10 @@ class SeparatedVariables(Coupler):
                          panels=np.zeros(q.shape, dtype=int))
         ok = np.ones(q.shape, dtype=bool)
         if table is not None:
-            v_t, rise_t, served = self._from_table(table, pts, np.where(direct, target, 1.0))
+            v_t, rise_t, served = self._from_table(table, scene, pts, np.where(direct, target, 1.0))
             served &= direct
             v[served], rise[served] = v_t[served], rise_t[served]
             direct &= ~served
-            if np.any(direct) and math.isfinite(table.j_infinity):
-                # at or beyond the table's J(inf) (what max_flow_rate reports): no steady state
-                j_inf = table.j_infinity * np.exp(self._log_norm(pts)) + np.zeros(q.shape)
-                beyond = direct & (target >= j_inf * (1.0 - _inverse.AT_THE_LIMIT))
-                v[beyond], ok[beyond], found.value[beyond] = np.inf, False, j_inf[beyond]
-                direct &= ~beyond
         if np.count_nonzero(direct) >= _CURVE_MIN_POINTS and scene.size == 1 and not scene.rheology.separable:
             sub = np.flatnonzero(direct)
             curve = self._curve(scene, q[sub])
@@ -416,21 +426,9 @@ class SeparatedVariables(Coupler):
     def _flow_from_log_stretch(self, scene, v, index):
         """The flow rates whose inlet log-stretch is ``v`` (separable): :math:`\\phi^{-1}(J(v)/L)`."""
         sp = scene.at(index)
-        j = np.full(v.shape, np.nan)
-        table = self._table(scene)
-        if table is not None:              # the forward table gives J at the inlet stretch
-            with np.errstate(divide="ignore"):
-                y = np.log(v)
-            inside = (y >= table.forward.lo) & (y <= table.forward.hi)
-            if np.any(inside):
-                norm = np.exp(self._log_norm(sp)) + np.zeros(v.shape)
-                j[inside] = np.exp(table.forward(y[inside])) * norm[inside]
-        rest = np.isnan(j)
-        if np.any(rest):
-            result = self._J(scene, v[rest], index[rest])
-            warn_unconverged("the separated-variables integral", result)
-            j[rest] = result.value
-        return sp.rheology._flow_factor_inverse(j / sp.length)
+        result = self._J(scene, v, index)
+        warn_unconverged("the separated-variables integral", result)
+        return sp.rheology._flow_factor_inverse(result.value / sp.length)
 
     def profile(self, scene: Scene, state: State, z):
         r"""``(strain, pressure_rise)`` at ``z`` (validated to lie in [0, L]) for a flat scene and a
@@ -449,9 +447,9 @@ class SeparatedVariables(Coupler):
         v = np.where(frac == 1.0, v_in, 0.0) + np.zeros(q.shape)
         rise = np.where(target > 0, np.nan, 0.0)
         direct = (target > 0) & (frac < 1.0)
-        table = self._table(scene)
+        table = self._table(scene, q.size)
         if table is not None:
-            v_t, rise_t, served = self._from_table(table, pts, np.where(direct, target, 1.0))
+            v_t, rise_t, served = self._from_table(table, scene, pts, np.where(direct, target, 1.0))
             served &= direct
             v[served] = np.minimum(v_t[served], v_in[served] if np.ndim(v_in) else v_in)
             rise[served] = rise_t[served]
@@ -494,16 +492,5 @@ class SeparatedVariables(Coupler):
     def max_flow_rate(self, scene: Scene):
         """Largest flow rate with a steady state at each point of a flat scene (a float for a
         scene of shared quantities; ``inf`` where there is none)."""
-        n = scene.size
-        index = np.arange(n)
-        pts = scene.at(index)
-        table = self._table(scene)
-        if table is not None:                   # J(inf) per unit modulus is in the table
-            with np.errstate(over="ignore"):
-                j = table.j_infinity * np.exp(self._log_norm(pts)) + np.zeros(n)
-                q = np.where(np.isfinite(j), pts.rheology._flow_factor_inverse(np.where(np.isfinite(j), j, 1.0)
-                                                                               / pts.length), np.inf)
-            q = np.where(np.isfinite(q), q, np.inf)
-            return float(q[0]) if n == 1 else q
-        out = _inverse.max_flow_rate(self, scene, index)
-        return float(out[0]) if n == 1 else out
+        out = _inverse.max_flow_rate(self, scene, np.arange(scene.size))
+        return float(out[0]) if scene.size == 1 else out

@@ -4,14 +4,13 @@ Tables (the separated identity's, :mod:`tubefsi.couplers.tables`; a fluid's flow
 :mod:`tubefsi.rheology.flow_law`) are accelerators: a table changes the time a solve takes, never
 its answer, because what a table holds depends only on its key, and the key describes everything
 it depends on by value (plain numbers and strings, weak references to classes: never a model, so
-the cache keeps no model or class alive). :data:`TABLES` holds at most 64 of them, the least
-recently used leaving first; :func:`tubefsi.cache_clear` empties it and :func:`tubefsi.cache_info`
+the cache keeps no model or class alive). :data:`TABLES` holds at most 64 of them, the oldest
+leaving first; :func:`tubefsi.cache_clear` empties it and :func:`tubefsi.cache_info`
 reports it.
 """
 
 from __future__ import annotations
 
-import collections
 import threading
 
 import attrs
@@ -25,7 +24,10 @@ def plain(value) -> bool:
     """Whether ``value`` is a plain value (a float, int, string, bool, None, or a tuple of them):
     what a key may hold, since it cannot change in place."""
     if type(value) is tuple:
-        return all(plain(item) for item in value)
+        for item in value:
+            if type(item) not in _PLAIN and not (type(item) is tuple and plain(item)):
+                return False
+        return True
     return type(value) in _PLAIN
 
 
@@ -40,35 +42,33 @@ class CacheInfo:
 
 
 class TableCache:
-    """A bounded, thread-safe cache of tables, keyed by value (:func:`table_key`).
+    """A bounded, thread-safe cache of tables, keyed by value.
 
     ``get(key, build)`` returns the table of ``key``, building it with ``build()`` on a miss (a
-    failed build, None, is remembered as such). The least recently used entry leaves first beyond
-    ``maxsize``. Two threads that miss the same key at once may both build it: the tables are
-    equal to the bit, and one of them is kept. Clearing changes the time of later calls, never
-    their answers.
+    failed build, None, is remembered as such). Beyond ``maxsize`` entries the oldest leaves first.
+    A hit reads one dictionary entry (atomic in CPython: no lock); a miss takes the lock to insert.
+    Two threads that miss the same key at once may both build: the tables are equal to the bit,
+    and the first one inserted is kept. Clearing changes the time of later calls, never their
+    answers. The hit and miss counts are for information (a hit is counted without the lock).
     """
 
     def __init__(self, maxsize: int = 64):
         self.maxsize = int(maxsize)
-        self._entries = collections.OrderedDict()
+        self._entries = {}
         self._lock = threading.Lock()
         self._hits = self._misses = 0
 
     def get(self, key, build):
-        with self._lock:
-            found = self._entries.get(key, self)
-            if found is not self:
-                self._entries.move_to_end(key)
-                self._hits += 1
-                return found
-            self._misses += 1
+        found = self._entries.get(key, self)
+        if found is not self:
+            self._hits += 1
+            return found
         table = build()
         with self._lock:
+            self._misses += 1
             table = self._entries.setdefault(key, table)
-            self._entries.move_to_end(key)
             while len(self._entries) > self.maxsize:
-                self._entries.popitem(last=False)
+                del self._entries[next(iter(self._entries))]
         return table
 
     def clear(self) -> None:

@@ -157,6 +157,9 @@ class PiecewisePolynomial:
             j = bisect.bisect_right(self._breaks_list, x) - 1
         j = 0 if j < 0 else (self.panels - 1 if j >= self.panels else j)
         t = x * self._scale_list[j] + self._offset_list[j]
+        if self.degree == 8:                     # the tables' degree: the loop below, written out
+            return tuple(((((((((a8 * t + a7) * t + a6) * t + a5) * t + a4) * t + a3) * t + a2) * t + a1) * t + a0)
+                         for a8, a7, a6, a5, a4, a3, a2, a1, a0 in self._panel_coefficients[j])
         out = []
         for coefficients in self._panel_coefficients[j]:
             value = coefficients[0]

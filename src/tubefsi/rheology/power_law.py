@@ -72,6 +72,9 @@ class _PowerLawForms(Rheology):
         # ln 2m + n ln((3n+1)/(pi n)) + n ln q: a log and a multiply-add, no power; finite wherever
         # q > 0, even where phi itself would leave double range
         n = self.index
+        if type(flow_rate) is float and type(n) is float and type(self.consistency) is float and flow_rate > 0.0:
+            return math.log(2.0 * self.consistency) + n * math.log((3.0 * n + 1.0) / (math.pi * n)) \
+                + n * math.log(flow_rate)                    # (one point: the same operations in floats)
         with np.errstate(divide="ignore"):
             shift = np.log(2.0 * self.consistency) + n * np.log((3.0 * n + 1.0) / (math.pi * n))
             out = np.log(flow_rate)
