@@ -390,8 +390,13 @@ def classify_runaway(engine, scene, q, bad, v, final, *, raise_):
     else:
         reach = float(solve_flow_rate(engine, one, cap, engine.pressure_rise(one, cap, ids, warn=False), ids)[0])
     if float(cap[0]) < MAX_LOG_STRETCH:
-        raise NoSteadyStateError("flow_rate", reach, float(q_bad[i]),
-                                 "the inlet stretch would reach the wall's maximum stretch")
+        if q_bad[i] >= reach:
+            raise NoSteadyStateError("flow_rate", reach, float(q_bad[i]),
+                                     "the inlet stretch would reach the wall's maximum stretch")
+        raise InvalidParameterError("flow_rate", "flow rates whose inlet stretch can be told from the wall's "
+                                    "locking stretch in double precision", float(q_bad[i]),
+                                    f"below the limit {reach:.6g} m^3/s the inlet stretch is the locking stretch to "
+                                    "the last digit: the pressure drop there cannot be resolved")
     limit = "max_flow_rate is inf" if not math.isfinite(q_max[i]) else f"below max_flow_rate = {q_max[i]:.6g} m^3/s"
     raise StretchRangeError(reach, float(q_bad[i]), f"a steady state exists ({limit}) but its inlet stretch exceeds "
                             "1e15, and R/L far exceeds 0.1 there: the model no longer applies")

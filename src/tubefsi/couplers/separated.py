@@ -58,6 +58,8 @@ _LOG_RANGE = 0.5 * -math.log(np.finfo(float).tiny)
 MAX_LOG_STRETCH = _inverse.MAX_LOG_STRETCH
 
 
+#: The accuracy contract (relative), beyond which an estimate is an AccuracyWarning.
+_CONTRACT = 1e-12
 #: A call of at least this many points (or of one) is served by the scene's table, if it has one.
 _TABLE_MIN_POINTS = 64
 #: A curve of at least this many flow rates through one scene of a non-separable fluid is
@@ -189,6 +191,24 @@ class SeparatedVariables(Coupler):
             direct = pts.wall._pressure_at_log_stretch(v, np.expm1(v), pts.tb)
             return np.where(zero_out, direct, rise.value)
         return rise.value
+
+    def _warn_near_a_lock(self, scene: Scene, v, index, rise):
+        r"""An ``AccuracyWarning`` where the pressure drop cannot be known to the contract from the
+        inlet stretch as a double: near a wall's locking stretch the tube law is so steep that the
+        rounding of :math:`\lambda` alone moves the pressure by :math:`|\lambda P'/\Delta p|\,\epsilon`
+        relative (the problem itself may be well conditioned in the flow rate; the stretch is not)."""
+        pts = scene.at(index)
+        if not np.any(np.isfinite(np.asarray(pts.log_stretch_max, dtype=float))):
+            return
+        with np.errstate(all="ignore"):       # (lambda P' = dP / d ln lambda)
+            estimate = 2.0 * EPS * np.abs(pts.wall._log_slope(self.stretch_at(pts, v), pts.tb) / rise)
+        bad = np.isfinite(estimate) & (estimate > _CONTRACT)
+        if np.any(bad):
+            warn_unconverged("the pressure drop this close to the wall's locking stretch (the tube law's slope "
+                             "magnifies the rounding of the inlet stretch)",
+                             Integral(value=np.ones(int(np.count_nonzero(bad))), error=estimate[bad],
+                                      converged=np.zeros(int(np.count_nonzero(bad)), dtype=bool),
+                                      panels=np.zeros(int(np.count_nonzero(bad)), dtype=int)))
 
     @staticmethod
     def _slope(points: Points, u):
@@ -369,6 +389,7 @@ class SeparatedVariables(Coupler):
             solved = np.union1d(solved, solved_by_curve)
         if solved.size:
             rise[solved] = self.pressure_rise(scene, v[solved], solved)
+            self._warn_near_a_lock(scene, v[solved], solved, rise[solved])
         rise[target == 0] = 0.0
         strain = self.strain_at(pts, v) + 0.0 * v
         if feasible is not None:
