@@ -16,6 +16,8 @@ separated as in ``tubefsi.testing.reference.power_law`` (section "Coupling witho
 
 import math
 
+import numpy as np
+
 import pytest
 from mpmath import mp, mpf
 
@@ -200,3 +202,22 @@ def test_a_thick_gent_tube_near_its_lock_meets_the_contract_or_says_so():
         assert err <= 1e-12 * max(1.0, kappa) or warned, (q, err, kappa)
         outcomes.append(warned)
     assert outcomes[0] is False and any(outcomes)
+
+
+@pytest.mark.parametrize("name", ["thick-fung", "thin-fung"])
+def test_fung_profiles_end_at_the_outlet_state(name):
+    """With an outlet pressure, the profiles end where the tube law puts the outlet: p(L) = p_out
+    exactly and R(L) = a lambda(p_out), against the mpmath inverse of the tube law (the outlet is not
+    interpolated: a profile at z = L is the outlet state itself)."""
+    from tubefsi.testing.reference.tube_laws import stretch_at_pressure
+
+    wall = walls[name](shear_modulus=1e3, stiffening=20.0)
+    law = ref.RefWall(theory(wall), material(wall), TUBE.reduced_thickness)
+    for p_out in (0.0, 50.0, 500.0):
+        lam_out = stretch_at_pressure(law, mpf(p_out)) if p_out else mpf(1)
+        for q in (1e-9, 3e-8, np.array([1e-9, 1e-8, 3e-8]), np.geomspace(1e-10, 3e-8, 100)):
+            sol = tubefsi.solve(FLUID, wall, TUBE, flow_rate=q, outlet_pressure=p_out)
+            length = np.full(np.shape(q), TUBE.length)
+            assert np.all(np.asarray(sol.pressure(length)) == p_out)
+            for r in np.ravel(sol.radius(length)):
+                assert rel_err(r, mpf(TUBE.radius) * lam_out) < 1e-14
