@@ -14,6 +14,7 @@ from tubefsi import InvalidParameterError, KeywordError, Network, Tube, advise, 
 from tubefsi._keywords import checked_keywords
 from tubefsi.fields import positive
 from tubefsi.registry import couplers, rheologies, walls
+from tubefsi.testing.profiles import scaled
 from tubefsi.walls.linear import ThinLinear
 
 TUBE = Tube(radius=1e-4, thickness=3e-5, length=1e-2)
@@ -165,7 +166,7 @@ def test_a_plugin_class_in_every_form_gets_the_check(slots):
         Handwritten(stifness=2e4)
 
 
-@settings(deadline=None, max_examples=60)
+@settings(deadline=None, max_examples=scaled(60))
 @given(st.lists(st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.sampled_from([0.0, -0.0, 1.0, 90.0]),
                           st.integers(-3, 3), st.sampled_from(["thin", "thick", "reference", "current", "other"])),
                 min_size=6, max_size=6))

@@ -10,9 +10,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tubefsi._products import fixed_width_product, rows_dot
+from tubefsi.testing.profiles import scaled
 
 
-@settings(deadline=None, max_examples=60)
+@settings(deadline=None, max_examples=scaled(60))
 @given(size=st.integers(1, 300), start=st.integers(0, 299), m=st.sampled_from([4, 17, 21, 23]),
        r=st.sampled_from([None, 2, 4]), seed=st.integers(0, 2**32 - 1))
 def test_rows_dot_is_batch_independent_and_correct(size, start, m, r, seed):
@@ -29,7 +30,7 @@ def test_rows_dot_is_batch_independent_and_correct(size, start, m, r, seed):
     assert np.all(np.abs(whole - y @ w) <= bound)
 
 
-@settings(deadline=None, max_examples=60)
+@settings(deadline=None, max_examples=scaled(60))
 @given(size=st.integers(1, 700), start=st.integers(0, 699), width=st.sampled_from([16, 256]),
        seed=st.integers(0, 2**32 - 1))
 def test_fixed_width_product_is_batch_independent_and_correct(size, start, width, seed):
