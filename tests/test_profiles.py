@@ -51,7 +51,9 @@ def test_the_variable_selects_and_ci_is_the_default(monkeypatch, restore_profile
 
 def test_the_suites_take_the_profile_loaded_before_them():
     """Importing tubefsi.testing.profiles does not import the contract suites, whose settings
-    (made on import) then inherit the profile's seeding."""
+    (made on import) then inherit the profile's seeding. Checked under explore: under ci the
+    check could pass by accident (hypothesis loads its own ci profile, also seeded, where the
+    variable CI is set)."""
     code = ("import sys\n"
             "from tubefsi.testing.profiles import load_profile\n"
             "assert 'tubefsi.testing.contracts' not in sys.modules\n"
@@ -59,6 +61,5 @@ def test_the_suites_take_the_profile_loaded_before_them():
             "from tubefsi.testing import WallContract, contracts\n"
             "assert contracts._settings.derandomize is {}\n"
             "assert contracts._settings.max_examples == {}\n")
-    for name, derandomize, n in (("ci", True, 25), ("explore", False, 250)):
-        env = dict(os.environ, **{profiles.PROFILE_VARIABLE: name})
-        subprocess.run([sys.executable, "-c", code.format(derandomize, n)], check=True, env=env)
+    env = dict(os.environ, **{profiles.PROFILE_VARIABLE: "explore"})
+    subprocess.run([sys.executable, "-c", code.format(False, 25 * profiles.EXPLORE_FACTOR)], check=True, env=env)
