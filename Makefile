@@ -16,7 +16,7 @@ LATEST := .venv-latest
 UV_VERSION := 0.13.9
 LOCK_FLAGS ?= --upgrade
 
-.PHONY: demo test fuzz docs install test-latest lock clean
+.PHONY: demo test test-explore fuzz docs install test-latest lock clean
 
 $(STAMP): $(LOCK) pyproject.toml $(PLUGINS)
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -30,8 +30,17 @@ install: $(STAMP)
 demo: $(STAMP)
 	MPLBACKEND=Agg $(PY) examples/demo.py
 
+# hypothesis profiles (tubefsi.testing.profiles, docs/verification.md "Random tests"): `make test`
+# is seeded ("ci": the same examples on every machine and in every fresh clone); `make
+# test-explore` draws new random examples on every run, ten times each test's own number, and
+# keeps failures in .hypothesis/ to replay them first; `make test-explore PYTEST_ARGS=tests/test_limits.py`
+# explores a part
+PYTEST_ARGS ?=
 test: $(STAMP)
-	MPLBACKEND=Agg $(PY) -m pytest -q -p no:cacheprovider
+	TUBEFSI_HYPOTHESIS_PROFILE=ci MPLBACKEND=Agg $(PY) -m pytest -q -p no:cacheprovider $(PYTEST_ARGS)
+
+test-explore: $(STAMP)
+	TUBEFSI_HYPOTHESIS_PROFILE=explore MPLBACKEND=Agg $(PY) -m pytest -q -p no:cacheprovider $(PYTEST_ARGS)
 
 # the long fuzz campaign (docs/verification.md, "Fuzzing"): every bad-input probe of every
 # registered model and entry point and FUZZ_SCENES random valid scenes; prints the counts per
@@ -53,7 +62,7 @@ test-latest:
 	$(LATEST)/bin/python -m pip install --quiet --upgrade pip setuptools wheel
 	$(LATEST)/bin/python -m pip install --quiet --upgrade --upgrade-strategy eager \
 	  -e '.[test,verify,fem,docs,network,pandas,xarray,progress,units,parallel]' $(foreach p,$(PLUGINS),-e $(dir $(p)))
-	MPLBACKEND=Agg $(LATEST)/bin/python -m pytest -q -p no:cacheprovider
+	TUBEFSI_HYPOTHESIS_PROFILE=ci MPLBACKEND=Agg $(LATEST)/bin/python -m pytest -q -p no:cacheprovider
 
 # uv, at a fixed version in a throw-away venv, writes the lock from PyPI (not pip's indexes)
 lock:

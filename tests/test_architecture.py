@@ -99,8 +99,10 @@ def test_imports_go_down_the_layers(importer, imported, line, top):
 
 
 #: Modules of the top layer that import lazily, inside functions, on purpose: the command line
-#: starts without SciPy for --help, --version (a downward import can make no cycle).
-LAZY = {"tubefsi.cli"}
+#: starts without SciPy for --help, --version; tubefsi.testing imports its suites on first use, so
+#: that a conftest can load a hypothesis profile (tubefsi.testing.profiles) before the suites
+#: create their settings (a downward import can make no cycle).
+LAZY = {"tubefsi.cli", "tubefsi.testing"}
 
 
 def test_function_level_imports_only_where_documented():

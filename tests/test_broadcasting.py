@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 
 import tubefsi
 from tubefsi.registry import rheologies, walls
+from tubefsi.testing.profiles import scaled
 
 TUBE = tubefsi.Tube(radius=1e-4, thickness=3e-5, length=1e-2)
 
@@ -21,7 +22,7 @@ def _pl(m, n):
     return rheologies["power-law"](consistency=m, index=n)
 
 
-@settings(deadline=None, max_examples=15)
+@settings(deadline=None, max_examples=scaled(15))
 @given(st.lists(st.tuples(st.floats(1e3, 1e4), st.floats(0.01, 0.05), st.floats(0.5, 1.5),
                           st.floats(5e-5, 3e-4), st.floats(0.05, 1.0), st.floats(5e-3, 5e-2), st.floats(0.05, 0.9)),
                 min_size=1, max_size=6),

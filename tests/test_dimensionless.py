@@ -13,6 +13,7 @@ from tubefsi import dimensionless as nd
 from tubefsi.fields import real
 from tubefsi.registry import rheologies, walls
 from tubefsi.rheology.base import Rheology
+from tubefsi.testing.profiles import scaled
 from tubefsi.walls.hyperelastic import HyperelasticWall, ThickWall
 
 TUBE = tubefsi.Tube(radius=1e-4, thickness=3e-5, length=1e-2)
@@ -107,7 +108,7 @@ def test_pressure_controlled_groups_solve_for_the_flow_rate():
 
 
 # ------------------------------------------------------------------------------ the reverse
-@settings(deadline=None, max_examples=25)
+@settings(deadline=None, max_examples=scaled(25))
 @given(n=st.floats(0.3, 2.0), tb=st.floats(0.01, 2.0), qbar=st.floats(0.0, 2.0), gam=st.floats(0.01, 10.0),
        wall=st.sampled_from(["thick-mooney-rivlin", "thin-mooney-rivlin", "thick-neo-hookean",
                              "thin-neo-hookean", "thick-linear", "thin-linear"]))

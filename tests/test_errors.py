@@ -10,6 +10,7 @@ from hypothesis import strategies as st
 import tubefsi
 from tubefsi import InvalidParameterError, NoSteadyStateError
 from tubefsi.registry import rheologies, walls
+from tubefsi.testing.profiles import scaled
 
 TUBE = tubefsi.Tube(radius=1e-4, thickness=3e-5, length=1e-2)
 FLUID = rheologies["power-law"](consistency=0.017, index=0.7)
@@ -159,7 +160,7 @@ def test_no_nan_over_a_wide_load_range(wall):
     assert np.all(np.isfinite(back.flow_rate))
 
 
-@settings(deadline=None, max_examples=300)
+@settings(deadline=None, max_examples=scaled(300))
 @given(low=st.sampled_from([-math.inf, -1.0, 0.0, 1.0]), width=st.sampled_from([0.0, 1.0, math.inf]),
        low_open=st.booleans(), high_open=st.booleans(),
        value=st.one_of(st.floats(allow_nan=True, allow_infinity=True),

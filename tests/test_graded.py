@@ -25,6 +25,7 @@ from hypothesis import strategies as st
 import tubefsi
 from tubefsi.couplers import Graded
 from tubefsi.scene import make_scene
+from tubefsi.testing.profiles import scaled
 
 walls = tubefsi.registry.walls
 fluids = tubefsi.registry.rheologies
@@ -193,7 +194,7 @@ def test_graded_tube_matches_segment_chain(case):
 
 
 # ------------------------------------------------------------------ limits (property tests)
-@settings(max_examples=12, deadline=None)
+@settings(max_examples=scaled(12), deadline=None)
 @given(n=st.floats(0.4, 1.5), eps=st.floats(1e-9, 1e-3), separable=st.booleans())
 def test_vanishing_taper_gives_the_uniform_tube(n, eps, separable):
     """a(z) = a0 (1 - eps z/L): the pressure drop differs from the uniform tube's by O(eps) (below
@@ -209,7 +210,7 @@ def test_vanishing_taper_gives_the_uniform_tube(n, eps, separable):
     assert 0.0 < change < (3 * n + 2) * eps
 
 
-@settings(max_examples=6, deadline=None)
+@settings(max_examples=scaled(6), deadline=None)
 @given(n=st.floats(0.4, 1.5), q=st.floats(1e-9, 1e-7), tb=st.floats(0.05, 1.0))
 def test_constant_callables_equal_the_scalar_tube(n, q, tb):
     """Constant functions of z give the scalar tube's answers: to 1e-13 where the scene separates

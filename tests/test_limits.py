@@ -18,6 +18,7 @@ from hypothesis import strategies as st
 import tubefsi
 from tubefsi.couplers import ODE, Quadrature
 from tubefsi.registry import rheologies, walls
+from tubefsi.testing.profiles import scaled
 
 TUBE = tubefsi.Tube(radius=1e-4, thickness=3e-5, length=1e-2)
 HYPERELASTIC = [("thin-neo-hookean", {"thickness_convention": "reference"}, "thin-linear"),
@@ -25,7 +26,7 @@ HYPERELASTIC = [("thin-neo-hookean", {"thickness_convention": "reference"}, "thi
                 ("thick-neo-hookean", {}, "thick-linear")]
 
 
-@settings(deadline=None, max_examples=20)
+@settings(deadline=None, max_examples=scaled(20))
 @given(n=st.floats(0.3, 2.0), q=st.floats(-12, -6).map(lambda x: 10.0**x))
 def test_rigid_is_hagen_poiseuille(n, q):
     fluid = rheologies["power-law"](consistency=0.02, index=n)
@@ -52,7 +53,7 @@ def test_stiff_wall_tends_to_rigid(name):
     assert errors[2] == pytest.approx(errors[1] / 100, rel=0.05)
 
 
-@settings(deadline=None, max_examples=15)
+@settings(deadline=None, max_examples=scaled(15))
 @given(q=st.floats(-12, -8).map(lambda x: 10.0**x), wall_index=st.integers(0, 6))
 def test_power_law_index_one_is_newtonian(q, wall_index):
     examples = [walls[n](**kw) for n in walls for kw in walls[n]._examples]

@@ -21,6 +21,7 @@ from hypothesis import given, settings, strategies as st
 import tubefsi
 from tubefsi import ConvergenceError, InvalidParameterError, Network, NoSteadyStateError, Tube
 from tubefsi.registry import rheologies, walls
+from tubefsi.testing.profiles import scaled
 
 FLUID = rheologies["power-law"](consistency=0.01, index=0.8)
 WALL = walls["thick-neo-hookean"](shear_modulus=4e3)
@@ -48,7 +49,7 @@ def _worst_balance(result):
 
 
 # ---------------------------------------------------------------------------- identities
-@settings(max_examples=12, deadline=None)
+@settings(max_examples=scaled(12), deadline=None)
 @given(fluid=fluids, mu=moduli, k=st.integers(2, 4), f_in=st.floats(0.1, 0.8), f_out=st.floats(0.0, 0.5))
 def test_a_tube_cut_in_series_is_the_tube(fluid, mu, k, f_in, f_out):
     wall = walls["thick-neo-hookean"](shear_modulus=mu)
@@ -70,7 +71,7 @@ def test_a_tube_cut_in_series_is_the_tube(fluid, mu, k, f_in, f_out):
     assert _worst_balance(result) <= 1e-12
 
 
-@settings(max_examples=10, deadline=None)
+@settings(max_examples=scaled(10), deadline=None)
 @given(fluid=fluids, mu=moduli, k=st.integers(2, 5), f=st.floats(0.01, 0.2))
 def test_identical_parallel_tubes_share_the_flow(fluid, mu, k, f):
     wall = walls["thick-neo-hookean"](shear_modulus=mu)
@@ -101,7 +102,7 @@ def _symmetric_tree(depth, fluid, wall, tube_of_generation):
     return net, leaves
 
 
-@settings(max_examples=8, deadline=None)
+@settings(max_examples=scaled(8), deadline=None)
 @given(fluid=fluids, mu=moduli, depth=st.integers(2, 5), f=st.floats(0.05, 0.9))
 def test_a_symmetric_tree_splits_evenly(fluid, mu, depth, f):
     wall = walls["thick-neo-hookean"](shear_modulus=mu)
@@ -123,7 +124,7 @@ def test_a_symmetric_tree_splits_evenly(fluid, mu, depth, f):
     assert _worst_balance(result) <= 1e-12
 
 
-@settings(max_examples=10, deadline=None)
+@settings(max_examples=scaled(10), deadline=None)
 @given(seed=st.integers(0, 2**31 - 1), n_nodes=st.integers(4, 14), loops=st.integers(0, 4))
 def test_mass_balances_at_every_node(seed, n_nodes, loops):
     """A random tree with extra loop tubes, mixed fluids and walls, inflows and fixed pressures."""

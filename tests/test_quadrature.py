@@ -17,6 +17,7 @@ from tubefsi.numerics.quadrature import (GAUSS_WEIGHTS, KRONROD_NODES, KRONROD_W
                                          unit_integral, warn_unconverged)
 from tubefsi.numerics.roots import solve_increasing
 from tubefsi.numerics.spectral import LOBATTO_NODES, solve_integral
+from tubefsi.testing.profiles import scaled
 
 
 def test_kronrod_rule_is_exact_to_degree_31_and_embeds_gauss_10():
@@ -40,7 +41,7 @@ def test_fast_growth_reaches_the_tolerance(b):
     assert r.error <= 1e-14 * abs(r.value)
 
 
-@settings(deadline=None, max_examples=30)
+@settings(deadline=None, max_examples=scaled(30))
 @given(st.lists(st.tuples(st.floats(0.0, 3.0), st.floats(0.1, 30.0)), min_size=1, max_size=20))
 def test_vectorized_equals_one_point_at_a_time(cases):
     k = np.array([c[0] for c in cases])
@@ -143,7 +144,7 @@ def test_interpolation_maps_against_numpy_chebyshev(degree):
     np.testing.assert_allclose(cumulative, np.polynomial.chebyshev.chebval(t, anti.T), rtol=0, atol=1e-13)
 
 
-@settings(deadline=None, max_examples=30)
+@settings(deadline=None, max_examples=scaled(30))
 @given(st.floats(0.0, 4.0), st.floats(0.2, 3.0), st.floats(0.01, 0.6))
 def test_solved_points_meet_the_tolerance_against_mpmath(k, c, target):
     """int_0^x e^{ku} (c + u) du = T, solved where the estimate says so, against mpmath's root."""

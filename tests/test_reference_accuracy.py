@@ -65,6 +65,7 @@ from hypothesis import strategies as st
 from mpmath import mp, mpf
 
 import tubefsi
+from tubefsi.testing.profiles import scaled
 from tubefsi.testing.reference import rel_err
 from tubefsi.testing.reference.power_law import ref_J, ref_J_inf, ref_phi, ref_phi_inverse
 from tubefsi.testing.reference.tube_laws import WALLS, RefWall, stretch_at_pressure
@@ -239,7 +240,7 @@ def test_max_flow_rate_infinite_without_limit_pressure(wall_name, n):
 
 
 # ---------------------------------------------------------------------------- hypothesis
-@settings(deadline=None, max_examples=15)
+@settings(deadline=None, max_examples=scaled(15))
 @given(
     n=st.floats(min_value=0.3, max_value=1.5),
     tb=st.floats(min_value=0.05, max_value=1.0),

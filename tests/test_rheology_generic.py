@@ -26,6 +26,7 @@ from tubefsi import AccuracyWarning, InvalidParameterError
 from tubefsi.errors import TubefsiError
 from tubefsi.rheology import Rheology
 from tubefsi.rheology._flow_table import TOL, flow_table, unit_integral
+from tubefsi.testing.profiles import scaled
 
 EPS = np.finfo(float).eps
 
@@ -475,7 +476,7 @@ def test_cumulative_panel_rate_refuses_a_stress_plateau():
     assert np.all(rel(np.exp(y), twin.exact_rate(tw, excess)) < 4 * EPS * law.yield_stress / excess)
 
 
-@settings(max_examples=25, deadline=None)
+@settings(max_examples=scaled(25), deadline=None)
 @given(eta0=st.floats(1e-3, 10.0), lam=st.floats(1e-3, 1e3), index=st.floats(0.05, 1.8),
        centre=st.floats(-25.0, 25.0), width=st.floats(0.05, 12.0))
 def test_cumulative_panel_rate_equals_the_pointwise_integrals(eta0, lam, index, centre, width):

@@ -13,6 +13,7 @@ from hypothesis import given, settings, strategies as st
 import tubefsi
 from tubefsi import Tube
 from tubefsi.registry import rheologies, walls
+from tubefsi.testing.profiles import scaled
 
 TUBE = Tube(radius=1e-4, thickness=3e-5, length=1e-2)
 H = 1e-3
@@ -120,7 +121,7 @@ def test_ode_coupler_uses_its_profile():
     np.testing.assert_allclose(by_ode, by_default, rtol=1e-6)     # the ODE's own tolerance
 
 
-@settings(deadline=None, max_examples=20)
+@settings(deadline=None, max_examples=scaled(20))
 @given(n=st.floats(0.4, 1.6), mu=st.floats(5e2, 5e4), q=st.floats(1e-11, 2e-9), p_out=st.floats(0.0, 500.0))
 def test_slope_matches_differences_property(n, mu, q, p_out):
     rheo = rheologies["power-law"](consistency=0.01, index=n)

@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 
 import tubefsi
 import tubefsi.testing
+from tubefsi.testing.profiles import scaled
 
 walls = tubefsi.registry.walls
 mp.mp.dps = 30
@@ -197,7 +198,7 @@ def test_thick_neo_hookean_under_external_pressure_matches_mpmath():
         assert sol.inlet_displacement == pytest.approx(float(e_in * TUBE.radius), rel=1e-11)
 
 
-@settings(deadline=None, max_examples=15)
+@settings(deadline=None, max_examples=scaled(15))
 @given(p_out=st.floats(0.0, 50.0), p_e=st.floats(-30.0, 200.0), q=st.floats(1e-12, 1e-9),
        name=st.sampled_from(["shapiro", "thin-neo-hookean", "thick-linear"]))
 # a subnormal outlet pressure: Newton's step on the outlet strain rounds to zero (it bisected away)
@@ -349,7 +350,7 @@ def test_pre_stretched_tube_in_situ_matches_mpmath(lz):
     assert sol.radius(0.0) == pytest.approx(float((1 + e_in) * installed.radius), rel=1e-11)
 
 
-@settings(deadline=None, max_examples=10)
+@settings(deadline=None, max_examples=scaled(10))
 @given(delta=st.floats(-1e-6, 1e-6), name=st.sampled_from(["thick-neo-hookean", "thin-mooney-rivlin"]),
        q=st.floats(1e-11, 1e-8))
 def test_axial_stretch_tends_to_todays_walls(delta, name, q):
@@ -597,20 +598,44 @@ def test_axial_stretch_of_plugin_materials_validates_and_locks():
     assert "axial_stretch" in names
 
 
-@settings(deadline=None, max_examples=6)
+@settings(deadline=None, max_examples=scaled(6))
 @given(delta=st.floats(-1e-6, 1e-6), name=st.sampled_from(["thick-gent", "thin-fung", "thick-ogden", "thin-yeoh",
                                                            "thick-hgo", "thin-hgo"]),
        lam=st.floats(1.001, 1.5))
+@example(delta=-1e-6, name="thick-hgo", lam=1.001)    # the fibre walls at the low end of lam, on the side
+@example(delta=1e-6, name="thin-hgo", lam=1.001)      # of delta where their fibres are slack at rest
 def test_axial_stretch_near_one_gives_todays_walls(delta, name, lam):
-    """lz -> 1: the tube law moves by O(delta) from the plane-strain wall (the fibre walls too)."""
+    r"""lz -> 1: the tube law moves by O(delta) from the plane-strain wall (the fibre walls too).
+
+    The change is measured against a pressure scale that does not vanish at lam = 1,
+    |P(lam; 1)| + K0 (K0 = P'(1), the small-strain modulus), not against P(lam; 1) alone. An
+    isotropic wall's law is smooth in (lam, lz) with P(1; lz) = 0, so the change
+    delta dP/dlz = O(delta (lam - 1)) and the relative change is O(delta) (at most 1.5 |delta| for
+    the four isotropic walls here). A fibre wall's plane law has a kink at lam = 1, where the
+    fibres engage (slope K- = matrix only below, K+ = K0 above). At lz = 1 + delta the fibre strain
+    at rest is x0 = delta (2 sin^2 b - cos^2 b) + O(delta^2); on the side where x0 < 0 (delta < 0
+    for thick-hgo, b = 62 deg; delta > 0 for thin-hgo, b = 29 deg) the fibres are slack at rest and
+    engage at lam* = 1 + k delta, k = -(2 sin^2 b - cos^2 b)/(2 cos^2 b) (thin wall), so for
+    lam > lam*: P(lam; 1 + delta) - P(lam; 1) = -(K+ - K-) k delta + O(delta (lam - 1)), which does
+    not vanish as lam -> 1. Against P(lam; 1) ~ K+ (lam - 1) that is c |delta| / (lam - 1),
+    c = |k| (K+ - K-)/K+: 0.092 for thin-hgo (measured 0.094), 0.47 for thick-hgo from the thin-wall
+    estimate (measured 0.60: the engagement spreads through the thick wall). At the strategy's
+    lam = 1.001 that is 94 |delta| and 600 |delta|, so the former bound 50 |delta| on the relative
+    change failed there (7.6e-5). Against the scale the measured coefficient is at most 2.04
+    (thin-hgo at lam = 1.5, where its fibres stiffen) over lam in [1.001, 1.5] and both signs; the
+    bound is 10. A wall whose lz -> 1 limit is wrong by a fraction e of P misses it as soon as
+    e (lam - 1) > 10 |delta| (e = 1e-4 fails under the ci profile), by an offset e K0 as soon as
+    e > 10 |delta| (e = 1e-5 fails). 1e-13: rounding in P near lam = 1 and for delta -> 0."""
     pytest.importorskip("tubefsi_hyperelastic")
     base = examples_of(name)
     near = attrs_evolve(base, axial_stretch=1.0 + delta)
     tb = 0.3
-    assert abs(near.pressure(lam, tb) / base.pressure(lam, tb) - 1) <= 50 * abs(delta) + 1e-13
+    p = base.pressure(lam, tb)
+    scale = abs(p) + base.small_strain_modulus(tb)
+    assert abs(near.pressure(lam, tb) - p) <= (10 * abs(delta) + 1e-13) * scale
 
 
-@settings(deadline=None, max_examples=4)
+@settings(deadline=None, max_examples=scaled(4))
 @given(lz=st.lists(st.floats(0.85, 1.8), min_size=2, max_size=3), name=st.sampled_from(["thick-hgo", "thin-hgo",
                                                                                         "thick-fung", "thin-gent"]))
 def test_axial_stretch_broadcasts_like_a_loop(lz, name):

@@ -44,14 +44,45 @@ modules directly:
 * ``tubefsi.testing.reference.rel_err`` — the relative error of a result against a reference.
 
 Nothing there calls tubefsi's numerics.
+
+Hypothesis profiles are in :mod:`tubefsi.testing.profiles`: ``ci`` (seeded, the default) and
+``explore`` (randomized, ten times the examples), chosen by ``TUBEFSI_HYPOTHESIS_PROFILE``. A test
+directory loads one in its ``conftest.py`` before the suites are imported::
+
+    from tubefsi.testing.profiles import load_profile
+
+    load_profile()
+
+That is why the names below are imported on first use (PEP 562), not with the package: importing
+``tubefsi.testing.profiles`` must not create the suites' hypothesis settings, which take their
+unset values from the profile active when they are created.
 """
 
-from .contracts import (AccuracyContract, BruteForce, CouplerContract, HyperelasticWallContract, RheologyContract,
-                        WallContract, accuracy_cases, brute_force)
-from .strategies import coupler_cases, examples, flow_rates, reduced_thicknesses, strains
+_LAZY = {
+    "WallContract": "contracts", "HyperelasticWallContract": "contracts", "RheologyContract": "contracts",
+    "CouplerContract": "contracts", "AccuracyContract": "contracts", "brute_force": "contracts",
+    "BruteForce": "contracts", "accuracy_cases": "contracts",
+    "examples": "strategies", "coupler_cases": "strategies", "strains": "strategies",
+    "reduced_thicknesses": "strategies", "flow_rates": "strategies",
+}
 
 __all__ = [
     "WallContract", "HyperelasticWallContract", "RheologyContract", "CouplerContract", "AccuracyContract",
     "brute_force", "BruteForce", "examples", "coupler_cases", "accuracy_cases", "strains", "reduced_thicknesses",
     "flow_rates",
 ]
+
+
+def __getattr__(name):
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    from . import contracts, strategies     # noqa: F401 - imported here on purpose (the docstring says why)
+
+    value = getattr({"contracts": contracts, "strategies": strategies}[module], name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))

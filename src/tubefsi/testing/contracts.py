@@ -27,12 +27,14 @@ from ..solve import max_flow_rate, solve
 from .reference.quadrature import tanh_sinh
 from ..walls.hyperelastic import HyperelasticWall, ThickWall, ThinWall
 from ..walls.linear import ThickLinear, ThinLinear
+from .profiles import scaled
 from .strategies import examples, flow_rates, reduced_thicknesses, strains
 
 __all__ = ["WallContract", "HyperelasticWallContract", "RheologyContract", "CouplerContract", "AccuracyContract",
            "BruteForce", "brute_force", "accuracy_cases"]
 
-_settings = settings(deadline=None, max_examples=25,
+# max_examples through scaled(): as written under the ci profile, ten times it under explore
+_settings = settings(deadline=None, max_examples=scaled(25),
                      suppress_health_check=[HealthCheck.function_scoped_fixture])
 
 
@@ -343,7 +345,7 @@ class CouplerContract:
         rheology, wall, coupler = case
         return solve(rheology, wall, self.tube, coupler=coupler, **kw)
 
-    @settings(deadline=None, max_examples=10, suppress_health_check=[HealthCheck.function_scoped_fixture])
+    @settings(deadline=None, max_examples=scaled(10), suppress_health_check=[HealthCheck.function_scoped_fixture])
     @given(fraction=flow_rates(1e-3, 1.0))
     def test_agrees_with_reference_and_inverts(self, case, fraction):
         rheology, wall, coupler = case
