@@ -48,6 +48,7 @@ from hypothesis import strategies as st
 from mpmath import mp, mpf
 
 from tubefsi import fields
+from tubefsi.testing.profiles import scaled
 from tubefsi.testing.reference import tube_laws as ref
 from tubefsi.walls import HyperelasticWall, ThickWall, ThinWall
 from tubefsi.walls import hyperelastic
@@ -330,7 +331,7 @@ def test_a_points_bits_do_not_depend_on_its_batch(name):
 
 
 # ---------------------------------------------------------------------------- properties
-@settings(deadline=None, max_examples=40)
+@settings(deadline=None, max_examples=scaled(40))
 @given(name=st.sampled_from(sorted(CASES)), log_strain=st.floats(-12.0, -0.5), log_tb=st.floats(-2.0, 1.0),
        compress=st.booleans())
 def test_thick_law_matches_mpmath_at_random_strains(name, log_strain, log_tb, compress):
