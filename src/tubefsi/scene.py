@@ -138,45 +138,45 @@ class Scene:
             object.__setattr__(self, "gauge_outlet_pressure", gauge)
         shapes = [parameter_shape(self.rheology), parameter_shape(self.wall), parameter_shape(self.tube)]
         shapes += [np.shape(v) for v in (p_out, p_e, self.gauge_outlet_pressure) if type(v) is not float]
-        shape = np.broadcast_shapes(*shapes) if any(shapes) else ()
-        object.__setattr__(self, "shape", shape)
+        object.__setattr__(self, "shape", np.broadcast_shapes(*shapes) if any(shapes) else ())
         object.__setattr__(self, "graded", self.tube.graded or varies(self.wall))
         if self.graded:                     # the outlet state of the tube law at z = L
             wall, tb = self.at_outlet()
-            strain = wall.strain(self.outlet_pressure, tb) if np.any(np.asarray(self.outlet_pressure) != 0) else 0.0
-            object.__setattr__(self, "outlet_strain", strain)
-            object.__setattr__(self, "outlet_stretch", 1.0 + strain)
-            object.__setattr__(self, "log_stretch_max", math.inf)
-            return
-        # the hoop strain at the outlet, once: every J evaluation needs it
-        tb = self.tb
-        if type(p_out) is float and p_out == 0.0 or np.ndim(p_out) == 0 and p_out == 0:
-            strain = 0.0
-        elif shape == ():
-            strain = float(self.wall._strain(np.asarray(p_out), tb))
-        else:
-            strain = np.where(np.asarray(p_out) == 0, 0.0, self.wall.strain(p_out, tb))
+            strain = wall.strain(p_out, tb) if np.any(np.asarray(p_out) != 0) else 0.0
+            lam_max = math.inf
+        else:                               # the outlet state, once: every J evaluation needs it
+            strain = self._outlet_strain()
+            lam_max = self._max_stretch()
         object.__setattr__(self, "outlet_strain", strain)
         object.__setattr__(self, "outlet_stretch", 1.0 + strain)
-        if shape == ():
-            lam_max = self.wall._max_stretch(tb)
-            if type(lam_max) is float and type(strain) is float:      # (a scene of scalars: no NumPy)
-                object.__setattr__(self, "log_stretch_max", math.log(lam_max / (1.0 + strain))
-                                   if lam_max < math.inf else math.inf)
-                return
+        if type(lam_max) is float and type(strain) is float:
+            v_max = math.log(lam_max / (1.0 + strain)) if lam_max < math.inf else math.inf
         else:
-            # the hook first: a wall that never locks says inf whatever its parameters (a tenth of
-            # the per-point evaluation's cost); any other answer, or a hook that takes no array
-            # parameters, gets the per-point, validated evaluation
-            try:
-                lam_max = self.wall._max_stretch(tb)
-            except Exception:                    # noqa: BLE001 (the evaluation below raises what is real)
-                lam_max = None
-            if not (type(lam_max) is float and lam_max == math.inf):
-                lam_max = self.wall.max_stretch(tb)
-        with np.errstate(divide="ignore"):
-            v_max = np.log(np.asarray(lam_max, dtype=float) / (1.0 + np.asarray(strain)))
-        object.__setattr__(self, "log_stretch_max", float(v_max) if v_max.ndim == 0 else v_max)
+            with np.errstate(divide="ignore"):
+                v_max = np.log(np.asarray(lam_max, dtype=float) / (1.0 + np.asarray(strain)))
+            v_max = float(v_max) if v_max.ndim == 0 else v_max
+        object.__setattr__(self, "log_stretch_max", v_max)
+
+    def _outlet_strain(self):
+        """The hoop strain under the (transmural) outlet pressure: 0 where it is 0."""
+        p_out, tb = self.outlet_pressure, self.tb
+        if np.ndim(p_out) == 0 and p_out == 0:
+            return 0.0
+        if self.shape == ():
+            return float(self.wall._strain(np.asarray(p_out), tb))
+        return np.where(np.asarray(p_out) == 0, 0.0, self.wall.strain(p_out, tb))
+
+    def _max_stretch(self):
+        """The wall's maximum stretch at every point: the hook first (a wall that never locks says
+        inf whatever its parameters), else the per-point, validated evaluation."""
+        tb = self.tb
+        try:
+            lam_max = self.wall._max_stretch(tb)
+        except Exception:                    # noqa: BLE001 (the evaluation below raises what is real)
+            lam_max = None
+        if self.shape == () and lam_max is not None or type(lam_max) is float and lam_max == math.inf:
+            return lam_max
+        return self.wall.max_stretch(tb)
 
     @classmethod
     def unloaded(cls, rheology, wall, tube) -> Scene:
@@ -263,13 +263,7 @@ class Scene:
         todo = np.asarray(todo)
         if self.size == 1 or todo.size == 0:
             return [(todo, self)]
-        grouped = []
-        for model in (self.rheology, self.wall):
-            broadcasts = getattr(type(model), "broadcasts", True)
-            if model is self.rheology:
-                broadcasts = broadcasts and model.separable
-            if not broadcasts and _array_values(model):
-                grouped.append(model)
+        grouped = self._grouped()
         if not grouped:
             # (every point in order, the common case: the scene itself, not a gathered copy of it)
             return [(todo, self if _every_point(todo, self.size) else self.take(todo))]
@@ -289,6 +283,18 @@ class Scene:
                     object.__setattr__(part, name, scalar)
             parts.append((index, _refresh(part)))
         return parts
+
+    def _grouped(self):
+        """The models whose array parameters must be split into parameter sets: a non-separable
+        rheology (its flow table is per fluid) or a model whose hooks do not broadcast."""
+        grouped = []
+        for model in (self.rheology, self.wall):
+            broadcasts = getattr(type(model), "broadcasts", True)
+            if model is self.rheology:
+                broadcasts = broadcasts and model.separable
+            if not broadcasts and _array_values(model):
+                grouped.append(model)
+        return grouped
 
     def at(self, index, *, column=False) -> Points:
         """The per-point quantities of a flat scene at ``index``, as columns (shape ``(n, 1)``, to
@@ -457,24 +463,31 @@ def make_scene(rheology, wall, tube, *, outlet_pressure=0.0, external_pressure=0
         if kinds == (_FLOATS, _FLOATS, _FLOATS) and (tube is installed or _kind(tube) == _FLOATS):
             return Scene.unloaded(rheology, wall, tube)
         return Scene(rheology=rheology, wall=wall, tube=tube, outlet_pressure=0.0)
+    p_out, p_e, gauge = _outlet(wall, tube.reduced_thickness, outlet_pressure, external_pressure)
+    if np.ndim(p_e) == 0 and p_e == 0:
+        return Scene(rheology=rheology, wall=wall, tube=tube, outlet_pressure=p_out)
+    return Scene(rheology=rheology, wall=wall, tube=tube, outlet_pressure=p_out, external_pressure=p_e,
+                 gauge_outlet_pressure=gauge)
+
+
+def _outlet(wall, tb, outlet_pressure, external_pressure):
+    """``(transmural outlet pressure, external pressure, gauge outlet pressure)``, validated: the
+    outlet below the wall's limit pressure and above its minimum (buckling) pressure."""
     p_out = as_array("outlet_pressure", outlet_pressure, "[0, inf)", lambda a: a >= 0)
     p_out = float(p_out) if p_out.ndim == 0 else p_out
     p_e = as_array("external_pressure", external_pressure, "the real numbers", lambda a: a == a)
     p_e = float(p_e) if p_e.ndim == 0 else p_e
     gauge = p_out
     if np.any(p_e != 0):
-        p_out = _transmural(wall, tube.reduced_thickness, p_out, p_e)
-    lim = wall.limit_pressure(tube.reduced_thickness)
+        p_out = _transmural(wall, tb, p_out, p_e)
+    lim = wall.limit_pressure(tb)
     beyond = np.asarray(p_out >= lim)
     if np.any(beyond):
         i = np.unravel_index(int(np.argmax(beyond.ravel())), beyond.shape) if beyond.ndim else ()
         raise NoSteadyStateError("pressure", float(np.broadcast_to(lim, beyond.shape)[i]),
                                  float(np.broadcast_to(p_out, beyond.shape)[i]),
                                  "the outlet pressure already reaches it", name="the outlet pressure")
-    if np.ndim(p_e) == 0 and p_e == 0:
-        return Scene(rheology=rheology, wall=wall, tube=tube, outlet_pressure=p_out)
-    return Scene(rheology=rheology, wall=wall, tube=tube, outlet_pressure=p_out, external_pressure=p_e,
-                 gauge_outlet_pressure=gauge)
+    return p_out, p_e, gauge
 
 
 #: Positions (fractions of L) where a graded scene's profiles are validated when it is made.
@@ -485,42 +498,15 @@ def _graded_scene(rheology, wall, tube, outlet_pressure, external_pressure):
     """:func:`make_scene` for a tube or wall that varies along z: installed at the axial stretch
     (positions and radii rescaled), validated at 65 positions and the breakpoints (every later
     evaluation validates itself), the outlet checked with the tube law at z = L."""
-    lz = getattr(wall, "axial_stretch", 1.0)
-    if np.ndim(lz) != 0:
-        raise InvalidParameterError("axial_stretch", "a number for a tube or wall that varies along z", lz)
-    if lz != 1.0 and not getattr(wall, "_homogeneous_rest", lambda: True)():
-        raise InvalidParameterError("axial_stretch", "1 for a pre-stretched fibre wall on a tube or wall that varies "
-                                    "along z", lz, "its installed rest state depends on the local geometry")
-    if lz != 1.0:
-        shrink = 1.0 / math.sqrt(lz)
-        fields = {n: (v.scaled(shrink, 1.0 / lz) if isinstance(v, Profile) else v * shrink)
-                  for n in ("radius", "thickness") for v in [getattr(tube, n)]}
-        tube = InstalledTube(**fields, length=tube.length * lz, axial_stretch=lz)
-        wall = _replace(wall, {n: v.scaled(1.0, 1.0 / lz) for n in _array_fields(type(wall))
-                               if isinstance(v := getattr(wall, n), Profile)})
+    tube, wall = _install_graded(tube, wall)
     length = np.asarray(tube.length, dtype=float)
-    top = float(np.max(length))
-    for model in (tube, wall):
-        for name in _array_fields(type(model)):
-            if isinstance(v := getattr(model, name), Profile):
-                v.check_span(top)
-    breaks = [b for m in (tube, wall) for n in _array_fields(type(m)) if isinstance(v := getattr(m, n), Profile)
-              for b in v.breakpoints if 0 < b < top]
-    z = np.concatenate([top * _CHECK_NODES, breaks]).reshape((-1,) + (1,) * max(
-        len(parameter_shape(wall)), np.ndim(length)))
-    a, t = tube.at(z)
-    tb = np.asarray(t / a)
-    if not np.all(np.isfinite(tb) & (tb > 0)):
-        raise InvalidParameterError("thickness", "values with a finite, nonzero t/a along the tube",
-                                    tube.thickness)
-    checked = {n: v(z) for n in _array_fields(type(wall)) if isinstance(v := getattr(wall, n), Profile)}
-    if checked:
-        attrs.evolve(_replace(wall, {n: getattr(wall, n) for n in checked}), **checked)   # validators, cross-checks
+    _check_along(tube, wall, length)
     p_out = as_array("outlet_pressure", outlet_pressure, "[0, inf)", lambda a: a >= 0)
     p_out = float(p_out) if p_out.ndim == 0 else p_out
     p_e = as_array("external_pressure", external_pressure, "the real numbers", lambda a: a == a)
     p_e = float(p_e) if p_e.ndim == 0 else p_e
-    outlet_wall, _, tb_out = (lambda w, a_, tb_: (_scalars(w), a_, tb_))(*_at(tube, wall, length))
+    outlet_wall, _, tb_out = _at(tube, wall, length)
+    outlet_wall = _scalars(outlet_wall)
     gauge = p_out
     if np.any(p_e != 0):
         p_out = _transmural(outlet_wall, tb_out, p_out, p_e)
@@ -530,6 +516,51 @@ def _graded_scene(rheology, wall, tube, outlet_pressure, external_pressure):
                                  "the outlet pressure already reaches it", name="the outlet pressure")
     return Scene(rheology=rheology, wall=wall, tube=tube, outlet_pressure=p_out, external_pressure=p_e,
                  gauge_outlet_pressure=gauge)
+
+
+def _install_graded(tube, wall):
+    """A graded tube and wall as installed at the wall's axial stretch (positions stretched, radii
+    and thickness over its square root)."""
+    lz = getattr(wall, "axial_stretch", 1.0)
+    if np.ndim(lz) != 0:
+        raise InvalidParameterError("axial_stretch", "a number for a tube or wall that varies along z", lz)
+    if lz == 1.0:
+        return tube, wall
+    if not getattr(wall, "_homogeneous_rest", lambda: True)():
+        raise InvalidParameterError("axial_stretch", "1 for a pre-stretched fibre wall on a tube or wall that varies "
+                                    "along z", lz, "its installed rest state depends on the local geometry")
+    shrink = 1.0 / math.sqrt(lz)
+    fields = {n: (v.scaled(shrink, 1.0 / lz) if isinstance(v, Profile) else v * shrink)
+              for n in ("radius", "thickness") for v in [getattr(tube, n)]}
+    tube = InstalledTube(**fields, length=tube.length * lz, axial_stretch=lz)
+    wall = _replace(wall, {n: v.scaled(1.0, 1.0 / lz) for n in _array_fields(type(wall))
+                           if isinstance(v := getattr(wall, n), Profile)})
+    return tube, wall
+
+
+def _profiles_of(model):
+    return {n: v for n in _array_fields(type(model)) if isinstance(v := getattr(model, n), Profile)}
+
+
+def _check_along(tube, wall, length):
+    """Validate a graded tube and wall at 65 positions and every breakpoint: t/a finite and
+    positive, the wall's validators and cross-checks at each position."""
+    top = float(np.max(length))
+    for model in (tube, wall):
+        for profile in _profiles_of(model).values():
+            profile.check_span(top)
+    breaks = [b for m in (tube, wall) for v in _profiles_of(m).values() for b in v.breakpoints if 0 < b < top]
+    z = np.concatenate([top * _CHECK_NODES, breaks]).reshape((-1,) + (1,) * max(
+        len(parameter_shape(wall)), np.ndim(length)))
+    a, t = tube.at(z)
+    tb = np.asarray(t / a)
+    if not np.all(np.isfinite(tb) & (tb > 0)):
+        raise InvalidParameterError("thickness", "values with a finite, nonzero t/a along the tube",
+                                    tube.thickness)
+    profiles = _profiles_of(wall)
+    if profiles:
+        checked = {n: v(z) for n, v in profiles.items()}
+        attrs.evolve(_replace(wall, profiles), **checked)   # validators, cross-checks
 
 
 def _at(tube, wall, z):

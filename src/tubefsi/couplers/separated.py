@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import abc
 import math
+from typing import NamedTuple
 
 import numpy as np
 
@@ -116,6 +117,15 @@ def _rigid_state(scene: Scene, *, flow_rate=None, pressure_drop=None) -> State:
         q = np.where(dp == 0, 0.0, rheo._flow_rate(a + 0.0 * dp, np.where(dp == 0, 1.0, dp) / L))
     zero = np.zeros_like(q)
     return State(q, dp, zero + scene.outlet_strain, zero)
+
+
+class _Direct(NamedTuple):
+    """What :meth:`SeparatedVariables._flow_direct` solved: the points it answered, whether each
+    point has a root (False: none below the solver's range) and J at the answer or J(inf)."""
+
+    points: np.ndarray
+    ok: np.ndarray
+    found: Integral
 
 
 class SeparatedVariables(Coupler):
@@ -343,7 +353,9 @@ class SeparatedVariables(Coupler):
 
     def _flow(self, scene: Scene, q, *, raise_):
         """``(State, feasible)`` of the flow rates ``q``: NaN and False where a point is beyond its
-        maximum flow rate (or, with ``raise_``, a NoSteadyStateError)."""
+        maximum flow rate (or, with ``raise_``, a NoSteadyStateError). Each point's route: the
+        scene's table where it serves the call, else a curve interpolated between direct solves
+        (a long curve of a non-separable fluid), else the direct solution."""
         if scene.wall.is_rigid:
             return _rigid_state(scene, flow_rate=q), None
         table = self._table(scene, q.size)
@@ -351,51 +363,55 @@ class SeparatedVariables(Coupler):
             answer = self._table_point(scene, table, float(q.reshape(-1)[0]))
             if answer is not None:
                 return State(*answer), None
-        index = np.arange(q.size)
-        pts = scene.at(index)
+        pts = scene.at(np.arange(q.size))
         target = np.where(q == 0, 0.0, self.target(pts, q))
         v, rise = np.zeros(q.shape), np.zeros(q.shape)
-        direct = target > 0
-        solved_by_curve = None
-        # what the direct solve found at the points without a root: J at the answer, or J(inf)
-        found = Integral(value=np.zeros(q.shape), error=np.zeros(q.shape), converged=np.ones(q.shape, dtype=bool),
-                         panels=np.zeros(q.shape, dtype=int))
-        ok = np.ones(q.shape, dtype=bool)
+        todo = target > 0                      # (the points no route has answered yet)
         if table is not None:
-            v_t, rise_t, served = self._from_table(table, scene, pts, np.where(direct, target, 1.0))
-            served &= direct
+            v_t, rise_t, served = self._from_table(table, scene, pts, np.where(todo, target, 1.0))
+            served &= todo
             v[served], rise[served] = v_t[served], rise_t[served]
-            direct &= ~served
-        if np.count_nonzero(direct) >= _CURVE_MIN_POINTS and scene.size == 1 and not scene.rheology.separable:
-            sub = np.flatnonzero(direct)
-            curve = self._curve(scene, q[sub])
-            if curve is not None:
-                v[sub] = curve
-                direct[sub] = False
-                solved_by_curve = sub
-        if np.any(direct):
-            sub = np.flatnonzero(direct)
-            v[sub], ok[sub], final = self._solve_J(scene, target[sub], sub, None if scene.rheology.separable else q[sub])
-            found = found.replaced(sub, final)
-            warn_unconverged("the separated-variables integral", final, where=ok[sub])
+            todo &= ~served
+        solved = self._flow_direct(scene, q, target, todo, v)
         feasible = None
-        if not np.all(ok):
-            beyond = _inverse.classify_runaway(self, scene, q, np.flatnonzero(~ok), v, found, raise_=raise_)
+        if not np.all(solved.ok):
+            beyond = _inverse.classify_runaway(self, scene, q, np.flatnonzero(~solved.ok), v, solved.found,
+                                               raise_=raise_)
             feasible = np.ones(q.shape, dtype=bool)
             feasible[beyond] = False
-            v[~ok] = 0.0
-        solved = np.flatnonzero(direct & ok)
-        if solved_by_curve is not None:
-            solved = np.union1d(solved, solved_by_curve)
-        if solved.size:
-            rise[solved] = self.pressure_rise(scene, v[solved], solved)
-            self._warn_near_a_lock(scene, v[solved], solved, rise[solved])
+            v[~solved.ok] = 0.0
+        if solved.points.size:
+            rise[solved.points] = self.pressure_rise(scene, v[solved.points], solved.points)
+            self._warn_near_a_lock(scene, v[solved.points], solved.points, rise[solved.points])
         rise[target == 0] = 0.0
         strain = self.strain_at(pts, v) + 0.0 * v
         if feasible is not None:
             for values in (rise, strain, v):
                 values[~feasible] = np.nan
         return State(q, rise, strain, v), feasible
+
+    def _flow_direct(self, scene: Scene, q, target, todo, v) -> _Direct:
+        """Solve the points ``todo`` without a table (into ``v``): a long curve of a non-separable
+        fluid by interpolation between direct solves, the others directly."""
+        ok = np.ones(q.shape, dtype=bool)
+        # what the direct solve found at the points without a root: J at the answer, or J(inf)
+        found = Integral.exact(np.zeros(q.shape))
+        points = np.zeros(0, dtype=int)
+        if np.count_nonzero(todo) >= _CURVE_MIN_POINTS and scene.size == 1 and not scene.rheology.separable:
+            sub = np.flatnonzero(todo)
+            curve = self._curve(scene, q[sub])
+            if curve is not None:
+                v[sub] = curve
+                todo = todo.copy()
+                todo[sub] = False
+                points = sub
+        if np.any(todo):
+            sub = np.flatnonzero(todo)
+            v[sub], ok[sub], final = self._solve_J(scene, target[sub], sub, None if scene.rheology.separable else q[sub])
+            found = found.replaced(sub, final)
+            warn_unconverged("the separated-variables integral", final, where=ok[sub])
+            points = np.union1d(points, sub[ok[sub]])
+        return _Direct(points=points, ok=ok, found=found)
 
     def _curve(self, scene: Scene, q):
         r"""The inlet log-stretches of a long curve through one scene without a table (a non-separable
