@@ -10,7 +10,6 @@ for a batch it must hand over (a stiff wall, large strains).
 from __future__ import annotations
 
 import numpy as np
-import pytest
 from mpmath import mp
 
 import tubefsi

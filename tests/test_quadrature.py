@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 
 from tubefsi.errors import AccuracyWarning
 from tubefsi.numerics.quadrature import (GAUSS_WEIGHTS, KRONROD_NODES, KRONROD_WEIGHTS, adaptive, adaptive_to_pole,
-                                         unit_integral, warn_unconverged)
+                                         warn_unconverged)
 from tubefsi.numerics.roots import solve_increasing
 from tubefsi.numerics.spectral import LOBATTO_NODES, solve_integral
 from tubefsi.testing.profiles import scaled

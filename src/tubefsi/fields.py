@@ -33,7 +33,6 @@ factory              admissible values
 from __future__ import annotations
 
 import copy
-import functools
 import math
 
 import attrs

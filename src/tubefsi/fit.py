@@ -14,7 +14,6 @@ errors come from the Gauss–Newton covariance :math:`s^2 (J^T J)^{-1}`,
 from __future__ import annotations
 
 import math
-import warnings
 
 import attrs
 import numpy as np

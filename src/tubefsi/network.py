@@ -42,7 +42,6 @@ from __future__ import annotations
 
 import copy
 import csv
-import functools
 import json
 import math
 import warnings

@@ -38,13 +38,12 @@ Example::
 from __future__ import annotations
 
 import math
-import warnings
 
 import attrs
 import numpy as np
 
 from . import registry
-from .errors import InvalidParameterError, ModelValidityWarning, NoSteadyStateError, StretchRangeError
+from .errors import InvalidParameterError, NoSteadyStateError, StretchRangeError
 from .solve import max_flow_rate, solve, solve_unchecked
 from .validity import SLENDERNESS
 from .walls.hyperelastic import HyperelasticWall

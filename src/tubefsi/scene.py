@@ -11,7 +11,6 @@ validates every argument. A coupler returns a :class:`State`: arrays of one shap
 
 from __future__ import annotations
 
-import functools
 import math
 
 import attrs

@@ -42,7 +42,7 @@ from .._lazy import lazy_module
 from ..numerics.quadrature import adaptive
 from ..errors import (AccuracyWarning, ConvergenceError, InvalidParameterError, NoSteadyStateError,
                       StretchRangeError, warn_user)
-from ..fields import _array_fields, at_position, model_at
+from ..fields import _array_fields, model_at
 from ..geometry import Tube
 from ..profiles import Profile
 from ..scene import Scene, State

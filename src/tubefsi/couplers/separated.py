@@ -40,7 +40,6 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..errors import NoSteadyStateError, StretchRangeError
 from ..numerics.chebyshev import fit_piecewise
 from ..numerics.kernels import EPS
 from ..numerics.quadrature import Integral, adaptive_to_pole, integrate_graded, warn_unconverged

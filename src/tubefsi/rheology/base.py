@@ -34,7 +34,6 @@ from typing import ClassVar
 import attrs
 import numpy as np
 
-from ..numerics.kernels import as_output
 from .._validation import as_array
 from ..errors import InvalidParameterError
 from ..fields import _array_fields, evaluate, model_at

@@ -22,13 +22,13 @@ with :math:`H_1(e_0) = 0`.
 
 from __future__ import annotations
 
-import functools
 
 import types
 
 import numpy as np
 
 from .._lazy import lazy_module
+from ..numerics.cache import TABLES
 from ..numerics.quadrature import Integral, adaptive, warn_unconverged
 from ..errors import ConvergenceError, InvalidParameterError
 
@@ -213,18 +213,21 @@ def thick_rest(law, tb, installed):
     return e0
 
 
-@functools.lru_cache(maxsize=4096)
 def _rest_scalar(constants, tb, kind):
-    law = Law(*constants)
-    if kind == "membrane":
-        return float(membrane_rest(law, 1)[0])
-    return float(thick_rest(law, np.array([tb]), kind == "installed")[0])
+    """The rest state of one wall (plain values): solved once per value, in the one cache."""
+    def solve():
+        law = Law(*constants)
+        if kind == "membrane":
+            return float(membrane_rest(law, 1)[0])
+        return float(thick_rest(law, np.array([tb]), kind == "installed")[0])
+
+    return TABLES.get(("HGO rest state", constants, tb, kind), solve)
 
 
 def rest(wall, tb, kind):
     """:math:`e_0` at the flat points of ``tb`` (aligned with the wall's flat parameters); ``kind``:
     ``"membrane"``, ``"installed"`` (thick, installed thickness) or ``"stress-free"`` (thick).
-    Cached for scalar walls."""
+    Kept in the one cache for scalar walls (by value)."""
     constants = (wall.shear_modulus, wall.fibre_stiffness, wall.fibre_exponent, wall.fibre_angle,
                  wall.axial_stretch)
     tb = np.asarray(tb, dtype=float)

@@ -23,11 +23,10 @@ import math
 import types
 from typing import ClassVar
 
-import attrs
 import numpy as np
 
 from .._lazy import lazy_module
-from ..numerics.quadrature import Integral, warn_unconverged
+from ..numerics.quadrature import Integral
 from ..numerics.roots import solve_signed
 from .._validation import as_array, real_array
 from ..fields import evaluate, flat_points, model_at, take

@@ -55,7 +55,7 @@ from ..numerics.quadrature import (GAUSS_WEIGHTS, KRONROD_NODES, KRONROD_WEIGHTS
                                    warn_unconverged)
 from ..errors import InvalidParameterError
 from ..geometry import Tube
-from ..fields import choice, evaluate, flat_points, model_at, parameter_shape, positive, take
+from ..fields import choice, evaluate, flat_points, model_at, parameter_shape, positive
 from .base import WallModel
 
 # SciPy on first use (tubefsi._lazy): listing the models must not import it
