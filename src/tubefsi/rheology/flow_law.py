@@ -312,8 +312,24 @@ class FlowTable:
         lowest = self._lowest()
         if not any(panel.finite for panel in self._panels.values()):
             j = self._start(float(np.median(y)))
-            while not self._panel(j).finite and j < _P_LIMIT - 1:
-                j += 1
+            if not self._panel(j).finite:
+                # the secant landed outside the law's range (the finite panels are one run): past
+                # its end (the flow function overflows) back into it by steps doubling downward,
+                # then the run's last panel by bisection; below its floor, upward
+                beyond, step = j, 1
+                while j > lowest and not self._panel(j).finite:
+                    beyond, j, step = j, max(j - step, lowest), 2 * step
+                if not self._panel(j).finite:
+                    j, beyond = lowest, None
+                    while j < _P_LIMIT - 1 and not self._panel(j).finite:
+                        j += 1
+                while beyond is not None and beyond - j > 1 and self._panel(j).finite:
+                    mid = (j + beyond) // 2
+                    j, beyond = (mid, beyond) if self._panel(mid).finite else (j, mid)
+                if not self._panel(j).finite:
+                    raise InvalidParameterError(
+                        "rheology", "a law whose tube-flow function is finite somewhere", self.rheology,
+                        f"its tube-flow function is not finite for any natural parameter in [{lowest}, {_P_LIMIT}]")
         for _ in range(4 * _P_LIMIT):
             run = sorted((panel for panel in self._panels.values() if panel.finite), key=lambda panel: panel.j)
             lo = np.array([panel.y_lo for panel in run])
