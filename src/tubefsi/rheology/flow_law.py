@@ -260,13 +260,16 @@ class FlowTable:
         fit, _ = fit_piecewise(forward, lo, hi, degree=16, tol=5e-15, panels=1, max_panels=64, relative=True)
         y_lo, y_hi = float(y_ends[0]), float(y_ends[1])
         node_error = max(errors) if errors else 0.0
+        # a direct panel's slopes (for the asymptote below the lowest panel, and the steps toward
+        # a load) are its ends' secant: its fit, if any, cannot be trusted
+        secant = {"slope_y": y_hi - y_lo, "slope_s": float(s_ends[1] - s_ends[0])}
         if fit is None:                        # a kink (or noise): solved exactly at each lookup
-            return _Panel(j, y_lo, y_hi, None, error=node_error)
+            return _Panel(j, y_lo, y_hi, None, error=node_error, **secant)
         slope = fit.derivative(0)
         grid = np.linspace(lo, hi, 257)
         grid_y = fit(grid, output=0)
         if not np.all(slope(grid) > 0):
-            return _Panel(j, y_lo, y_hi, None, error=node_error)
+            return _Panel(j, y_lo, y_hi, None, error=node_error, **secant)
 
         def inverse_values(y):
             p = np.interp(y, grid_y, grid)
