@@ -251,10 +251,16 @@ class FlowTable:
                                         f"its tube-flow function does not increase near ln(tau_w - tau_y) = "
                                         f"{float(s_ends[0]):.6g}")
         errors = []
+        # TOL is a relative error of G: a relative error e of Gamma (a node's estimate) is one of
+        # e (ds/dy) (tau_w - tau_y) / tau_w in G, ds/dy taken as the ends' secant (near yield the
+        # quadrature's rounding floor, large in Gamma, is small in G)
+        gain = float(s_ends[1] - s_ends[0]) / float(y_ends[1] - y_ends[0])
 
         def forward(p):
             s, y, err = self._exact(p)
-            errors.append(float(np.max(err, initial=0.0)))
+            with np.errstate(all="ignore"):
+                share = 1.0 / (1.0 + self.yield_stress * np.exp(-s)) if self.yield_stress > 0 else 1.0
+                errors.append(gain * float(np.max(np.where(np.isfinite(s), err * share, err), initial=0.0)))
             return np.stack([y, s])
 
         fit, _ = fit_piecewise(forward, lo, hi, degree=16, tol=5e-15, panels=1, max_panels=64, relative=True)
