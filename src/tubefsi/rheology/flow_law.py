@@ -256,8 +256,11 @@ class FlowTable:
         # quadrature's rounding floor, large in Gamma, is small in G)
         gain = float(s_ends[1] - s_ends[0]) / float(y_ends[1] - y_ends[0])
 
+        samples = []
+
         def forward(p):
             s, y, err = self._exact(p)
+            samples.append((np.ravel(p), s.ravel(), y.ravel(), err.ravel()))
             with np.errstate(all="ignore"):
                 share = 1.0 / (1.0 + self.yield_stress * np.exp(-s)) if self.yield_stress > 0 else 1.0
                 errors.append(gain * float(np.max(np.where(np.isfinite(s), err * share, err), initial=0.0)))
@@ -270,11 +273,13 @@ class FlowTable:
         # a load) are its ends' secant: its fit, if any, cannot be trusted
         secant = {"slope_y": y_hi - y_lo, "slope_s": float(s_ends[1] - s_ends[0])}
         if fit is None:                        # a kink (or noise): solved exactly at each lookup
+            self._increasing(samples)
             return _Panel(j, y_lo, y_hi, None, error=node_error, **secant)
         slope = fit.derivative(0)
         grid = np.linspace(lo, hi, 257)
         grid_y = fit(grid, output=0)
         if not np.all(slope(grid) > 0):
+            self._increasing(samples)
             return _Panel(j, y_lo, y_hi, None, error=node_error, **secant)
 
         def inverse_values(y):
@@ -293,6 +298,23 @@ class FlowTable:
         if inverse is None:
             return _Panel(j, y_lo, y_hi, None, error=node_error, slope_y=slope_y, slope_s=slope_s)
         return _Panel(j, y_lo, y_hi, inverse, error=node_error, slope_y=slope_y, slope_s=slope_s)
+
+    def _increasing(self, samples) -> None:
+        """Raise :class:`InvalidParameterError` where the exact values ``(p, s, y, err)`` of a direct
+        panel show y(p) decreasing beyond their error estimates: a lookup solves y(p) = y by
+        bisection there, which assumes one root (the ends alone cannot show a dip between them)."""
+        if not samples:
+            return
+        p, s, y, err = (np.concatenate(column) for column in zip(*samples))
+        order = np.argsort(p, kind="stable")
+        s, y, err = s[order], y[order], err[order]
+        allowed = 2.0 * (err[:-1] + err[1:]) + 8.0 * _EPS * np.maximum(1.0, np.abs(y[1:]))
+        with np.errstate(invalid="ignore"):
+            drop = np.flatnonzero(y[:-1] - y[1:] > allowed)
+        if drop.size:
+            raise InvalidParameterError("rheology", "a shear stress increasing with the shear rate", self.rheology,
+                                        f"its tube-flow function decreases near ln(tau_w - tau_y) = "
+                                        f"{float(s[drop[0]]):.6g}")
 
     def _panel(self, j: int) -> _Panel:
         found = self._panels.get(j)
