@@ -366,7 +366,11 @@ class FlowTable:
             lo = np.array([panel.y_lo for panel in run])
             hi = np.array([panel.y_hi for panel in run])
             k = np.clip(np.searchsorted(lo, y, side="right") - 1, 0, len(run) - 1)
-            held = (y >= lo[k]) & (y <= hi[k])
+            # a panel holds lo <= y < hi (its upper end too where no panel can follow it): a load on
+            # the common end of two panels gets the upper one, whether or not it was built before
+            last = np.array([panel.j + 1 >= _P_LIMIT or not self._panels.get(panel.j + 1, panel).finite
+                             for panel in run])
+            held = (y >= lo[k]) & ((y < hi[k]) | ((y == hi[k]) & last[k]))
             # below the first panel, and nothing resolvable below it: the asymptote's (the panel
             # below is built only when a load needs it)
             below = y < lo[0]
@@ -384,7 +388,7 @@ class FlowTable:
             for i in np.unique(k[~held & ~below]):
                 targets = y[(k == i) & ~held & ~below]
                 panel = run[i]
-                if targets.max() > panel.y_hi:         # above panel i: toward run[i + 1] (or beyond the last)
+                if targets.max() >= panel.y_hi:        # above panel i: toward run[i + 1] (or beyond the last)
                     step = (float(targets.max()) - panel.y_hi) / max(panel.slope_y, 1e-3)
                     j = panel.j + 1 + int(step)
                     if i + 1 < len(run):
