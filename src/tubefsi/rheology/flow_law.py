@@ -391,8 +391,11 @@ class FlowTable:
                 if targets.max() >= panel.y_hi:        # above panel i: toward run[i + 1] (or beyond the last)
                     step = (float(targets.max()) - panel.y_hi) / max(panel.slope_y, 1e-3)
                     j = panel.j + 1 + int(step)
-                    if i + 1 < len(run):
-                        j = min(j, run[i + 1].j - 1)
+                    if i + 1 < len(run):       # not past the next built panel: the secant between the two
+                        upper = run[i + 1]
+                        gap = upper.y_lo - panel.y_hi
+                        share = (float(targets.max()) - panel.y_hi) / gap if gap > 0 else 0.0
+                        j = min(j, panel.j + 1 + int(share * (upper.j - panel.j - 1)))
                     wanted.add(min(max(j, panel.j + 1), _P_LIMIT - 1))
                 if targets.min() < panel.y_lo:         # below the first panel
                     step = (panel.y_lo - float(targets.min())) / max(panel.slope_y, 1e-3)
