@@ -1,16 +1,29 @@
-"""The generic (non-separable) rheology path: error-controlled Rabinowitsch–Mooney quadrature,
-the error-checked flow table and its inverse, bounded work at extreme loads, typed errors.
+"""The generic (non-separable) rheology path: error-controlled Rabinowitsch–Mooney quadrature, the
+flow law's inverse tabulated on fixed panels (``tubefsi.rheology.flow_law``), bounded work at
+extreme loads, typed errors, and what the fixed panels promise: an answer independent of the
+table's history, a table per parameter set, and threads that share a fluid.
 
-References are independent of the library: the Rabinowitsch–Mooney integral
+Everything goes through the public API (``flow_rate``, ``pressure_gradient``, ``velocity``,
+``tubefsi.solve``, ``tubefsi.cache_clear``); the quadrature's own tests import it from the
+numerics layer. References are independent of the library: the Rabinowitsch–Mooney integral
 :math:`\\Gamma = (4/\\tau_w^3)\\int_0^{\\tau_w}\\tau^2\\dot\\gamma\\,d\\tau` of a piecewise law is
 elementary (``docs/theory.md``, section "The flow law of a generalized Newtonian fluid"), and
-mpmath integrates the smooth laws. Work is bounded by counting flow-function evaluations and
-table panels, not by wall-clock time.
+mpmath integrates the smooth laws. Work is bounded by counting flow-function evaluations and table
+panels (``flow_table(fluid).evaluations``, ``.panel_count``: an internal of the rheology layer,
+read only because no public call counts work), not by wall-clock time.
+
+The table's promise (``docs/theory.md``; the ``flow_law`` module docstring) is a relative error
+``TOL = 1e-14`` of :math:`G`. A comparison of :math:`\\tau_w = GR/2` against a reference adds the
+rounding of the two logarithms the table works in, :math:`\\ln\\Gamma` and
+:math:`s = \\ln(\\tau_w - \\tau_y)`: :math:`4\\epsilon(|\\ln\\Gamma| + |s|)`.
 """
 
 from __future__ import annotations
 
+import concurrent.futures
 import math
+import random
+import threading
 import tracemalloc
 import warnings
 
@@ -24,11 +37,20 @@ from mpmath import mp, mpf
 import tubefsi
 from tubefsi import AccuracyWarning, InvalidParameterError
 from tubefsi.errors import TubefsiError
-from tubefsi.rheology import Rheology
-from tubefsi.rheology._flow_table import TOL, flow_table, unit_integral
+from tubefsi.numerics.quadrature import unit_integral
 from tubefsi.testing.profiles import scaled
+from tubefsi.rheology import Rheology
+from tubefsi.rheology.flow_law import flow_table
 
 EPS = np.finfo(float).eps
+#: The table's tolerance: the relative error of G it promises.
+TOL = 1e-14
+#: Flow-function evaluations of one smooth panel: its two ends, then the degree-16 fit of the
+#: forward map on 17 Chebyshev nodes and 4 check points (accepted at the first try).
+SMOOTH_PANEL = 2 + 17 + 4
+#: The most one panel can cost beyond that: a fit attempt that bisects up to its cap of 64
+#: sub-panels evaluates at most 127 of them (a binary tree with 64 leaves), 21 points each.
+KINKED_PANEL = 127 * 21 - 21
 
 
 # ---------------------------------------------------------------- laws written afresh
@@ -88,6 +110,11 @@ class KinkedPowerLaw(Rheology):
         return 4 * (below + above) / tw**3
 
 
+def _carreau_stress(law, g):
+    log_x = np.log(law.lam * g)
+    return g * law.eta0 * np.exp(0.5 * (law.index - 1.0) * np.logaddexp(0.0, 2.0 * log_x))
+
+
 @attrs.frozen
 class CarreauLike(Rheology):
     """Stress-natural Carreau law, written afresh: eta = eta0 (1 + (lam g)^2)^((n-1)/2)."""
@@ -97,8 +124,19 @@ class CarreauLike(Rheology):
     index: float = 0.3568
 
     def _stress(self, g):
-        log_x = np.log(self.lam * g)
-        return g * self.eta0 * np.exp(0.5 * (self.index - 1.0) * np.logaddexp(0.0, 2.0 * log_x))
+        return _carreau_stress(self, g)
+
+
+@attrs.define
+class MutableCarreau(Rheology):
+    """The same law in a class that is not frozen: its parameters may change in place."""
+
+    eta0: float = 0.056
+    lam: float = 3.313
+    index: float = 0.3568
+
+    def _stress(self, g):
+        return _carreau_stress(self, g)
 
 
 @attrs.frozen
@@ -130,8 +168,51 @@ class StressOnlyHerschelBulkley(Rheology):
         return self.yield_stress + self.consistency * g**self.index
 
 
+@attrs.frozen
+class TwoKinks(Rheology):
+    """Rate-natural, increasing, with two kinks: slopes 1, 1/2 and 2 (Pa s)^-1 at 1 and 1.5 Pa."""
+
+    def _shear_rate(self, tau):
+        return np.where(tau < 1.0, tau, np.where(tau < 1.5, 1.0 + 0.5 * (tau - 1.0), 1.25 + 2.0 * (tau - 1.5)))
+
+
 def rel(a, b):
     return np.abs(np.asarray(a) - b) / np.abs(b)
+
+
+def carreau_reference(law, wall_rates):
+    """``(tau_w, Gamma)`` of a Carreau law at the wall shear rates ``wall_rates``: 30-digit mpmath,
+    :math:`\\Gamma = \\tfrac43\\dot\\gamma_w\\int_0^1[1 - (\\tau(\\dot\\gamma_w t)/\\tau_w)^3]dt` with
+    breakpoints around the transition (where tanh-sinh needs them), rounded to doubles."""
+    taus, gammas = [], []
+    with mp.workdps(30):
+        e0, lam, n = mpf(law.eta0), mpf(law.lam), mpf(law.index)
+
+        def tau(g):
+            return g * e0 * (1 + (lam * g) ** 2) ** ((n - 1) / 2)
+
+        for rate in np.ravel(wall_rates):
+            g_w = mpf(float(rate))
+            t_w = tau(g_w)
+            corner = 1 / (lam * g_w)
+            points = [0] + sorted(c for c in (corner / 1000, corner / 10, corner, 10 * corner, 1000 * corner)
+                                  if c < 1) + [1]
+            gamma = 4 * g_w / 3 * mp.quad(lambda t: 1 - (tau(g_w * t) / t_w) ** 3, points)
+            taus.append(float(t_w))
+            gammas.append(float(gamma))
+    return np.array(taus), np.array(gammas)
+
+
+def wall_stress_error(law, tw, gamma, radius=1e-3):
+    """Relative error of tau_w = G R / 2 from ``pressure_gradient`` at the flow rate of the
+    reference apparent shear rate ``gamma`` of wall stress ``tw``."""
+    q = 0.25 * math.pi * radius**3 * np.asarray(gamma)
+    return rel(0.5 * law.pressure_gradient(q, radius) * radius, tw)
+
+
+def allowed(tw, gamma):
+    """TOL plus the rounding of the table's logarithms (module docstring; no yield stress)."""
+    return TOL + 4 * EPS * (np.abs(np.log(gamma)) + np.abs(np.log(tw)))
 
 
 @pytest.fixture(autouse=True)
@@ -141,16 +222,25 @@ def _accuracy_warnings_are_errors():
         yield
 
 
+@pytest.fixture(autouse=True)
+def _fresh_tables():
+    """Each test starts from an empty cache (its counts of work are its own)."""
+    tubefsi.cache_clear()
+    yield
+    tubefsi.cache_clear()
+
+
 # ---------------------------------------------------------------- the Rabinowitsch–Mooney integral
 @pytest.mark.parametrize("law", [NewtonianBelow(), NewtonianBelow(eta0=1.0, index=1.8, tau_c=0.3),
                                  KinkedPowerLaw(), KinkedPowerLaw(m=2.0, index=1.4, g_c=0.2)], ids=repr)
 def test_kinked_law_is_integrated_to_the_tolerance(law):
-    """Dense wall stresses across the kink (wherever it falls in the quadrature's panels):
-    within ~1e-14 of the elementary closed form, without a warning. The fixed graded rule this
-    replaced lost ~1e-4 here, silently."""
+    """Dense wall stresses across the kink (wherever it falls in the quadrature's panels): the flow
+    rate within ~1e-14 of the elementary closed form, without a warning. (R = 1 and G = 2 tau_w:
+    the wall stress reaches the integral exactly; q = pi Gamma / 4 adds two roundings, 2 eps.)
+    The fixed graded rule this replaced lost ~1e-4 here, silently."""
     tw = np.geomspace(1e-3, 1e3, 1500)
-    got = law._apparent_shear_rate(tw)
-    assert np.max(rel(got, law.exact_rate(tw))) < 2e-14
+    q = law.flow_rate(1.0, 2.0 * tw)
+    assert np.max(rel(q, 0.25 * math.pi * law.exact_rate(tw))) < 2e-14 + 2 * EPS
 
 
 def test_kinked_law_against_mpmath():
@@ -168,24 +258,25 @@ def test_kinked_law_against_mpmath():
             pts = [0, tc, t] if t > tc else [0, t]
             ref = 4 * mp.quad(lambda s: s * s * rate(s), pts) / t**3
             assert float(abs(law.exact_rate(np.array(tw))[()] - ref) / ref) < 1e-15
-            assert float(abs(law._apparent_shear_rate(np.array([tw]))[0] - ref) / ref) < 2e-14
+            q = law.flow_rate(1.0, 2.0 * tw)
+            assert float(abs(q - mp.pi * ref / 4) / (mp.pi * ref / 4)) < 2e-14 + 2 * EPS
 
 
 def test_yield_stress_quadrature_runs_over_the_yielded_part_only():
-    """A generic rate-natural yield-stress law, ``excess`` exact: to the tolerance away from yield;
-    near it the law itself (given tau, not tau - tau_y) resolves the excess only to
-    ~eps tau_y / excess, the rounding floor that the quadrature reports (no quadrature does
-    better: the problem's own condition number)."""
+    """A generic rate-natural yield-stress law: to the tolerance away from yield; near it the law
+    itself (given tau, not tau - tau_y) resolves the excess only to ~eps tau_y / excess, the
+    rounding floor that the quadrature reports (no quadrature does better: the problem's own
+    condition number). The reference takes the excess of the wall stress as given, tw - tau_y:
+    exact (Sterbenz) for tw < 2 tau_y, and within eps/2 beyond (3.2 eps/2 in Gamma)."""
     law = RateOnlyHerschelBulkley()
-    excess = np.geomspace(1e-1, 1e4, 100) * law.yield_stress
-    tw = law.yield_stress + excess
-    got = law._apparent_shear_rate(tw, excess=excess)
-    assert np.max(rel(got, law.exact_rate(tw, excess))) < 2e-14
-    excess = np.geomspace(1e-12, 1e-3, 20) * law.yield_stress
-    tw = law.yield_stress + excess
-    got = law._apparent_shear_rate(tw, excess=excess)
-    assert np.all(rel(got, law.exact_rate(tw, excess)) < 40 * EPS * tw / excess)
-    assert np.all(law._apparent_shear_rate(np.array([0.5, 2.0])) == 0.0)
+    tw = law.yield_stress + np.geomspace(1e-1, 1e4, 100) * law.yield_stress
+    q = law.flow_rate(1.0, 2.0 * tw)
+    assert np.max(rel(q, 0.25 * math.pi * law.exact_rate(tw, tw - law.yield_stress))) < 2e-14 + 2 * EPS
+    tw = law.yield_stress + np.geomspace(1e-12, 1e-3, 20) * law.yield_stress
+    excess = tw - law.yield_stress                       # exact: the excess the library sees
+    q = law.flow_rate(1.0, 2.0 * tw)
+    assert np.all(rel(q, 0.25 * math.pi * law.exact_rate(tw, excess)) < 40 * EPS * tw / excess)
+    assert np.all(law.flow_rate(1.0, np.array([1.0, 4.0])) == 0.0)     # tau_w = 0.5, 2.0 <= tau_y
 
 
 def test_kinked_velocity_profile():
@@ -205,7 +296,7 @@ def test_an_unresolvable_integrand_is_warned_about():
             return tau * (1.0 + 1e-6 * np.sin(1e9 * tau))
 
     with pytest.warns(AccuracyWarning, match="Rabinowitsch"):
-        Rippled()._apparent_shear_rate(np.array([3.0]))
+        Rippled().flow_rate(1.0, 6.0)
 
 
 def test_unit_integral_endpoint_singularity_and_hidden_kink():
@@ -220,30 +311,66 @@ def test_unit_integral_endpoint_singularity_and_hidden_kink():
     assert abs(res.value[0] - exact) / exact < 1e-14
 
 
+@pytest.mark.xfail(strict=True, reason=(
+    "tubefsi.numerics.quadrature.adaptive (robust=True) stops a point as 'hopeless' when its "
+    "estimate has not fallen four-fold in 12 rounds; with two kinks, the bisection that uncovers "
+    "the second kink's hidden error raises the estimate meanwhile, and the point stops after ~40 "
+    "panels, unconverged: an AccuracyWarning and an error up to 4e-9. Without that stop it "
+    "converges to 6e-16 in ~100 panels."))
+@pytest.mark.parametrize("tw", [2.20383715, 2.87801264, 3.86282971])
+def test_two_kinks_are_integrated_to_the_tolerance(tw):
+    """An increasing law with two kinks, at wall stresses where the quadrature stopped early: the
+    flow rate against mpmath (kinks as breakpoints) to 2e-14, without a warning."""
+    q = TwoKinks().flow_rate(1.0, 2.0 * tw)
+    with mp.workdps(30):
+        t_w = mpf(tw)
+
+        def rate(t):
+            return t if t < 1 else (1 + (t - 1) / 2 if t < mpf(1.5) else mpf(1.25) + 2 * (t - mpf(1.5)))
+
+        ref = mp.pi * mp.quad(lambda s: s * s * rate(s), [0, 1, mpf(1.5), t_w]) / t_w**3
+    assert float(abs(q - ref) / ref) < 2e-14
+
+
 # ---------------------------------------------------------------- the flow table
-def _table_error(law, tw, excess=None):
-    """Relative error of pressure_gradient at the exact flow rate of wall stress tw."""
-    radius = 1e-3
-    rate = law._apparent_shear_rate(tw) if excess is None else law._apparent_shear_rate(tw, excess=excess)
-    q = 0.25 * math.pi * radius**3 * rate
-    g = law.pressure_gradient(q, radius)
-    return rel(0.5 * g * radius, tw), rate
-
-
 @pytest.mark.parametrize("law", [CarreauLike(), NewtonianBelow(), KinkedPowerLaw(),
                                  NewtonianBelow(eta0=1.0, index=1.8, tau_c=0.3)], ids=repr)
 def test_table_against_direct_integrals_over_many_decades(law):
-    """The table's inverse against the error-controlled direct integral over 40 decades of wall
-    stress: within TOL plus the rounding of the logarithms (4 eps (|ln Gamma| + |ln tau_w|))."""
-    tw = np.geomspace(1e-20, 1e20, 801)
-    err, rate = _table_error(law, tw)
-    allowed = TOL + 4 * EPS * (np.abs(np.log(rate)) + np.abs(np.log(tw)))
-    assert np.all(err <= allowed), float(np.max(err / allowed))
+    """tau_w = G R / 2 from the table at the reference flow rate of 40 decades of wall stress,
+    within TOL plus the rounding of the logarithms: the piecewise laws against their elementary
+    Gamma (801 wall stresses), the Carreau law against mpmath (101 wall shear rates).
+
+    Work, once 801 wall stresses across the 40 decades have been served: the table holds fixed
+    unit panels of the natural parameter p (ln tau_w for a rate-natural law, ln of the wall shear
+    rate, from the public ``shear_rate``, for a stress-natural one), so it builds the panels those
+    loads span, plus at most one past each end where the first jump toward the far end overshoots
+    it (1 measured: a slope taken where the law is Newtonian, used where it is twice as steep).
+    Each costs SMOOTH_PANEL evaluations, a few more where a fit needs bisecting (25 on average
+    allowed, 23.2 measured for the Carreau law), and at most KINKED_PANEL more at a kink."""
+    radius = 1e-3
+    dense = np.geomspace(1e-20, 1e20, 801)
+    if isinstance(law, CarreauLike):
+        tw, gamma = carreau_reference(law, np.geomspace(law.shear_rate(1e-20), law.shear_rate(1e20), 101))
+        kinks = 0
+    else:
+        tw, gamma = dense, law.exact_rate(dense)
+        kinks = 1
+    err = wall_stress_error(law, tw, gamma, radius)
+    bound = allowed(tw, gamma)
+    assert np.all(err <= bound), float(np.max(err / bound))
+    law.pressure_gradient(law.flow_rate(radius, 2.0 * dense / radius), radius)
+    p = np.log(law.shear_rate(dense)) if isinstance(law, (CarreauLike, KinkedPowerLaw)) else np.log(dense)
+    spanned = math.floor(p.max()) - math.floor(p.min()) + 1
     table = flow_table(law)
-    assert table.evaluations < 6000 and table.panel_count < 120
+    assert spanned <= table.panel_count <= spanned + 2
+    assert table.evaluations <= 25 * table.panel_count + kinks * KINKED_PANEL
 
 
 def test_table_of_a_yield_stress_fluid_near_and_far_from_yield():
+    """Against the elementary Gamma from 1e-9 to 1e6 Pa above yield. Below the lowest panel the
+    law resolves (tau_w - tau_y < sqrt(eps) tau_y for a law that gets only tau) the table follows
+    that panel's power-law asymptote: G stays within TOL (it carries tau_y), the excess within
+    TOL tau_w / excess (its condition number near yield)."""
     law = RateOnlyHerschelBulkley()
     excess = np.geomspace(1e-9, 1e6, 301)
     tw = law.yield_stress + excess
@@ -258,11 +385,13 @@ def test_table_of_a_yield_stress_fluid_near_and_far_from_yield():
     assert law.pressure_gradient(1e-300, radius) == 2 * law.yield_stress / radius
 
 
-# (equal rheologies share one cached table: each test below uses a fluid of its own)
 @pytest.mark.parametrize("law", [RateOnlyHerschelBulkley(consistency=0.32), StressOnlyHerschelBulkley()], ids=repr)
 def test_generic_yield_stress_laws_from_tiny_to_large_loads(law):
-    """No closed forms, only the law: G(q -> 0+) is the yield gradient, and G inverts the
-    flow rate over 30 decades of it, with a bounded table."""
+    """No closed forms, only the law: G(q -> 0+) is the yield gradient, and G inverts the flow
+    rate over 30 decades of it, with a bounded table: fewer than 40 panels (23 and 34 measured),
+    each at most SMOOTH_PANEL + KINKED_PANEL evaluations (near yield the quadrature's noise
+    defeats the fit, and the panel is solved directly: a bisection of at most ~60 evaluations
+    for each of the 57 loads)."""
     radius = 1e-3
     g_yield = 2 * law.yield_stress / radius
     assert law.pressure_gradient(1e-300, radius) == g_yield
@@ -272,85 +401,265 @@ def test_generic_yield_stress_laws_from_tiny_to_large_loads(law):
     # q(G) is ill-conditioned near yield (tau_w / (tau_w - tau_y)): compare G, well-conditioned
     g_back = law.pressure_gradient(law.flow_rate(radius, g), radius)
     assert np.all(rel(g_back, g) < 1e-14)
-    assert flow_table(law).panel_count < 40
+    table = flow_table(law)
+    assert table.panel_count < 40
+    assert table.evaluations <= 2 + (SMOOTH_PANEL + KINKED_PANEL) * table.panel_count + 57 * 60
 
 
-@pytest.mark.parametrize("law", [CarreauLike(eta0=0.057), NewtonianBelow(eta0=0.051)], ids=repr)
+@pytest.mark.parametrize("law", [CarreauLike(), NewtonianBelow()], ids=repr)
 def test_tiny_loads_take_a_bounded_number_of_evaluations(law):
-    """G(q, R) down to q = 1e-300 (the old table was extended panel by panel: 25 s at 1e-100,
-    > 590 s at 1e-300): a few panels per load, and the Newtonian asymptote 8 eta0 q / (pi R^4)."""
+    """G(q, R) down to q = 1e-300 (the first table was extended panel by panel: 25 s at 1e-100,
+    > 590 s at 1e-300): each load builds at most 3 panels (the one its secant step lands on, and
+    a neighbour or two), SMOOTH_PANEL evaluations each, plus 2 for the first secant; and G is the
+    Newtonian asymptote 8 eta0 q / (pi R^4)."""
     radius = 1e-4
     table = flow_table(law)
     for q in (1e-20, 1e-100, 1e-300):
         before = table.evaluations, table.panel_count
         g = law.pressure_gradient(q, radius)
         assert rel(g, 8 * law.eta0 * q / (math.pi * radius**4)) < 1e-13 + 8 * EPS * abs(math.log(q))
-        assert table.evaluations - before[0] <= 120 and table.panel_count - before[1] <= 3
+        built = table.panel_count - before[1]
+        assert built <= 3 and table.evaluations - before[0] <= 2 + SMOOTH_PANEL * built
 
 
-@pytest.mark.parametrize("law", [CarreauLike(eta0=0.058), KinkedPowerLaw(m=0.021)], ids=repr)
+@pytest.mark.parametrize("law", [CarreauLike(), KinkedPowerLaw()], ids=repr)
 def test_huge_loads_take_a_bounded_number_of_evaluations(law):
+    """Up to q = 1e120, as the tiny loads above; the flow rate of the answer gives q back."""
     radius = 1e-4
     table = flow_table(law)
     for q in (1e3, 1e60, 1e120):
         before = table.evaluations, table.panel_count
         g = law.pressure_gradient(q, radius)
-        assert table.evaluations - before[0] <= 120 and table.panel_count - before[1] <= 3
+        built = table.panel_count - before[1]
+        assert built <= 3 and table.evaluations - before[0] <= 2 + SMOOTH_PANEL * built
         back = law.flow_rate(radius, g)
         assert rel(back, q) < 2e-14 + 8 * EPS * math.log(q)
 
 
 def test_loads_beyond_the_flow_functions_range_cost_little():
-    """Where the law overflows (((tau - tau_y)/K)^(1/n) beyond ~1e139 Pa) the table ends there: a
-    huge load is an InvalidParameterError after a bounded number of evaluations."""
+    """Where the law's flow function overflows (its Rabinowitsch–Mooney integral, beyond ~1e58 Pa)
+    the table ends: a huge load is an InvalidParameterError after a bounded number of evaluations.
+    The first panel's secant lands beyond the range; the table steps back by doubling steps and
+    bisects for the range's last panel: at most ~21 panels tried (2 evaluations each where the
+    flow function is not finite, up to 25 where it is), 110 measured."""
     law = RateOnlyHerschelBulkley(consistency=0.31)
     with pytest.raises(InvalidParameterError, match="flow_rate"):
         law.pressure_gradient(1e200, 1e-4)
-    assert flow_table(law).evaluations < 3000
+    assert flow_table(law).evaluations <= 2 + 21 * 25
+
+
+def test_a_valid_load_beyond_the_first_secant_step():
+    """A law that steepens 10-fold at tau_c = 1e13 Pa (the secant from p = 0, 1 sees its Newtonian
+    part) and overflows beyond ~1e42 Pa: a load of a fresh table whose secant start lands past
+    that end is found, to TOL against the elementary Gamma (it was an IndexError), after the
+    probes of the test above and the 3 panels of the load (114 to 162 evaluations measured)."""
+    law = NewtonianBelow(eta0=1.0, index=0.1, tau_c=1e13)
+    tw = np.array([1e18, 1e20, 1e22])
+    gamma = law.exact_rate(tw)
+    for i in range(tw.size):
+        tubefsi.cache_clear()
+        err = wall_stress_error(law, tw[i], gamma[i])
+        assert err <= allowed(tw[i], gamma[i]), err
+        assert flow_table(law).evaluations <= 2 + 21 * 25 + 3 * 25
 
 
 def test_far_apart_loads_do_not_tabulate_the_gap():
-    """Two loads 90 units of ln Gamma apart: two short segments; a call spanning both merges them."""
+    """Two loads 90 units of ln Gamma apart build panels near each (at most 3 each, 6 measured),
+    never the ~90 between; a call spanning both adds only the panels of its middle load (1
+    measured): the fixed panels need no contiguous run."""
     law = CarreauLike(lam=1.0)
     radius = 1e-3
     law.pressure_gradient(1e-40, radius)
     law.pressure_gradient(1e-1, radius)
     table = flow_table(law)
-    assert len(table.segments) == 2 and table.panel_count <= 4
+    assert table.panel_count <= 6
     q = np.array([1e-40, 1e-20, 1e-1])
     g = law.pressure_gradient(q, radius)
-    assert len(table.segments) == 1
+    assert table.panel_count <= 9
+    assert table.evaluations <= 2 + 25 * table.panel_count
     assert np.all(rel(law.flow_rate(radius, g), q) < 1e-13)
 
 
-def test_lookups_do_not_gather_coefficient_rows():
-    """The lookup's working set is a few arrays of the points' size (the old table gathered an
-    (M x 29) coefficient array twice: ~60 arrays)."""
-    law = CarreauLike(eta0=0.059)
+def test_lookups_stay_a_few_arrays_of_the_points_size():
+    """The working set of pressure_gradient over 344064 built points: ~16 arrays of their size
+    (measured 16.3: the public call's validation, broadcasting and masking ~9 copies, the table's
+    lookup itself 7.1), below 20. A lookup that gathered each point's 9 coefficient rows of the
+    degree-8 inverse would add 9 arrays on its own."""
+    law = CarreauLike()
     q = np.geomspace(1e-12, 1e-8, 16384)[:, None]
     r = 1e-4 * np.exp(np.linspace(0.0, 0.6, 21))[None, :] * np.ones((16384, 1))
-    law._pressure_gradient(np.broadcast_to(q, r.shape), r)            # build the table first
+    law.pressure_gradient(np.broadcast_to(q, r.shape), r)            # build the table first
     tracemalloc.start()
     try:
-        law._pressure_gradient(np.broadcast_to(q, r.shape), r)
+        law.pressure_gradient(np.broadcast_to(q, r.shape), r)
         peak = tracemalloc.get_traced_memory()[1]
     finally:
         tracemalloc.stop()
-    assert peak < 10 * r.nbytes
+    assert peak < 20 * r.nbytes
+
+
+@settings(max_examples=scaled(25), deadline=None)
+@given(eta0=st.floats(1e-3, 10.0), lam=st.floats(1e-3, 1e3), index=st.floats(0.05, 1.8),
+       centre=st.floats(-25.0, 25.0), width=st.floats(0.05, 12.0))
+def test_table_inverts_the_direct_integral_of_any_carreau_law(eta0, lam, index, centre, width):
+    """Property (it replaces the cumulative panel rule's, removed with it): for a Carreau law and a
+    window of wall shear rates e^(centre +- width/2), the table's G at the flow rate of the
+    error-controlled direct integral (``flow_rate``) gives back the wall stress, within TOL, the
+    rounding of the logarithms, and the direct integral's own error (its estimate 1e-15, else an
+    AccuracyWarning, amplified by d ln tau_w / d ln Gamma <= max(1, n)) plus its roundings."""
+    tubefsi.cache_clear()
+    law = CarreauLike(eta0=eta0, lam=lam, index=index)
+    radius = 1.0
+    tw = law.stress(np.exp(np.linspace(centre - width / 2, centre + width / 2, 9)))
+    q = law.flow_rate(radius, 2.0 * tw)
+    gamma = q / (0.25 * math.pi)
+    err = wall_stress_error(law, tw, gamma, radius)
+    assert np.all(err <= allowed(tw, gamma) + max(1.0, index) * (1e-15 + 4 * EPS))
+
+
+# ---------------------------------------------------------------- what the fixed panels promise
+def _neighbours(x, k):
+    """``x`` and the ``k`` doubles on either side of it."""
+    below, above, out = x, x, [x]
+    for _ in range(k):
+        below, above = np.nextafter(below, 0.0), np.nextafter(above, np.inf)
+        out += [below, above]
+    return sorted(out)
+
+
+def _panel_ends(law, natural, js, radius=1.0):
+    """Flow rates within a few ulps of where the table's panels meet: panel j ends at natural
+    parameter p = j + 1, i.e. tau_w - tau_y = e^p (rate-natural) or the wall shear rate e^p
+    (stress-natural). Through the public API the end is reached within a few roundings; 16
+    doubles either side of it make sure that one load lies exactly on it."""
+    loads = []
+    for j in js:
+        tw = float(law.stress(math.exp(j))) if natural == "stress" else law.yield_stress + math.exp(j)
+        loads += _neighbours(float(law.flow_rate(radius, 2.0 * tw / radius)), 16)
+    return loads
+
+
+@pytest.mark.parametrize("law, natural, js, span", [
+    (CarreauLike(), "stress", range(-4, 6), (1e-5, 1e2)),
+    (NewtonianBelow(), "rate", range(-3, 5), (1e-4, 1e4)),
+    (RateOnlyHerschelBulkley(), "rate", (-15, -11, -5, 0, 3), (1e-10, 1e2)),
+], ids=["stress-natural", "rate-natural-kinked", "yield-stress"])
+def test_an_answer_does_not_depend_on_the_tables_history(law, natural, js, span):
+    """The same load gives the same bits whatever loads the table served before: loads across the
+    law's range, loads on (and around) the ends where panels meet, and (a yield-stress fluid) loads
+    below its lowest panel, served one at a time in increasing order, one at a time in a shuffled
+    order, and in one call in decreasing order after a sweep of other loads."""
+    radius = 1.0
+    common = np.array(sorted(set(np.geomspace(*span, 24).tolist() + _panel_ends(law, natural, js, radius)
+                                 + [1e-300, 1e-30])))
+
+    def one_at_a_time(order):
+        tubefsi.cache_clear()
+        out = np.empty(common.size)
+        for i in order:
+            out[i] = law.pressure_gradient(common[i], radius)
+        return out
+
+    increasing = one_at_a_time(range(common.size))
+    shuffled = list(range(common.size))
+    random.Random(7).shuffle(shuffled)
+    scattered = one_at_a_time(shuffled)
+    tubefsi.cache_clear()
+    law.pressure_gradient(np.geomspace(span[0] * 1e-3, span[1] * 1e3, 57), radius)
+    swept = law.pressure_gradient(common[::-1], radius)[::-1]
+    assert np.array_equal(increasing, scattered)
+    assert np.array_equal(increasing, swept)
+
+
+def test_a_fluid_whose_parameters_differ_gets_its_own_table():
+    """Two fluids of one class with different parameters, in either order: each its own G, to TOL
+    against its mpmath reference, the same bits in both orders; an equal fluid shares a table."""
+    radius = 1e-3
+    rates = np.geomspace(1e-3, 1e5, 9)
+    laws = [CarreauLike(), CarreauLike(eta0=0.56, lam=0.5, index=0.7)]
+    refs = [carreau_reference(law, rates) for law in laws]
+    answers = {}
+    for order in ((0, 1), (1, 0)):
+        tubefsi.cache_clear()
+        for i in order:
+            tw, gamma = refs[i]
+            g = laws[i].pressure_gradient(0.25 * math.pi * radius**3 * gamma, radius)
+            assert np.all(rel(0.5 * g * radius, tw) <= allowed(tw, gamma))
+            if i in answers:
+                assert np.array_equal(g, answers[i])
+            answers[i] = g
+        assert tubefsi.cache_info().size == 2
+    assert not np.array_equal(answers[0], answers[1])
+    CarreauLike().pressure_gradient(1e-9, radius)                # equal to laws[0]: its table
+    assert tubefsi.cache_info().size == 2
+
+
+def test_a_fluid_changed_in_place_answers_for_its_new_values():
+    """A fluid that is not frozen, changed between calls: each call answers for the values it has
+    then (to TOL against mpmath, and the same bits as a fresh fluid of those values), and changed
+    back it answers as before, to the bit."""
+    radius = 1e-3
+    rates = np.geomspace(1e-2, 1e4, 7)
+    fluid = MutableCarreau()
+    tw, gamma = carreau_reference(fluid, rates)
+    q = 0.25 * math.pi * radius**3 * gamma
+    first = fluid.pressure_gradient(q, radius)
+    assert np.all(rel(0.5 * first * radius, tw) <= allowed(tw, gamma))
+    fluid.eta0, fluid.lam, fluid.index = 0.3, 0.2, 0.5
+    tw2, gamma2 = carreau_reference(fluid, rates)
+    q2 = 0.25 * math.pi * radius**3 * gamma2
+    second = fluid.pressure_gradient(q2, radius)
+    assert np.all(rel(0.5 * second * radius, tw2) <= allowed(tw2, gamma2))
+    assert np.array_equal(second, MutableCarreau(eta0=0.3, lam=0.2, index=0.5).pressure_gradient(q2, radius))
+    assert np.array_equal(fluid.pressure_gradient(q, radius), MutableCarreau(eta0=0.3, lam=0.2, index=0.5)
+                          .pressure_gradient(q, radius))
+    fluid.eta0, fluid.lam, fluid.index = 0.056, 3.313, 0.3568
+    assert np.array_equal(fluid.pressure_gradient(q, radius), first)
+
+
+def test_threads_sharing_one_fluid_get_the_sequential_answers():
+    """8 threads share one Carreau fluid on a cold cache, released together: each computes G at
+    its own 40 loads one at a time (interleaved with the others') and a flow-controlled solve.
+    Every answer is the sequential one, to the bit, and none raises."""
+    law = CarreauLike()
+    wall = tubefsi.registry.walls["thick-neo-hookean"](shear_modulus=5e3)
+    tube = tubefsi.Tube(radius=5e-4, thickness=1.5e-4, length=2e-2)
+    radius, threads = 1e-3, 8
+    loads = np.geomspace(1e-16, 1e-4, threads * 40)
+    curves = [np.geomspace(1e-10, 1e-7, 5) * (1.0 + 0.01 * i) for i in range(threads)]
+
+    def work(i, barrier=None):
+        if barrier is not None:
+            barrier.wait()
+        g = np.array([law.pressure_gradient(q, radius) for q in loads[i::threads]])
+        return g, np.asarray(tubefsi.solve(law, wall, tube, flow_rate=curves[i]).pressure_drop)
+
+    sequential = [work(i) for i in range(threads)]
+    tubefsi.cache_clear()
+    barrier = threading.Barrier(threads)
+    with concurrent.futures.ThreadPoolExecutor(max_workers=threads) as pool:
+        futures = [pool.submit(work, i, barrier) for i in range(threads)]
+        parallel = [future.result(timeout=120) for future in futures]
+    for (g, drop), (g_par, drop_par) in zip(sequential, parallel):
+        assert np.array_equal(g, g_par)
+        assert np.array_equal(drop, drop_par)
 
 
 # ---------------------------------------------------------------- zero loads and typed errors
 def test_zero_flow_rate():
-    """G(0, R) = 0 through the public API (a convention for yield-stress fluids too); the hook
-    gives the limit q -> 0+: 0, or the yield gradient 2 tau_y / R."""
+    """G(0, R) = 0 through the public API (a convention for yield-stress fluids too), while the
+    limit q -> 0+ is 0, or the yield gradient 2 tau_y / R."""
     radius = 1e-3
     for law in (CarreauLike(), RateOnlyHerschelBulkley(), KinkedPowerLaw()):
         assert law.pressure_gradient(0.0, radius) == 0.0
         np.testing.assert_array_equal(law.pressure_gradient(np.zeros(3), radius), 0.0)
-        g = law._pressure_gradient(np.array([0.0, 0.0]), np.array([radius, 2 * radius]))
-        np.testing.assert_array_equal(g, 2 * law.yield_stress / np.array([radius, 2 * radius]))
         mixed = law.pressure_gradient(np.array([0.0, 1e-9]), radius)
         assert mixed[0] == 0.0 < mixed[1]
+        tiny = law.pressure_gradient(np.array([1e-300, 1e-300]), np.array([radius, 2 * radius]))
+        if law.yield_stress > 0:
+            np.testing.assert_array_equal(tiny, 2 * law.yield_stress / np.array([radius, 2 * radius]))
+        else:                                  # 1e-289 (Newtonian), 1e-173 (power law tau ~ rate^0.6)
+            assert np.all((tiny > 0) & (tiny < 1e-100))
 
 
 def test_plugin_rheologies_at_zero_flow_rate():
@@ -360,7 +669,11 @@ def test_plugin_rheologies_at_zero_flow_rate():
     for name in ("carreau", "carreau-yasuda", "cross", "ellis", "bingham", "casson", "herschel-bulkley"):
         law = rheologies[name](**rheologies[name]._examples[0])
         assert law.pressure_gradient(0.0, 1e-4) == 0.0
-        assert law._pressure_gradient(np.zeros(1), np.full(1, 1e-4))[0] == 2 * law.yield_stress / 1e-4
+        tiny = law.pressure_gradient(1e-300, 1e-4)
+        if law.yield_stress > 0:
+            assert tiny == 2 * law.yield_stress / 1e-4
+        else:
+            assert 0.0 < tiny < 1e-100
 
 
 def test_loads_beyond_the_representable_range_are_typed_errors():
@@ -372,6 +685,9 @@ def test_loads_beyond_the_representable_range_are_typed_errors():
 
 
 def test_a_decreasing_law_is_rejected():
+    """A shear rate that decreases between 1 and 1.5 Pa: Gamma rises, falls and rises again
+    inside one panel of the table (its ends alone do not show it)."""
+
     @attrs.frozen
     class NotAFluid(Rheology):
         def _shear_rate(self, tau):                   # continuous, decreasing between 1 and 1.5 Pa
@@ -383,8 +699,10 @@ def test_a_decreasing_law_is_rejected():
 
 def test_no_bare_arithmetic_errors_across_loads():
     """Every outcome over a wide range of loads is a value or a tubefsi error."""
-    for law in (CarreauLike(), RateOnlyHerschelBulkley(), KinkedPowerLaw(), NewtonianBelow()):
+    for law in (CarreauLike(), RateOnlyHerschelBulkley(), KinkedPowerLaw(), NewtonianBelow(),
+                NewtonianBelow(eta0=1.0, index=0.1, tau_c=1e13)):
         for q in (0.0, 5e-324, 1e-200, 1e-30, 1e-6, 1.0, 1e30, 1e200):
+            tubefsi.cache_clear()                  # each load the first of its table
             try:
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore", AccuracyWarning)
@@ -403,99 +721,3 @@ def test_solve_with_a_kinked_law():
     a = tubefsi.solve(law, wall, tube, flow_rate=q)
     back = tubefsi.solve(law, wall, tube, pressure_drop=a.pressure_drop)
     np.testing.assert_allclose(back.flow_rate, q, rtol=1e-11)
-
-
-# ---------------------------------------------------------------- a panel's nodes from one cumulative integral
-def _panel_nodes(a, b):
-    """The 29 parameters of the table panel on [a, b] (its Lobatto nodes and check points), (1, 29)."""
-    from tubefsi.rheology._flow_table import _panel_nodes as nodes
-    return nodes(np.array([a]), np.array([b]))
-
-
-@pytest.mark.parametrize("a, b", [(-6.0, -4.0), (-1.0, 1.0), (3.0, 5.0), (-4.0, 4.0), (12.0, 20.0)])
-def test_cumulative_panel_rate_against_mpmath(a, b):
-    """Gamma at a panel's nodes from the cumulative integral K (one rule for the whole panel)
-    against 30-digit mpmath quadrature of 4/3 rate int_0^1 (1 - (tau(rate t)/tau_w)^3) dt for
-    the Carreau law written afresh: every accepted node within 3e-15 and within its estimate
-    plus 1e-15; at least 80 % of the nodes accepted on a smooth law."""
-    from tubefsi.rheology._flow_table import stress_natural_rate_panels
-    law = CarreauLike()
-    p = _panel_nodes(a, b)
-    rate = np.exp(p)
-    tw = law._stress(rate)     # the reference takes these as given: their rounding, amplified 3q/(1-q), is the law's
-    gamma, estimate, ok = stress_natural_rate_panels(law, p, tw)
-    assert ok.mean() >= 0.8
-    with mp.workdps(30):
-        e0, lam, n = mpf(law.eta0), mpf(law.lam), mpf(law.index)
-
-        def tau(g):
-            return g * e0 * (1 + (lam * g) ** 2) ** ((n - 1) / 2)
-
-        for j in range(0, p.shape[1], 4):
-            g_w = mpf(float(rate[0, j]))
-            t_w = mpf(float(tw[0, j]))           # the given wall stress (see above)
-            corner = 1 / (lam * g_w)             # the transition, where tanh-sinh needs a breakpoint
-            points = [0] + sorted(c for c in (corner / 1000, corner / 10, corner, 10 * corner, 1000 * corner) if c < 1) + [1]
-            ref = 4 * g_w / 3 * mp.quad(lambda t: 1 - (tau(g_w * t) / t_w) ** 3, points)
-            err = float(abs(gamma[0, j] - ref) / ref)
-            if ok[0, j]:
-                assert err < 3e-15 and err < estimate[0, j] + 1e-15, (j, err, estimate[0, j])
-
-
-@pytest.mark.parametrize("a, b", [(3.0, 5.0), (3.9, 4.0), (3.0, 3.912)])
-def test_cumulative_panel_rate_across_a_kink(a, b):
-    """A stress-natural law with a kink inside the panel (ln g_c = 3.912): the accepted nodes
-    against the elementary closed form within 2e-14, and the table's exact values (accepted or
-    integrated one by one) too."""
-    from tubefsi.rheology._flow_table import FlowTable, stress_natural_rate_panels
-    law = KinkedPowerLaw()
-    p = _panel_nodes(a, b)
-    rate = np.exp(p)
-    tw = law._stress(rate)
-    gamma, _, ok = stress_natural_rate_panels(law, p, tw)
-    exact = law.exact_rate(tw)
-    assert np.all(rel(gamma[ok], exact[ok]) < 2e-14)
-    s, y, _ = FlowTable(law)._exact(p)
-    assert np.all(rel(np.exp(y), exact) < 2e-14)
-
-
-def test_cumulative_panel_rate_refuses_a_stress_plateau():
-    """Near a yield stress 1 - q cancels (q -> 1): those nodes are refused, and the table's
-    exact values there are the point-wise integrals."""
-    from tubefsi.rheology._flow_table import FlowTable, stress_natural_rate, stress_natural_rate_panels
-    law, twin = StressOnlyHerschelBulkley(), RateOnlyHerschelBulkley()
-    p = _panel_nodes(-20.0, -14.0)            # tau - tau_y ~ 1e-5 .. 1e-3 tau_y
-    rate = np.exp(p)
-    tw = law._stress(rate)
-    _, _, ok = stress_natural_rate_panels(law, p, tw)
-    assert not np.any(ok)
-    _, y, _ = FlowTable(law)._exact(p)
-    assert np.array_equal(np.exp(y), np.exp(np.log(stress_natural_rate(law, rate, tw)[0])))
-    # (their own accuracy there is the law's: 1 - (tau / tau_w)^3 carries eps tau_y / (tau - tau_y))
-    excess = law.consistency * rate**law.index
-    assert np.all(rel(np.exp(y), twin.exact_rate(tw, excess)) < 4 * EPS * law.yield_stress / excess)
-
-
-@settings(max_examples=scaled(25), deadline=None)
-@given(eta0=st.floats(1e-3, 10.0), lam=st.floats(1e-3, 1e3), index=st.floats(0.05, 1.8),
-       centre=st.floats(-25.0, 25.0), width=st.floats(0.05, 12.0))
-def test_cumulative_panel_rate_equals_the_pointwise_integrals(eta0, lam, index, centre, width):
-    """Property: wherever the cumulative rule accepts a node, it agrees with the point-wise
-    error-controlled integral of the other formulation (1 - ratio^3 over t in (0, 1]) within its
-    own estimate plus the other's rounding, and the estimates stay within a quarter of the
-    table's 1e-14."""
-    from tubefsi.rheology._flow_table import stress_natural_rate, stress_natural_rate_panels
-    law = CarreauLike(eta0=eta0, lam=lam, index=index)
-    p = _panel_nodes(centre - width / 2, centre + width / 2)
-    rate = np.exp(p)
-    tw = law._stress(rate)
-    gamma, estimate, ok = stress_natural_rate_panels(law, p, tw)
-    if not np.any(ok):                     # every node left to the point-wise rule
-        return
-    pointwise, (result, live) = stress_natural_rate(law, rate[ok], tw[ok])
-    assert live.size == np.count_nonzero(ok)
-    # each within its own estimate (the point-wise one, with its rounding floor, from its
-    # quadrature), plus the two roundings of the comparison
-    own = np.abs(result.error) / np.abs(result.value)
-    assert np.all(rel(gamma[ok], pointwise) < estimate[ok] + own + 4 * EPS)
-    assert np.all(estimate[ok] <= 0.25 * TOL)

@@ -251,22 +251,36 @@ class FlowTable:
                                         f"its tube-flow function does not increase near ln(tau_w - tau_y) = "
                                         f"{float(s_ends[0]):.6g}")
         errors = []
+        # TOL is a relative error of G: a relative error e of Gamma (a node's estimate) is one of
+        # e (ds/dy) (tau_w - tau_y) / tau_w in G, ds/dy taken as the ends' secant (near yield the
+        # quadrature's rounding floor, large in Gamma, is small in G)
+        gain = float(s_ends[1] - s_ends[0]) / float(y_ends[1] - y_ends[0])
+
+        samples = []
 
         def forward(p):
             s, y, err = self._exact(p)
-            errors.append(float(np.max(err, initial=0.0)))
+            samples.append((np.ravel(p), s.ravel(), y.ravel(), err.ravel()))
+            with np.errstate(all="ignore"):
+                share = 1.0 / (1.0 + self.yield_stress * np.exp(-s)) if self.yield_stress > 0 else 1.0
+                errors.append(gain * float(np.max(np.where(np.isfinite(s), err * share, err), initial=0.0)))
             return np.stack([y, s])
 
         fit, _ = fit_piecewise(forward, lo, hi, degree=16, tol=5e-15, panels=1, max_panels=64, relative=True)
         y_lo, y_hi = float(y_ends[0]), float(y_ends[1])
         node_error = max(errors) if errors else 0.0
+        # a direct panel's slopes (for the asymptote below the lowest panel, and the steps toward
+        # a load) are its ends' secant: its fit, if any, cannot be trusted
+        secant = {"slope_y": y_hi - y_lo, "slope_s": float(s_ends[1] - s_ends[0])}
         if fit is None:                        # a kink (or noise): solved exactly at each lookup
-            return _Panel(j, y_lo, y_hi, None, error=node_error)
+            self._increasing(samples)
+            return _Panel(j, y_lo, y_hi, None, error=node_error, **secant)
         slope = fit.derivative(0)
         grid = np.linspace(lo, hi, 257)
         grid_y = fit(grid, output=0)
         if not np.all(slope(grid) > 0):
-            return _Panel(j, y_lo, y_hi, None, error=node_error)
+            self._increasing(samples)
+            return _Panel(j, y_lo, y_hi, None, error=node_error, **secant)
 
         def inverse_values(y):
             p = np.interp(y, grid_y, grid)
@@ -284,6 +298,23 @@ class FlowTable:
         if inverse is None:
             return _Panel(j, y_lo, y_hi, None, error=node_error, slope_y=slope_y, slope_s=slope_s)
         return _Panel(j, y_lo, y_hi, inverse, error=node_error, slope_y=slope_y, slope_s=slope_s)
+
+    def _increasing(self, samples) -> None:
+        """Raise :class:`InvalidParameterError` where the exact values ``(p, s, y, err)`` of a direct
+        panel show y(p) decreasing beyond their error estimates: a lookup solves y(p) = y by
+        bisection there, which assumes one root (the ends alone cannot show a dip between them)."""
+        if not samples:
+            return
+        p, s, y, err = (np.concatenate(column) for column in zip(*samples))
+        order = np.argsort(p, kind="stable")
+        s, y, err = s[order], y[order], err[order]
+        allowed = 2.0 * (err[:-1] + err[1:]) + 8.0 * _EPS * np.maximum(1.0, np.abs(y[1:]))
+        with np.errstate(invalid="ignore"):
+            drop = np.flatnonzero(y[:-1] - y[1:] > allowed)
+        if drop.size:
+            raise InvalidParameterError("rheology", "a shear stress increasing with the shear rate", self.rheology,
+                                        f"its tube-flow function decreases near ln(tau_w - tau_y) = "
+                                        f"{float(s[drop[0]]):.6g}")
 
     def _panel(self, j: int) -> _Panel:
         found = self._panels.get(j)
@@ -312,14 +343,34 @@ class FlowTable:
         lowest = self._lowest()
         if not any(panel.finite for panel in self._panels.values()):
             j = self._start(float(np.median(y)))
-            while not self._panel(j).finite and j < _P_LIMIT - 1:
-                j += 1
+            if not self._panel(j).finite:
+                # the secant landed outside the law's range (the finite panels are one run): past
+                # its end (the flow function overflows) back into it by steps doubling downward,
+                # then the run's last panel by bisection; below its floor, upward
+                beyond, step = j, 1
+                while j > lowest and not self._panel(j).finite:
+                    beyond, j, step = j, max(j - step, lowest), 2 * step
+                if not self._panel(j).finite:
+                    j, beyond = lowest, None
+                    while j < _P_LIMIT - 1 and not self._panel(j).finite:
+                        j += 1
+                while beyond is not None and beyond - j > 1 and self._panel(j).finite:
+                    mid = (j + beyond) // 2
+                    j, beyond = (mid, beyond) if self._panel(mid).finite else (j, mid)
+                if not self._panel(j).finite:
+                    raise InvalidParameterError(
+                        "rheology", "a law whose tube-flow function is finite somewhere", self.rheology,
+                        f"its tube-flow function is not finite for any natural parameter in [{lowest}, {_P_LIMIT}]")
         for _ in range(4 * _P_LIMIT):
             run = sorted((panel for panel in self._panels.values() if panel.finite), key=lambda panel: panel.j)
             lo = np.array([panel.y_lo for panel in run])
             hi = np.array([panel.y_hi for panel in run])
             k = np.clip(np.searchsorted(lo, y, side="right") - 1, 0, len(run) - 1)
-            held = (y >= lo[k]) & (y <= hi[k])
+            # a panel holds lo <= y < hi (its upper end too where no panel can follow it): a load on
+            # the common end of two panels gets the upper one, whether or not it was built before
+            last = np.array([panel.j + 1 >= _P_LIMIT or not self._panels.get(panel.j + 1, panel).finite
+                             for panel in run])
+            held = (y >= lo[k]) & ((y < hi[k]) | ((y == hi[k]) & last[k]))
             # below the first panel, and nothing resolvable below it: the asymptote's (the panel
             # below is built only when a load needs it)
             below = y < lo[0]
@@ -337,11 +388,14 @@ class FlowTable:
             for i in np.unique(k[~held & ~below]):
                 targets = y[(k == i) & ~held & ~below]
                 panel = run[i]
-                if targets.max() > panel.y_hi:         # above panel i: toward run[i + 1] (or beyond the last)
+                if targets.max() >= panel.y_hi:        # above panel i: toward run[i + 1] (or beyond the last)
                     step = (float(targets.max()) - panel.y_hi) / max(panel.slope_y, 1e-3)
                     j = panel.j + 1 + int(step)
-                    if i + 1 < len(run):
-                        j = min(j, run[i + 1].j - 1)
+                    if i + 1 < len(run):       # not past the next built panel: the secant between the two
+                        upper = run[i + 1]
+                        gap = upper.y_lo - panel.y_hi
+                        share = (float(targets.max()) - panel.y_hi) / gap if gap > 0 else 0.0
+                        j = min(j, panel.j + 1 + int(share * (upper.j - panel.j - 1)))
                     wanted.add(min(max(j, panel.j + 1), _P_LIMIT - 1))
                 if targets.min() < panel.y_lo:         # below the first panel
                     step = (panel.y_lo - float(targets.min())) / max(panel.slope_y, 1e-3)
