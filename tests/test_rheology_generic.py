@@ -311,12 +311,6 @@ def test_unit_integral_endpoint_singularity_and_hidden_kink():
     assert abs(res.value[0] - exact) / exact < 1e-14
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "tubefsi.numerics.quadrature.adaptive (robust=True) stops a point as 'hopeless' when its "
-    "estimate has not fallen four-fold in 12 rounds; with two kinks, the bisection that uncovers "
-    "the second kink's hidden error raises the estimate meanwhile, and the point stops after ~40 "
-    "panels, unconverged: an AccuracyWarning and an error up to 4e-9. Without that stop it "
-    "converges to 6e-16 in ~100 panels."))
 @pytest.mark.parametrize("tw", [2.20383715, 2.87801264, 3.86282971])
 def test_two_kinks_are_integrated_to_the_tolerance(tw):
     """An increasing law with two kinks, at wall stresses where the quadrature stopped early: the

@@ -215,7 +215,8 @@ def adaptive(f, lower, upper, *, rtol=1e-14, atol=0.0, panels=None, max_rounds=6
     Integral
         ``value``, ``error``, ``converged`` and ``panels``, shaped like the broadcast limits. A
         point stops when its estimate meets the tolerance (or twice its rounding floor), when it
-        has not fallen four-fold in 12 rounds (a noisy integrand), or at ``max_rounds`` or
+        has not fallen four-fold in 24 rounds (a noisy integrand; a shorter window stops points
+        whose bisection is still uncovering a second kink's hidden error), or at ``max_rounds`` or
         ``max_panels``; ``converged`` says which.
     """
     lower, upper = np.broadcast_arrays(np.asarray(lower, dtype=float), np.asarray(upper, dtype=float))
@@ -235,7 +236,7 @@ def adaptive(f, lower, upper, *, rtol=1e-14, atol=0.0, panels=None, max_rounds=6
     snapshots = []
     for round_ in range(max_rounds):
         tol = np.maximum(atol, rtol * np.abs(total))
-        if round_ % 6 == 0:                    # hopeless: not fallen four-fold in 12 rounds
+        if round_ % 12 == 0:                   # hopeless: not fallen four-fold in 24 rounds
             if len(snapshots) == 2:
                 finished |= err > 0.25 * snapshots.pop(0)
             snapshots.append(err.copy())
