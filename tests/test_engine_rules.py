@@ -25,7 +25,6 @@ import os
 import random
 import subprocess
 import sys
-import textwrap
 import threading
 import warnings
 import weakref
@@ -39,7 +38,7 @@ import tubefsi
 from tubefsi import registry
 from tubefsi.registry import rheologies, walls
 from tubefsi.rheology import Rheology
-from tubefsi.walls import WallModel
+from tubefsi.walls import HyperelasticWall, ThickWall, WallModel
 
 TUBE = tubefsi.Tube(radius=1e-4, thickness=3e-5, length=1e-2)
 POWER = dict(consistency=0.017, index=0.7)
@@ -791,7 +790,8 @@ def _run_time_classes():
     plain_wall = type("RunTimeWall", (WallModel,), {
         "__init__": lambda self, modulus: setattr(self, "modulus", modulus),
         "_pressure": lambda self, stretch, tb: tb * self.modulus * (1.0 - stretch**-4)})
-    split_wall = type("RunTimeNeoHookean", (walls["thick-neo-hookean"],), {"__module__": __name__})
+    split_wall = type("RunTimeNeoHookean", (walls["thick-neo-hookean"],),    # (declaring its split)
+                      {"__module__": __name__, "_shape_key": walls["thick-neo-hookean"]._shape_key})
     power = rheologies["power-law"](**POWER)
     curve = np.geomspace(1e-11, 1e-9, 100)
     for fluid in (RunTimeFluid(0.05), RunTimePlainFluid(0.04)):
@@ -806,7 +806,7 @@ def _run_time_classes():
 
 def test_classes_made_at_run_time_are_released_without_clearing():
     """Run-time fluid classes (attrs and plain) and wall classes (a plain WallModel and a subclass
-    of thick-neo-hookean that inherits its shape/scale split, so its tables are keyed by a weak
+    of thick-neo-hookean that declares its shape/scale split, so its tables are keyed by a weak
     reference to it) are released once their instances are gone, the cache still holding their
     tables: no cache_clear is needed."""
     tubefsi.cache_clear()
@@ -875,3 +875,61 @@ def test_the_cache_is_bounded_and_clearing_changes_no_answer():
     assert tubefsi.cache_info().size == 0
     after = [call() for call in calls]
     assert all(_same_bits(a, b) and _same_bits(a, c) for a, b, c in zip(before, warm, after))
+
+
+@attrs.frozen(kw_only=True)
+class _Declared(ThickWall, HyperelasticWall):
+    """A Gent-like law written the tutorial's way, declaring its shape/scale split in its body."""
+
+    mu: float = 2e3
+
+    def _dW(self, s):
+        return self.mu * (s - s**-3) / (1.0 - (s - 1.0 / s) ** 2 / 50.0)
+
+    def _pressure_scale(self):
+        return self.mu
+
+    def _shape_key(self):
+        return ()
+
+    def _unit_wall(self):
+        return attrs.evolve(self, mu=1.0)
+
+
+@attrs.frozen(kw_only=True)
+class _Offset(_Declared):
+    """A subclass whose law is no longer proportional to mu, declaring nothing."""
+
+    def _dW(self, s):
+        return super()._dW(s) + 500.0 * (s - s**-3)
+
+
+@attrs.frozen(kw_only=True)
+class _Written(ThickWall, HyperelasticWall):
+    """_Offset's law written out, without a split (the reference: it shares no table)."""
+
+    mu: float = 2e3
+
+    def _dW(self, s):
+        return self.mu * (s - s**-3) / (1.0 - (s - 1.0 / s) ** 2 / 50.0) + 500.0 * (s - s**-3)
+
+
+def test_a_subclass_that_changes_the_law_does_not_inherit_the_split():
+    """A wall class that declares its split in its body shares one table between its instances;
+    a subclass that changes the law (W' + 500 Pa (lambda - lambda^-3), no longer proportional to
+    mu) and declares nothing shares none: its answers are the same law written out without a split
+    (the reference), to 1e-12, scalar and curve, after the parent's table exists. A split inherited
+    from the parent would scale the subclass's unit law (off by ~20 %)."""
+    power = rheologies["power-law"](**POWER)
+    curve = np.geomspace(1e-11, 5e-10, 80)
+    tubefsi.cache_clear()
+    tubefsi.solve(power, _Declared(mu=1e3), TUBE, flow_rate=curve)
+    assert tubefsi.cache_info().size == 1                  # the declared split's table
+    for mu in (1e3, 3e3):
+        reference = tubefsi.solve(power, _Written(mu=mu), TUBE, flow_rate=curve)
+        got = tubefsi.solve(power, _Offset(mu=mu), TUBE, flow_rate=curve)
+        np.testing.assert_allclose(got.pressure_drop, reference.pressure_drop, rtol=1e-12)
+        one = tubefsi.solve(power, _Offset(mu=mu), TUBE, flow_rate=5e-10).pressure_drop
+        assert one == pytest.approx(tubefsi.solve(power, _Written(mu=mu), TUBE, flow_rate=5e-10).pressure_drop,
+                                    rel=1e-12)
+    assert tubefsi.cache_info().size == 1                  # neither made a table of its own

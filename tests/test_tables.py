@@ -122,7 +122,7 @@ def test_the_scalar_evaluation_is_the_array_evaluation_bit_for_bit():
     x = np.concatenate([np.random.default_rng(0).uniform(-20, 10, 500), poly.breaks])
     values = poly.evaluate(x)
     for i, xi in enumerate(x):
-        assert poly.scalar(float(xi)) == tuple(values[:, i])
+        assert poly.scalar(float(xi)) == values[:, i].tolist()
 
 
 @pytest.mark.parametrize("decay", [0.3, 0.5])

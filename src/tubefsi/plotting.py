@@ -204,8 +204,8 @@ def _subset(solution, max_loads):
         pick = order[np.unique(np.round(np.linspace(0, q.size - 1, max_loads)).astype(int))]
     else:
         pick = order
-    fields = {f.name: np.ravel(np.asarray(getattr(state, f.name)))[pick] for f in attrs.fields(type(state))}
-    sub = attrs.evolve(solution, state=attrs.evolve(state, **fields), scalar=False)
+    sub = attrs.evolve(solution, state=type(state)(*(np.ravel(np.asarray(value))[pick] for value in state)),
+                       scalar=False)
     return sub, q[pick]
 
 

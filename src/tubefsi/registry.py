@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import re
 import sys
+import threading
 import warnings
 from collections.abc import Iterator, Mapping
 from importlib import metadata
@@ -66,6 +67,10 @@ class Registry(Mapping):
         self._origin: dict[str, str] = {}
         self._pending: dict[str, list[tuple[str, metadata.EntryPoint]]] = {}  # name -> providers, by priority
         self._derived: dict = {}    # what callers derived from the registry (derived()), until refresh()
+        # reading the entry points and importing a provider happen under this lock (a lookup that
+        # finds its name resolved takes none): two threads never import one name at once, and no
+        # thread sees a name half-resolved
+        self._lock = threading.RLock()
 
     def _read(self) -> dict[str, type]:
         """Read the entry points (once) and order each name's providers; import nothing."""
@@ -107,16 +112,22 @@ class Registry(Mapping):
 
     def _load(self) -> dict[str, type]:
         """Resolve every name."""
-        entries = self._read()
-        for name in list(self._pending):
-            self._resolve(name)
-        return entries
+        with self._lock:
+            entries = self._read()
+            for name in list(self._pending):
+                self._resolve(name)
+            return entries
 
     def _get(self, name: str) -> type | None:
-        entries = self._read()
-        if name in self._pending:
-            self._resolve(name)
-        return entries.get(name)
+        entries = self._entries
+        found = None if entries is None else entries.get(name)
+        if found is not None:
+            return found
+        with self._lock:
+            entries = self._read()
+            if name in self._pending:
+                self._resolve(name)
+            return entries.get(name)
 
     def __getitem__(self, name: str) -> type:
         obj = self._get(name)
@@ -152,15 +163,23 @@ class Registry(Mapping):
         ``coupler="auto"`` tries, in order) and forgotten by :meth:`refresh`."""
         found = self._derived.get(name)
         if found is None:
-            found = self._derived[name] = compute(self)
+            with self._lock:
+                found = self._derived.get(name)
+                if found is None:
+                    found = self._derived[name] = compute(self)
         return found
 
     def refresh(self) -> None:
         """Forget the cache; the next access reads the entry points again."""
-        self._entries = None
-        self._origin = {}
-        self._pending = {}
-        self._derived = {}
+        with self._lock:
+            self._entries = None
+            self._origin = {}
+            self._pending = {}
+            self._derived = {}
+
+    def __reduce__(self):
+        # pickled by reference (a worker process has its own registries, and a lock pickles not)
+        return _registry_of, (self.group,)
 
     def __repr__(self) -> str:
         return f"Registry({self.group!r}: {', '.join(self)})"
@@ -169,6 +188,11 @@ class Registry(Mapping):
 rheologies = Registry("tubefsi.rheologies")
 walls = Registry("tubefsi.walls")
 couplers = Registry("tubefsi.couplers")
+
+
+def _registry_of(group: str) -> Registry:
+    """The module's registry of an entry-point group (what a pickled registry becomes)."""
+    return {r.group: r for r in (rheologies, walls, couplers)}[group]
 
 
 def refresh() -> None:

@@ -12,6 +12,7 @@ validates every argument. A coupler returns a :class:`State`: arrays of one shap
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import attrs
 import numpy as np
@@ -30,9 +31,8 @@ from .profiles import Profile
 __all__ = ["Scene", "State", "Points", "make_scene", "resolve"]
 
 
-@attrs.frozen
-class State:
-    r"""What a coupler returns: arrays of one shape (the loads' shape).
+class State(NamedTuple):
+    r"""What a coupler returns: four numbers or four arrays of one shape (the loads' shape).
 
     Attributes
     ----------
@@ -53,8 +53,7 @@ class State:
 
     def arrays(self, n: int) -> dict:
         """Every field as a float array of ``n`` entries (broadcast, not copied), by name."""
-        return {f.name: np.broadcast_to(np.asarray(getattr(self, f.name), dtype=float), (n,))
-                for f in attrs.fields(State)}
+        return {name: np.broadcast_to(np.asarray(value, dtype=float), (n,)) for name, value in zip(self._fields, self)}
 
     def take(self, index) -> State:
         """The state at the entries ``index`` of its (flat) arrays."""
@@ -65,16 +64,17 @@ class State:
 _FLOATS, _ARRAYS, _ALONG_Z = 0, 1, 2
 
 
-def _kind(model) -> int:
-    """``_FLOATS`` where every parameter of ``model`` that may be an array is a float, ``_ALONG_Z``
+def _kind(*models) -> int:
+    """``_FLOATS`` where every parameter of ``models`` that may be an array is a float, ``_ALONG_Z``
     where one is a function of z (a :class:`~tubefsi.Profile`), else ``_ARRAYS``."""
     kind = _FLOATS
-    for name in _array_fields(type(model)):
-        value = getattr(model, name)
-        if type(value) is not float:
-            if isinstance(value, Profile):
-                return _ALONG_Z
-            kind = _ARRAYS
+    for model in models:
+        for name in _array_fields(type(model)):
+            value = getattr(model, name)
+            if type(value) is not float:
+                if isinstance(value, Profile):
+                    return _ALONG_Z
+                kind = _ARRAYS
     return kind
 
 
@@ -444,22 +444,24 @@ def make_scene(rheology, wall, tube, *, outlet_pressure=0.0, external_pressure=0
     BucklingError
         If it is below the wall's minimum pressure (minus its buckling pressure).
     """
-    rheology = resolve("rheology", rheology)
-    wall = resolve("wall", wall)
+    if not isinstance(rheology, Rheology):
+        rheology = resolve("rheology", rheology)
+    if not isinstance(wall, WallModel):
+        wall = resolve("wall", wall)
     if not isinstance(tube, Tube):
         raise InvalidParameterError("tube", "a tubefsi.Tube", tube)
-    kinds = _kind(rheology), _kind(wall), _kind(tube)
-    if kinds[0] == _ALONG_Z:
-        name = next(n for n in _array_fields(type(rheology)) if isinstance(getattr(rheology, n), Profile))
-        raise InvalidParameterError(name, "a number or an array (a fluid's parameters do not vary along the tube)",
-                                    getattr(rheology, name))
-    if kinds[1] == _ALONG_Z or kinds[2] == _ALONG_Z:
+    kind = _kind(rheology, wall, tube)
+    if kind == _ALONG_Z:
+        if _kind(rheology) == _ALONG_Z:
+            name = next(n for n in _array_fields(type(rheology)) if isinstance(getattr(rheology, n), Profile))
+            raise InvalidParameterError(name, "a number or an array (a fluid's parameters do not vary along "
+                                        "the tube)", getattr(rheology, name))
         return _graded_scene(rheology, wall, tube, outlet_pressure, external_pressure)
     installed = tube
     tube = wall._installed_tube(tube)        # an axial pre-stretch installs the tube longer and narrower
     if (type(outlet_pressure) is float and outlet_pressure == 0.0 and type(external_pressure) is float
             and external_pressure == 0.0):   # the common case: an unloaded outlet is below every limit
-        if kinds == (_FLOATS, _FLOATS, _FLOATS) and (tube is installed or _kind(tube) == _FLOATS):
+        if kind == _FLOATS and (tube is installed or _kind(tube) == _FLOATS):
             return Scene.unloaded(rheology, wall, tube)
         return Scene(rheology=rheology, wall=wall, tube=tube, outlet_pressure=0.0)
     p_out, p_e, gauge = _outlet(wall, tube.reduced_thickness, outlet_pressure, external_pressure)

@@ -133,8 +133,8 @@ class Solution:
         and one parameter set per chunk where a model needs it (:meth:`Scene.split`)."""
         st = self.state
         flat = self.scene.flat(shape) if self.scene.shape != () else self.scene
-        fields = {f.name: np.broadcast_to(np.asarray(getattr(st, f.name), dtype=float), shape).ravel()
-                  for f in attrs.fields(State)}
+        fields = {name: np.broadcast_to(np.asarray(value, dtype=float), shape).ravel()
+                  for name, value in zip(State._fields, st)}
         ok = np.flatnonzero(np.isfinite(fields["flow_rate"]))
 
         def parts():

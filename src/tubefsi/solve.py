@@ -35,7 +35,7 @@ __all__ = ["solve", "max_flow_rate", "select_coupler", "Problem", "CHUNK"]
 
 #: Points per coupler call: bounds the working memory (a few tens of MB) of any sweep.
 CHUNK = 1 << 14
-_STATE_FIELDS = tuple(f.name for f in attrs.fields(State))
+_STATE_FIELDS = State._fields
 
 
 def _ranked(couplers):
@@ -87,8 +87,10 @@ def _load(flow_rate, pressure_drop):
                                     None, "give flow_rate= or pressure_drop=, not both or neither")
     controlled = "flow_rate" if flow_rate is not None else "pressure_drop"
     value = flow_rate if flow_rate is not None else pressure_drop
-    if type(value) is float and 0.0 <= value < math.inf:       # the commonest call: nothing to convert
-        return controlled, value
+    if isinstance(value, float) or type(value) is int:         # a Python or NumPy float, an int
+        number = float(value)
+        if 0.0 <= number < math.inf:
+            return controlled, number
     load = as_load(controlled, value)
     return controlled, (float(load) if load.ndim == 0 else load)
 

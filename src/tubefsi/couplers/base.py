@@ -53,7 +53,7 @@ from ..scene import State
 
 __all__ = ["Coupler"]
 
-_STATE_FIELDS = ("flow_rate", "pressure_drop", "inlet_strain", "log_stretch")
+_STATE_FIELDS = State._fields
 
 
 def _flow_index(rheology, flow_rate, radius):

@@ -53,7 +53,7 @@ class Quadrature(SeparatedVariables):
         return self.order is not None
 
     def _table_options(self):
-        return None if self._coarse else (self.rtol,)
+        return (self.rtol,) if self.order is None else None
 
     def max_flow_rate(self, scene):
         # a property of the problem, not of the rule: a coarse rule must not move it
@@ -61,7 +61,7 @@ class Quadrature(SeparatedVariables):
 
     def refined(self):
         """The adaptive rule, against which a fixed rule is checked (``check_error``)."""
-        return Quadrature() if self._coarse and self.check_error else None
+        return None if self.order is None or not self.check_error else Quadrature()
 
     def describe(self) -> str:
         if self._coarse:

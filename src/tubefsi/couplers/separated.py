@@ -303,10 +303,8 @@ class SeparatedVariables(Coupler):
         return k * np.log(points.radius) + np.log(points.wall._pressure_scale())
 
     def _table_point(self, scene: Scene, table, q: float):
-        """``(q, rise, strain, v)`` of one flow rate through a scene of scalars from its table, in
-        plain Python (floats), or None where the table leaves it to the direct path."""
-        if not q > 0.0:
-            return q, 0.0, scene.outlet_strain, 0.0
+        """``(q, rise, strain, v)`` of one positive flow rate through a scene of scalars from its
+        table, in plain Python (floats), or None where the table leaves it to the direct path."""
         rheology, tube = scene.rheology, scene.tube
         scale = scene.wall._pressure_scale()
         x = (rheology._log_flow_factor(q) + math.log(tube.length) - rheology.radius_exponent * math.log(tube.radius)
@@ -314,9 +312,8 @@ class SeparatedVariables(Coupler):
         found = table.scalar(x, self, scene)
         if found is None:
             return None
-        y, w = found
-        v = math.exp(y)
-        return q, scale * math.exp(w), math.expm1(v), v
+        v = math.exp(found[0])
+        return State(q, scale * math.exp(found[1]), math.expm1(v), v)
 
     def _from_table(self, table, scene, pts: Points, target):
         """``(v, rise, served)`` of the positive ``target`` s the table's panels serve (arrays)."""
@@ -337,12 +334,12 @@ class SeparatedVariables(Coupler):
     def flow_controlled_point(self, scene: Scene, flow_rate: float) -> State:
         """One flow rate through a scene of scalars: from its table in plain Python where it has one
         (the operations of :meth:`flow_controlled` on a one-point array), else as that array."""
-        if not scene.wall.is_rigid:
+        if flow_rate > 0.0 and not scene.wall.is_rigid:
             table = self._table(scene, 1)
             if table is not None:
                 answer = self._table_point(scene, table, flow_rate)
                 if answer is not None:
-                    return State(*answer)
+                    return answer
         return super().flow_controlled_point(scene, flow_rate)
 
     def solve_feasible(self, scene: Scene, load, controlled: str):
@@ -358,10 +355,10 @@ class SeparatedVariables(Coupler):
         if scene.wall.is_rigid:
             return _rigid_state(scene, flow_rate=q), None
         table = self._table(scene, q.size)
-        if table is not None and q.size == 1 and scene.size == 1:
+        if table is not None and q.size == 1 and scene.size == 1 and q.reshape(-1)[0] > 0.0:
             answer = self._table_point(scene, table, float(q.reshape(-1)[0]))
             if answer is not None:
-                return State(*answer), None
+                return answer, None
         pts = scene.at(np.arange(q.size))
         target = np.where(q == 0, 0.0, self.target(pts, q))
         v, rise = np.zeros(q.shape), np.zeros(q.shape)

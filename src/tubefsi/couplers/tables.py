@@ -34,12 +34,13 @@ import weakref
 
 import numpy as np
 
+from .. import registry
 from ..geometry import Tube
 from ..numerics.cache import TABLES, CacheInfo, plain
 from ..numerics.chebyshev import fit_piecewise
 from ..scene import Scene
 
-__all__ = ["SeparatedTable", "table_key", "unit_scene", "cache_clear", "cache_info", "TOL"]
+__all__ = ["SeparatedTable", "table_key", "declares_split", "unit_scene", "cache_clear", "cache_info", "TOL"]
 
 #: The tolerance of a panel, absolute in ln v and in ln P: a little above the direct answers' own
 #: scatter (~1e-14), so that the panel's check points can meet it.
@@ -57,15 +58,15 @@ def table_key(coupler, scene):
     the coupler's options and the wall's shape as plain values: a model that could change in place
     (a field holding a list or an array) declares no plain shape and gets no table.
     """
-    rheology, wall = scene.rheology, scene.wall
+    rheology, tube = scene.rheology, scene.tube
     k = rheology.radius_exponent
-    if type(k) is not float or not rheology.separable:
-        return None
-    tb = scene.tube.thickness / scene.tube.radius if type(scene.tube.radius) is float else scene.tb
-    if type(tb) is not float:
+    if type(k) is not float or not rheology.separable or type(tube.radius) is not float or type(tube.thickness) is not float:
         return None
     outlet = scene.outlet_pressure
     if type(outlet) is not float or outlet != 0.0:
+        return None
+    wall = scene.wall
+    if not declares_split(type(wall)):
         return None
     shape = wall._shape_key()
     if shape is None or not plain(shape):
@@ -73,7 +74,19 @@ def table_key(coupler, scene):
     options = coupler._table_options()
     if options is None:
         return None
-    return (weakref.ref(type(coupler)), options, weakref.ref(type(wall)), shape, tb, k)
+    return (weakref.ref(type(coupler)), options, weakref.ref(type(wall)), shape, tube.thickness / tube.radius, k)
+
+
+def declares_split(cls) -> bool:
+    """Whether the instances of the wall class ``cls`` share tables: it declares its shape/scale
+    split in its own body (``_shape_key``), or it is a registered wall, whose split the contract
+    suite checks (:class:`tubefsi.testing.WallContract`). A subclass that only inherits a split
+    may have changed the law or added a parameter: it shares nothing until it declares its own."""
+    return "_shape_key" in cls.__dict__ or cls in registry.walls.derived("classes", _classes)
+
+
+def _classes(walls) -> frozenset:
+    return frozenset(walls[name] for name in walls)
 
 
 def unit_scene(scene) -> Scene:
@@ -105,7 +118,10 @@ class SeparatedTable:
         """``(y, w)`` at one float ``x``, or None where its panel leaves it to the direct path."""
         if not -745.0 < x < 710.0:
             return None
-        found = self.panel(math.floor(x), coupler, scene)
+        j = math.floor(x)
+        found = self._panels.get(j, self)
+        if found is self:
+            found = self.panel(j, coupler, scene)
         return None if found is None else found.scalar(x)
 
     def evaluate(self, x, coupler, scene):

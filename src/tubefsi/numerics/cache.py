@@ -15,7 +15,7 @@ import threading
 
 import attrs
 
-__all__ = ["TableCache", "CacheInfo", "TABLES", "plain"]
+__all__ = ["TableCache", "CacheInfo", "TABLES", "plain", "instance_values"]
 
 _PLAIN = (float, int, str, bool, type(None))
 
@@ -29,6 +29,37 @@ def plain(value) -> bool:
                 return False
         return True
     return type(value) in _PLAIN
+
+
+def _slot_names(cls) -> tuple:
+    """The names of the slots the instances of ``cls`` have, across its classes (kept on the class,
+    as :func:`tubefsi.fields._array_fields` keeps its list)."""
+    found = cls.__dict__.get("_tubefsi_slot_names")
+    if found is None:
+        names = []
+        for klass in reversed(cls.__mro__):
+            slots = klass.__dict__.get("__slots__", ())
+            for name in ((slots,) if isinstance(slots, str) else slots):
+                if name not in ("__dict__", "__weakref__") and name not in names:
+                    names.append(name)
+        found = tuple(names)
+        try:
+            type.__setattr__(cls, "_tubefsi_slot_names", found)
+        except TypeError:                  # a class that takes no attributes: computed each time
+            pass
+    return found
+
+
+def instance_values(obj):
+    """Every value ``obj`` holds, as ``(name, value)`` pairs in a fixed order — its slots across its
+    classes (attrs fields included), then its ``__dict__`` sorted by name — or None where one is
+    not a plain value: what a key by value needs (a subclass's own attributes included, so two
+    instances that differ in any of them never share a table)."""
+    values = tuple((name, getattr(obj, name, None)) for name in _slot_names(type(obj)))
+    state = getattr(obj, "__dict__", None)
+    if state:
+        values += tuple(sorted(state.items()))
+    return values if plain(values) else None
 
 
 @attrs.frozen

@@ -94,6 +94,7 @@ class PiecewisePolynomial:
         self._crowded = _read_only(last > first + 1)
         self._any_crowded = bool(self._crowded.any())
         self._buckets = count
+        self._last_panel = panels - 1
         # the scalar path's plain lists
         self._first_list, self._next_list = self._first.tolist(), self._next_break.tolist()
         self._crowded_list, self._breaks_list = self._crowded.tolist(), self.breaks.tolist()
@@ -147,26 +148,29 @@ class PiecewisePolynomial:
             value += term
         return value
 
-    def scalar(self, x: float) -> tuple:
+    def scalar(self, x: float) -> list:
         """Every output at one float ``x`` within ``[lo, hi]``, in plain Python: the operations of
         :meth:`evaluate` in the same order."""
-        b = (x - self.lo) * self._bucket_scale
-        b = 0 if b < 0.0 else (self._buckets - 1 if b > self._buckets - 1 else int(b))
-        j = self._first_list[b] + (x >= self._next_list[b])
-        if self._crowded_list[b]:
+        b = int((x - self.lo) * self._bucket_scale)        # (truncation: -1 < b < 0 gives 0)
+        if not 0 <= b < self._buckets:
+            b = 0 if b < 0 else self._buckets - 1
+        j = self._first_list[b]
+        if x >= self._next_list[b]:
+            j += 1
+        if self._any_crowded and self._crowded_list[b]:
             j = bisect.bisect_right(self._breaks_list, x) - 1
-        j = 0 if j < 0 else (self.panels - 1 if j >= self.panels else j)
+        j = 0 if j < 0 else (self._last_panel if j > self._last_panel else j)
         t = x * self._scale_list[j] + self._offset_list[j]
         if self.degree == 8:                     # the tables' degree: the loop below, written out
-            return tuple(((((((((a8 * t + a7) * t + a6) * t + a5) * t + a4) * t + a3) * t + a2) * t + a1) * t + a0)
-                         for a8, a7, a6, a5, a4, a3, a2, a1, a0 in self._panel_coefficients[j])
+            return [((((((((a8 * t + a7) * t + a6) * t + a5) * t + a4) * t + a3) * t + a2) * t + a1) * t + a0)
+                    for a8, a7, a6, a5, a4, a3, a2, a1, a0 in self._panel_coefficients[j]]
         out = []
         for coefficients in self._panel_coefficients[j]:
             value = coefficients[0]
             for a in coefficients[1:]:
                 value = value * t + a
             out.append(value)
-        return tuple(out)
+        return out
 
     def derivative(self, output: int = 0) -> PiecewisePolynomial:
         """The derivative of ``output`` (on the same panels, one degree lower)."""

@@ -50,7 +50,7 @@ import weakref
 import numpy as np
 
 from ..errors import ConvergenceError, InvalidParameterError
-from ..numerics.cache import TABLES, plain
+from ..numerics.cache import TABLES, instance_values
 from ..numerics.chebyshev import fit_piecewise
 from ..numerics.quadrature import Integral, unit_integral, warn_unconverged
 
@@ -477,17 +477,10 @@ class FlowTable:
 
 
 def _key(rheology):
-    """The cache key of a fluid's table: its class (weakly) and its parameter values, or None
-    where they are not plain numbers (such a fluid gets a fresh table each call)."""
-    fields = getattr(type(rheology), "__attrs_attrs__", None)
-    if fields is not None:
-        values = tuple(getattr(rheology, f.name) for f in fields)
-    else:
-        state = getattr(rheology, "__dict__", None)
-        if state is None:
-            return None
-        values = tuple(sorted(state.items()))
-    if not plain(values):
+    """The cache key of a fluid's table: its class (weakly) and every value it holds, or None where
+    one is not a plain number (such a fluid gets a fresh table each call)."""
+    values = instance_values(rheology)
+    if values is None:
         return None
     return ("flow law", weakref.ref(type(rheology)), values)
 

@@ -23,6 +23,7 @@ from scipy.optimize import elementwise
 from ..couplers.quadrature import Quadrature
 from ..errors import AccuracyWarning, BucklingError, InvalidParameterError, NoSteadyStateError
 from ..geometry import Tube
+from ..numerics.cache import plain
 from ..solve import max_flow_rate, solve
 from .reference.quadrature import tanh_sinh
 from ..walls.hyperelastic import HyperelasticWall, ThickWall, ThinWall
@@ -161,6 +162,27 @@ class WallContract:
             with pytest.raises(InvalidParameterError, match="reduced_thickness"):
                 wall.pressure(1.1, tb)
 
+
+    def test_shape_scale_split(self, wall):
+        r"""A wall that declares its shape/scale split, so that one table serves every scale
+        (``docs/theory.md``): :math:`P = s\,\hat P` with :math:`\hat P` its unit wall's law, the
+        unit wall of scale 1 and of the wall's shape, the shape plain values, the maximum stretch
+        the unit wall's. Reference: the wall's own tube law."""
+        self._skip_rigid(wall)
+        shape = wall._shape_key()
+        if shape is None:
+            pytest.skip("no shape/scale split declared: no table is shared between instances")
+        assert plain(shape), f"the shape {shape!r} is not plain values (numbers, strings, tuples)"
+        unit = wall._unit_wall()
+        assert type(unit) is type(wall)
+        assert unit._shape_key() == shape
+        assert _rel(unit._pressure_scale(), 1.0) <= 1e-15
+        scale = wall._pressure_scale()
+        for tb in (0.05, 0.3, 1.0):
+            assert _rel(unit.max_stretch(tb), wall.max_stretch(tb)) <= 1e-13 or unit.max_stretch(tb) == math.inf
+            for e in (1e-6, 0.1, 1.0, 5.0):
+                lam = 1.0 + self._top_strain(wall, tb, e)
+                assert _rel(scale * unit.pressure(lam, tb), wall.pressure(lam, tb)) <= 1e-12, (tb, lam)
 
     @_settings
     @given(fraction=st.floats(1e-6, 1.0), tb=reduced_thicknesses())

@@ -11,10 +11,11 @@ maximum flow rate. Laws that keep increasing get the limit pressure of their asy
 
 from __future__ import annotations
 
-import functools
 import math
+import weakref
 
 import numpy as np
+from tubefsi.numerics.cache import TABLES, instance_values
 
 __all__ = ["LimitPoint"]
 
@@ -22,9 +23,16 @@ __all__ = ["LimitPoint"]
 _SCAN = np.geomspace(1e-4, 1e4, 1601)
 
 
-@functools.lru_cache(maxsize=1024)
 def first_peak(wall, tb: float) -> tuple[float, float]:
-    """``(stretch, pressure)`` at the first zero of ``dP/dlam``, or ``(inf, nan)`` if there is none."""
+    """``(stretch, pressure)`` at the first zero of ``dP/dlam``, or ``(inf, nan)`` if there is none:
+    kept in tubefsi's one cache, keyed by the wall's class (weakly) and values (never the wall)."""
+    values = instance_values(wall)
+    if values is None:
+        return _first_peak(wall, tb)
+    return TABLES.get(("first peak", weakref.ref(type(wall)), values, tb), lambda: _first_peak(wall, tb))
+
+
+def _first_peak(wall, tb: float) -> tuple[float, float]:
     lam = 1.0 + _SCAN
     with np.errstate(over="ignore", invalid="ignore"):
         slope = wall._stiffness(lam, tb)
