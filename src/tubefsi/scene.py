@@ -83,7 +83,7 @@ def _value_eq(a, b) -> bool:
     return a.shape == b.shape and bool(np.all(a == b))
 
 
-@attrs.frozen(kw_only=True)
+@attrs.define(kw_only=True)
 class Scene:
     r"""A rheology, a wall, a tube and an outlet pressure: everything but the load.
 
@@ -92,7 +92,9 @@ class Scene:
     ``gauge_outlet_pressure`` the fluid's outlet pressure :math:`p(L)` (by default
     ``outlet_pressure + external_pressure``; :func:`make_scene` passes the exact value).
 
-    Build it with :func:`make_scene` (which validates). Every model parameter, every tube field
+    Build it with :func:`make_scene` (which validates); treat it as read-only (couplers, solutions
+    and threads share it; it is not frozen only so that the commonest scene, one per scalar solve,
+    is cheap to build). Every model parameter, every tube field
     and the outlet pressure may be an array: the scene's :attr:`shape` is their broadcast shape,
     and the loads of a solve broadcast against it. The outlet state is derived once:
 
@@ -184,18 +186,17 @@ class Scene:
         broadcasting (what ``__attrs_post_init__`` derives, directly)."""
         scene = object.__new__(cls)
         lam_max = wall._max_stretch(tube.thickness / tube.radius)
-        put = object.__setattr__
-        put(scene, "rheology", rheology)
-        put(scene, "wall", wall)
-        put(scene, "tube", tube)
-        put(scene, "outlet_pressure", 0.0)
-        put(scene, "external_pressure", 0.0)
-        put(scene, "gauge_outlet_pressure", 0.0)
-        put(scene, "shape", ())
-        put(scene, "graded", False)
-        put(scene, "outlet_strain", 0.0)
-        put(scene, "outlet_stretch", 1.0)
-        put(scene, "log_stretch_max", math.log(lam_max) if lam_max < math.inf else math.inf)
+        scene.rheology = rheology
+        scene.wall = wall
+        scene.tube = tube
+        scene.outlet_pressure = 0.0
+        scene.external_pressure = 0.0
+        scene.gauge_outlet_pressure = 0.0
+        scene.shape = ()
+        scene.graded = False
+        scene.outlet_strain = 0.0
+        scene.outlet_stretch = 1.0
+        scene.log_stretch_max = math.log(lam_max) if lam_max < math.inf else math.inf
         return scene
 
     @property

@@ -191,46 +191,52 @@ def _solve(validity, rheology, wall, tube, flow_rate, pressure_drop, coupler, ou
 
 def _solve_scene(scene, chosen, name, controlled, load, on_infeasible, density, progress, *,
                  validity=True) -> Solution:
-    """The solve of a validated scene with its coupler: chunks, checks, the Solution."""
+    """The solve of a validated scene with its coupler: one point, or chunks of points; the
+    checks; the Solution."""
     if not scene.graded:
         _radius_power_in_range(scene)
     runner = checked(chosen)            # a self-checking coupler is re-solved finer (AccuracyWarning)
+    if scene.shape == () and type(load) is float and (density is None or density.ndim == 0):
+        return _solve_point(runner, scene, chosen, name, controlled, load, on_infeasible,
+                            None if density is None else float(density), validity)
     shape = _result_shape(scene, controlled, load, density)
-    if shape == () and scene.size == 1:             # one point: one coupler call
-        state, feasible = _solve_point(runner, scene, controlled, load, on_infeasible)
-    else:
-        state, feasible = _solve_points(runner, scene, controlled, load, shape, on_infeasible, progress)
-    flat = scene.flat(shape) if shape != () else scene
+    state, feasible = _solve_points(runner, scene, controlled, load, shape, on_infeasible, progress)
     _check_finite(state, feasible, controlled, load)
     if density is not None:
         density = float(density) if density.ndim == 0 else np.broadcast_to(density, shape).ravel()
     if validity:
-        if shape == ():
-            check_and_warn(scene.uniform_at(0.0) if scene.graded else scene, state.flow_rate, state.inlet_strain,
-                           density=density)
-        else:
-            check_and_warn(flat.uniform_at(0.0) if scene.graded else flat, np.ravel(state.flow_rate),
-                           np.ravel(state.inlet_strain), density=density)
+        flat = scene.flat(shape) if shape != () else scene
+        strain = state.inlet_strain if shape == () else np.ravel(state.inlet_strain)
+        check_and_warn(flat.uniform_at(0.0) if scene.graded else flat, np.ravel(state.flow_rate), strain,
+                       density=density)
     return Solution(scene=scene, coupler=chosen, state=state, scalar=shape == (), coupler_name=name,
                     feasible=None if feasible is None or np.all(feasible) else np.asarray(feasible).reshape(shape),
                     density=density, controlled=controlled)
 
 
-def _solve_point(runner, scene, controlled, load, on_infeasible):
-    """One load (a float) through a scene of scalars: ``(State of floats, feasible or None)``."""
-    if controlled == "flow_rate" and on_infeasible == "raise":
-        try:
-            return runner.flow_controlled_point(scene, load), None
-        except OverflowError:              # a scene beyond double precision: a typed error
-            raise _beyond_range(controlled, load, "an intermediate quantity overflows") from None
-    state, feasible = _run(runner, scene, controlled, np.array([load], dtype=float), on_infeasible)
-    state = State(*(float(np.ravel(getattr(state, f))[0]) for f in _STATE_FIELDS))
-    return state, (None if feasible is None else bool(np.ravel(feasible)[0]))
+def _solve_point(runner, scene, chosen, name, controlled, load, on_infeasible, density, validity) -> Solution:
+    """One load (a float) through a scene of scalars: one coupler call (its ``_point`` method for
+    a flow rate), the checks, the Solution of floats."""
+    feasible = None
+    try:
+        if controlled == "flow_rate" and on_infeasible == "raise":
+            state = runner.flow_controlled_point(scene, load)
+        else:
+            state, feasible = _run(runner, scene, controlled, np.array([load], dtype=float), on_infeasible)
+            state = State(*(float(np.ravel(value)[0]) for value in state))
+            feasible = None if feasible is None else bool(np.ravel(feasible)[0])
+    except OverflowError:                  # a scene beyond double precision: a typed error
+        raise _beyond_range(controlled, load, "an intermediate quantity overflows") from None
+    _check_finite(state, feasible, controlled, load)
+    if validity:
+        check_and_warn(scene.uniform_at(0.0) if scene.graded else scene, state.flow_rate, state.inlet_strain,
+                       density=density)
+    return Solution(scene=scene, coupler=chosen, state=state, scalar=True, coupler_name=name,
+                    feasible=None if feasible is None or feasible else np.asarray(feasible),
+                    density=density, controlled=controlled)
 
 
 def _result_shape(scene, controlled, load, density):
-    if scene.shape == () and type(load) is float and density is None:      # (one point)
-        return ()
     try:
         shape = np.broadcast_shapes(scene.shape, np.shape(load))
     except ValueError:

@@ -36,7 +36,7 @@ class ClosedForm(SeparatedVariables):
     cost_rank: ClassVar[int] = 0
 
     def supports(self, rheology, wall) -> bool:
-        return rheology.separable and rheology.radius_exponent is not None and wall.closed_form_integral
+        return wall.closed_form_integral and rheology.separable and rheology.radius_exponent is not None
 
     def _J(self, scene, v, index, q=None):
         pts = scene.at(np.asarray(index))

@@ -335,9 +335,9 @@ class SeparatedVariables(Coupler):
         """One flow rate through a scene of scalars: from its table in plain Python where it has one
         (the operations of :meth:`flow_controlled` on a one-point array), else as that array."""
         if flow_rate > 0.0 and not scene.wall.is_rigid:
-            table = self._table(scene, 1)
-            if table is not None:
-                answer = self._table_point(scene, table, flow_rate)
+            key = table_key(self, scene)
+            if key is not None:
+                answer = self._table_point(scene, TABLES.get(key, SeparatedTable), flow_rate)
                 if answer is not None:
                     return answer
         return super().flow_controlled_point(scene, flow_rate)
