@@ -102,7 +102,10 @@ class WallModel(abc.ABC):
     ``_unit_wall()`` the same law at unit modulus (whose ``_pressure_scale()`` is 1.0 and whose
     ``_shape_key()`` is the same). The couplers then share one table among every wall of the same
     class and shape (:mod:`tubefsi.couplers.tables`); ``tubefsi.testing`` checks the declaration.
-    A law that declares nothing gets no table: the same answers, from the direct path.
+    The declaration counts for the class whose body defines ``_shape_key`` (and for a registered
+    wall, which the contract suite checks): a subclass that only inherits it may have changed the
+    law or added a parameter, so its instances share nothing until it defines its own. A law that
+    declares nothing gets no table: the same answers, from the direct path.
 
     Class attributes: ``is_rigid`` (True only for :class:`~tubefsi.walls.Rigid`),
     ``closed_form_integral`` (True where ``_power_law_integral`` is implemented, which makes
