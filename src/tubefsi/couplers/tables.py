@@ -37,7 +37,7 @@ import numpy as np
 from .. import registry
 from ..geometry import Tube
 from ..numerics.cache import TABLES, CacheInfo, plain
-from ..numerics.chebyshev import fit_piecewise
+from ..numerics.chebyshev import PiecewisePolynomial, fit_piecewise
 from ..scene import Scene
 
 __all__ = ["SeparatedTable", "table_key", "declares_split", "unit_scene", "cache_clear", "cache_info", "TOL"]
@@ -102,6 +102,7 @@ class SeparatedTable:
     def __init__(self):
         self._panels = {}               # j -> PiecewisePolynomial of (y, w) on [j, j + 1], or None
         self._lock = threading.Lock()
+        self._view = None               # the panels last evaluated together, joined (evaluate)
 
     def panel(self, j: int, coupler, scene):
         """Panel ``j`` (built from ``coupler``'s direct answers on ``scene``'s unit scene if missing),
@@ -125,18 +126,33 @@ class SeparatedTable:
         return None if found is None else found.scalar(x)
 
     def evaluate(self, x, coupler, scene):
-        """``(y, w, served)`` at the finite ``x`` (an array): the points whose panels serve them."""
+        """``(y, w, served)`` at the finite ``x`` (an array): the points whose panels serve them.
+        Where every panel the points need is accepted, one lookup over their joined panels
+        (:meth:`~tubefsi.numerics.chebyshev.PiecewisePolynomial.join`: the same coefficients,
+        the same bits), else one pass per panel."""
         y, w = np.zeros(x.shape), np.zeros(x.shape)
-        served = np.zeros(x.shape, dtype=bool)
-        inside = np.flatnonzero((x > -745.0) & (x < 710.0))
-        j = np.floor(x[inside])
-        for panel in np.unique(j):              # (one pass per panel, not per point)
-            found = self.panel(int(panel), coupler, scene)
-            if found is None:
+        served = (x > -745.0) & (x < 710.0)
+        inside = np.flatnonzero(served)
+        if inside.size == 0:
+            return y, w, served
+        x_in = x[inside]
+        first, last = math.floor(x_in.min()), math.floor(x_in.max())
+        pieces = [self.panel(j, coupler, scene) for j in range(first, last + 1)]
+        if all(piece is not None for piece in pieces):
+            view = self._view                   # (first, last, joined): replaced whole, never changed
+            if view is None or view[:2] != (first, last):
+                view = self._view = (first, last, PiecewisePolynomial.join(pieces))
+            y[inside], w[inside] = view[2].evaluate(x_in)
+            return y, w, served
+        j = np.floor(x_in)
+        served[:] = False
+        for panel, piece in zip(range(first, last + 1), pieces):    # (one pass per panel, not per point)
+            if piece is None:
                 continue
             sel = inside[j == panel]
-            y[sel], w[sel] = found.evaluate(x[sel])
-            served[sel] = True
+            if sel.size:
+                y[sel], w[sel] = piece.evaluate(x[sel])
+                served[sel] = True
         return y, w, served
 
     @property

@@ -66,7 +66,7 @@ class PiecewisePolynomial:
     the equivalent monomial coefficients in :math:`t` (the fit checks that form's accuracy).
     """
 
-    def __init__(self, breaks, coef):
+    def __init__(self, breaks, coef, *, monomial=None):
         breaks = np.asarray(breaks, dtype=float)
         coef = np.asarray(coef, dtype=float)
         if coef.ndim == 2:
@@ -81,7 +81,8 @@ class PiecewisePolynomial:
         width = np.diff(breaks)
         self._scale = _read_only(2.0 / width)                             # t = x scale + offset
         self._offset = _read_only(-(breaks[:-1] + breaks[1:]) / width)
-        mono = coef @ _to_monomial(self.degree)                           # (outputs, panels, degree + 1)
+        # (outputs, panels, degree + 1); given by join(), which keeps its pieces' to the bit
+        mono = coef @ _to_monomial(self.degree) if monomial is None else np.asarray(monomial, dtype=float)
         self._mono = _read_only(np.moveaxis(mono, 2, 1))                  # (outputs, degree + 1, panels)
         # the lookup: buckets as narrow as the narrowest panel (so that a bucket holds at most two)
         count = int(min(_MAX_BUCKETS, max(1, math.ceil((self.hi - self.lo) / width.min() - 1e-9))))
@@ -101,6 +102,15 @@ class PiecewisePolynomial:
         self._scale_list, self._offset_list = self._scale.tolist(), self._offset.tolist()
         self._panel_coefficients = [[tuple(mono[o, j, ::-1].tolist()) for o in range(self.outputs)]
                                     for j in range(panels)]               # per panel: per output a_D..a_0
+
+    @classmethod
+    def join(cls, pieces) -> PiecewisePolynomial:
+        """One piecewise polynomial of ``pieces`` that follow each other (each one's ``hi`` the next
+        one's ``lo``), with their coefficients: the same values, to the bit, with one lookup."""
+        breaks = np.concatenate([pieces[0].breaks[:1]] + [piece.breaks[1:] for piece in pieces])
+        coef = np.concatenate([piece.chebyshev for piece in pieces], axis=1)
+        mono = np.concatenate([np.moveaxis(piece._mono, 1, 2) for piece in pieces], axis=1)
+        return cls(breaks, coef, monomial=mono)
 
     @property
     def panels(self) -> int:
