@@ -67,6 +67,28 @@ def test_table_reproduces_the_direct_path(wall):
                                tubefsi.solve(FLUID, plain, TUBE, pressure_drop=dp).flow_rate, rtol=1e-12)
 
 
+@pytest.mark.parametrize("wall", [w for w in WALLS if type(w).__name__ in ("ThickNeoHookean", "ThickMooneyRivlin")],
+                         ids=repr)
+def test_table_reproduces_the_direct_path_up_to_the_maximum_flow_rate(wall):
+    """Where the inlet stretch runs away (the table's panels in the runaway variable, up to
+    q_max (1 - 1e-9)), curve and single points against the direct path (the same law declaring
+    no split): the pressure drop to 1e-13, the inlet displacement to 1e-13 times the problem's
+    condition number, which grows as 1 / (1 - q/q_max)."""
+    q_max = tubefsi.max_flow_rate(FLUID, wall, TUBE)
+    gap = np.geomspace(1e-9, 0.5, 120)
+    q = q_max * (1.0 - gap)
+    plain = undeclared(wall)
+    fast = tubefsi.solve(FLUID, wall, TUBE, flow_rate=q)
+    slow = tubefsi.solve(FLUID, plain, TUBE, flow_rate=q)
+    np.testing.assert_allclose(fast.pressure_drop, slow.pressure_drop, rtol=1e-13, atol=0)
+    bound = 1e-13 / gap
+    assert np.all(np.abs(fast.inlet_displacement / slow.inlet_displacement - 1) <= bound)
+    for i in (0, 30, 60, 119):
+        one = tubefsi.solve(FLUID, wall, TUBE, flow_rate=float(q[i]))
+        assert abs(one.inlet_displacement / slow.inlet_displacement[i] - 1) <= bound[i]
+        assert one.pressure_drop == pytest.approx(float(slow.pressure_drop[i]), rel=1e-13)
+
+
 def test_one_table_serves_every_modulus_and_the_cache_is_bounded_and_clearable():
     """Walls of one shape share a table (a hit), another shape or t/a builds its own (a miss);
     clearing changes nothing but the time."""

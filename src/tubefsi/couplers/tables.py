@@ -97,63 +97,105 @@ def unit_scene(scene) -> Scene:
 
 
 class SeparatedTable:
-    """The panels of one key (module docstring); each immutable once built, built under a lock."""
+    """The panels of one key (module docstring); each immutable once built, built under a lock.
+
+    Below ``x_far = x_inf + ln(1 - 1/e)`` (``x_inf = ln J_hat(inf)``, the unit scene's largest
+    target: ``inf`` where the wall has no maximum flow rate) the panels are ``[j, j + 1]`` in
+    ``x`` (the last one ending at ``x_far``). Between ``x_far`` and ``x_inf``, where the inlet
+    stretch runs away, they are ``[1 + i, 2 + i]`` in the *runaway variable*
+    :math:`u = -\ln(1 - e^{x - x_{inf}})` (1 at ``x_far``), in which :math:`\ln v` is smooth up
+    to the maximum flow rate (:math:`J_\infty - J \propto e^{-\alpha v}` makes :math:`v` affine
+    in :math:`u`); beyond ``u = 41`` (a target within ``2e-18`` of the limit) and beyond ``x_inf``
+    the direct path answers.
+    """
 
     def __init__(self):
-        self._panels = {}               # j -> PiecewisePolynomial of (y, w) on [j, j + 1], or None
+        self._panels = {}               # ("x", j) or ("u", i) -> PiecewisePolynomial of (y, w), or None
         self._lock = threading.Lock()
-        self._view = None               # the panels last evaluated together, joined (evaluate)
+        self._view = None               # the x-panels last evaluated together, joined (evaluate)
+        self._limit = None              # (x_inf, x_far, u_far), from the unit scene's J(inf)
 
-    def panel(self, j: int, coupler, scene):
-        """Panel ``j`` (built from ``coupler``'s direct answers on ``scene``'s unit scene if missing),
-        or None where it could not be accepted."""
-        found = self._panels.get(j, self)
-        if found is self:
+    def limit(self, coupler, scene) -> tuple:
+        """``(x_inf, x_far, u_far)`` of this key (computed once, on the unit scene)."""
+        found = self._limit
+        if found is None:
             with self._lock:
-                found = self._panels.get(j, self)
+                found = self._limit
+                if found is None:
+                    found = self._limit = _limit(coupler, unit_scene(scene))
+        return found
+
+    def panel(self, kind: str, i: int, coupler, scene):
+        """Panel ``i`` in ``x`` (``kind="x"``) or in the runaway variable (``"u"``), built from
+        ``coupler``'s direct answers on ``scene``'s unit scene if missing; None where it could not
+        be accepted."""
+        found = self._panels.get((kind, i), self)
+        if found is self:
+            limit = self.limit(coupler, scene)
+            with self._lock:
+                found = self._panels.get((kind, i), self)
                 if found is self:
-                    found = self._panels[j] = _build(coupler, unit_scene(scene), j)
+                    found = self._panels[kind, i] = _build(coupler, unit_scene(scene), kind, i, limit)
         return found
 
     def scalar(self, x: float, coupler, scene):
         """``(y, w)`` at one float ``x``, or None where its panel leaves it to the direct path."""
-        if not -745.0 < x < 710.0:
+        x_inf, x_far, u_far = self.limit(coupler, scene)
+        if -745.0 < x < x_far and x < 710.0:
+            found = self._panels.get(("x", math.floor(x)), self)
+            if found is self:
+                found = self.panel("x", math.floor(x), coupler, scene)
+            return None if found is None else found.scalar(x)
+        if not x_far <= x < x_inf:
             return None
-        j = math.floor(x)
-        found = self._panels.get(j, self)
-        if found is self:
-            found = self.panel(j, coupler, scene)
-        return None if found is None else found.scalar(x)
+        u = -math.log(-math.expm1(x - x_inf)) - u_far
+        if not u < _RUNAWAY_PANELS:
+            return None
+        found = self.panel("u", math.floor(u), coupler, scene)
+        return None if found is None else found.scalar(u)
 
     def evaluate(self, x, coupler, scene):
         """``(y, w, served)`` at the finite ``x`` (an array): the points whose panels serve them.
-        Where every panel the points need is accepted, one lookup over their joined panels
+        Where every ``x``-panel the points need is accepted, one lookup over their joined panels
         (:meth:`~tubefsi.numerics.chebyshev.PiecewisePolynomial.join`: the same coefficients,
-        the same bits), else one pass per panel."""
+        the same bits), else one pass per panel; the runaway panels one pass per panel."""
+        x_inf, x_far, u_far = self.limit(coupler, scene)
         y, w = np.zeros(x.shape), np.zeros(x.shape)
-        served = (x > -745.0) & (x < 710.0)
-        inside = np.flatnonzero(served)
-        if inside.size == 0:
-            return y, w, served
+        served = np.zeros(x.shape, dtype=bool)
+        near = (x >= x_far) & (x < x_inf)
+        inside = np.flatnonzero((x > -745.0) & (x < min(x_far, 710.0)))
+        if inside.size:
+            self._evaluate_x(x, inside, coupler, scene, y, w, served)
+        near = np.flatnonzero(near)
+        if near.size:
+            with np.errstate(divide="ignore"):
+                u = -np.log(-np.expm1(x[near] - x_inf)) - u_far
+            self._evaluate_panels("u", u, near, coupler, scene, y, w, served, u < _RUNAWAY_PANELS)
+        return y, w, served
+
+    def _evaluate_x(self, x, inside, coupler, scene, y, w, served):
         x_in = x[inside]
         first, last = math.floor(x_in.min()), math.floor(x_in.max())
-        pieces = [self.panel(j, coupler, scene) for j in range(first, last + 1)]
+        pieces = [self.panel("x", j, coupler, scene) for j in range(first, last + 1)]
         if all(piece is not None for piece in pieces):
             view = self._view                   # (first, last, joined): replaced whole, never changed
             if view is None or view[:2] != (first, last):
                 view = self._view = (first, last, PiecewisePolynomial.join(pieces))
             y[inside], w[inside] = view[2].evaluate(x_in)
-            return y, w, served
-        j = np.floor(x_in)
-        served[:] = False
-        for panel, piece in zip(range(first, last + 1), pieces):    # (one pass per panel, not per point)
+            served[inside] = True
+            return
+        self._evaluate_panels("x", x_in, inside, coupler, scene, y, w, served, np.ones(inside.size, dtype=bool))
+
+    def _evaluate_panels(self, kind, t, where, coupler, scene, y, w, served, usable):
+        """Fill the points ``where`` (at the panel variable ``t``) one panel at a time."""
+        j = np.floor(np.where(usable, t, -1.0))
+        for i in np.unique(j[usable]):           # (one pass per panel, not per point)
+            piece = self.panel(kind, int(i), coupler, scene)
             if piece is None:
                 continue
-            sel = inside[j == panel]
-            if sel.size:
-                y[sel], w[sel] = piece.evaluate(x[sel])
-                served[sel] = True
-        return y, w, served
+            sel = np.flatnonzero(usable & (j == i))
+            y[where[sel]], w[where[sel]] = piece.evaluate(t[sel])
+            served[where[sel]] = True
 
     @property
     def panel_count(self) -> int:
@@ -161,22 +203,46 @@ class SeparatedTable:
         return len(self._panels)
 
 
-def _build(coupler, unit, j):
-    """The interpolant of ``(ln v, ln P_hat)`` on ``[j, j + 1]`` from ``coupler``'s direct answers on
-    the unit scene, or None where it cannot be accepted."""
-    tb = unit.tb
+#: Runaway panels, in units of u from u = 1: beyond them a target is within e^-41 of J(inf)
+#: (the direct path answers).
+_RUNAWAY_PANELS = 40
+_U_FAR = 1.0
 
-    def answers(x):
-        target = np.exp(x)
-        v, ok, final = coupler._solve_J(unit, target, np.zeros(x.size, dtype=int))
+
+def _limit(coupler, unit) -> tuple:
+    """``(x_inf, x_far, u_far)``: ``ln J_hat(inf)`` of the unit scene (``inf`` where it is not
+    finite or not converged: then every panel is in ``x``) and where the runaway panels start, in
+    ``x`` and in ``u`` (at ``u = 1``: closer to ``x_inf`` the ``x``-panels would need ever more
+    subpanels, and closer to ``x_far`` the ``u``-panels, as ``u ~ ln(x_inf - x)`` there)."""
+    with np.errstate(all="ignore"):
+        found = coupler._J_infinity(unit, np.zeros(1, dtype=int))
+    value = float(np.ravel(found.value)[0])
+    if not (0.0 < value < math.inf and bool(np.all(found.converged))):
+        return math.inf, math.inf, math.inf
+    x_inf = math.log(value)
+    return x_inf, x_inf + math.log(-math.expm1(-_U_FAR)), _U_FAR
+
+
+def _build(coupler, unit, kind, i, limit):
+    """The interpolant of ``(ln v, ln P_hat)`` on panel ``i`` in ``x`` (``[i, i + 1]``, the last one
+    ending at ``x_far``) or in the runaway variable ``u`` (``[u_far + i, u_far + i + 1]``, shifted
+    to ``[i, i + 1]``) from ``coupler``'s direct answers on the unit scene, or None where it
+    cannot be accepted."""
+    tb = unit.tb
+    x_inf, x_far, u_far = limit
+    j_inf = math.exp(x_inf) if x_inf < math.inf else math.inf
+
+    def answers(t):
+        target = np.exp(t) if kind == "x" else -j_inf * np.expm1(-(t + u_far))
+        v, ok, final = coupler._solve_J(unit, target, np.zeros(t.size, dtype=int))
         estimate = unit.wall._pressure_estimate(np.expm1(v), tb)
         good = ok & np.asarray(final.converged) & np.asarray(estimate.converged) & (v > 0)
         with np.errstate(all="ignore"):
             return np.where(good, np.stack([np.log(v), np.log(np.asarray(estimate.value, dtype=float))]), np.nan)
 
+    hi = min(float(i + 1), x_far) if kind == "x" else float(i + 1)
     with np.errstate(all="ignore"):
-        fitted, _ = fit_piecewise(answers, float(j), float(j + 1), degree=8, tol=TOL, panels=2,
-                                  max_panels=_MAX_SUBPANELS)
+        fitted, _ = fit_piecewise(answers, float(i), hi, degree=8, tol=TOL, panels=2, max_panels=_MAX_SUBPANELS)
     return fitted
 
 
