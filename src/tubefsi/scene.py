@@ -284,6 +284,11 @@ class Scene:
             parts.append((index, _refresh(part)))
         return parts
 
+    def is_one_part(self) -> bool:
+        """Whether :meth:`split` keeps every point in one part (no model needs one parameter set
+        per part)."""
+        return self.size == 1 or not self._grouped()
+
     def _grouped(self):
         """The models whose array parameters must be split into parameter sets: a non-separable
         rheology (its flow table is per fluid) or a model whose hooks do not broadcast."""

@@ -281,6 +281,12 @@ def _solve_points(runner, scene, controlled, load, shape, on_infeasible, progres
     flat = scene.flat(shape)
     values = np.broadcast_to(np.asarray(load, dtype=float), shape).ravel()
     n = values.size
+    if n <= CHUNK and flat.is_one_part():                # one coupler call on every point
+        state, feasible = _run(runner, flat, controlled, values.copy(), on_infeasible)
+        shown = bar(n, progress, "tubefsi.solve")
+        shown.update(n)
+        shown.close()
+        return State(*(_own_array(value, n, shape) for value in state)), feasible
     out = {f: np.full(n, np.nan) for f in _STATE_FIELDS}
     feasible = np.ones(n, dtype=bool)
     shown = bar(n, progress, "tubefsi.solve")
@@ -297,6 +303,14 @@ def _solve_points(runner, scene, controlled, load, shape, on_infeasible, progres
     shown.close()
     state = State(*(out[f].reshape(shape) for f in _STATE_FIELDS))
     return state, (None if np.all(feasible) else feasible)
+
+
+def _own_array(value, n, shape):
+    """A coupler's result of ``n`` points as a writable array of ``shape`` (its own, not a view)."""
+    value = np.asarray(value, dtype=float)
+    if value.size == n and value.flags.writeable and value.base is None:
+        return value.reshape(shape)
+    return np.array(np.broadcast_to(value, (n,))).reshape(shape)
 
 
 def _check_finite(state, feasible, controlled, load):

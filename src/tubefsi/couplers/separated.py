@@ -366,7 +366,10 @@ class SeparatedVariables(Coupler):
         if table is not None:
             v_t, rise_t, served = self._from_table(table, scene, pts, np.where(todo, target, 1.0))
             served &= todo
-            v[served], rise[served] = v_t[served], rise_t[served]
+            if served.all():                   # (every point: no gathers)
+                v, rise = v_t, rise_t
+            else:
+                v[served], rise[served] = v_t[served], rise_t[served]
             todo &= ~served
         solved = self._flow_direct(scene, q, target, todo, v)
         feasible = None

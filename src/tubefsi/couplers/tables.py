@@ -181,7 +181,10 @@ class SeparatedTable:
             view = self._view                   # (first, last, joined): replaced whole, never changed
             if view is None or view[:2] != (first, last):
                 view = self._view = (first, last, PiecewisePolynomial.join(pieces))
-            y[inside], w[inside] = view[2].evaluate(x_in)
+            if inside.size == x.size:             # (every point: no scatter)
+                y[:], w[:] = view[2].evaluate(x_in)
+            else:
+                y[inside], w[inside] = view[2].evaluate(x_in)
             served[inside] = True
             return
         self._evaluate_panels("x", x_in, inside, coupler, scene, y, w, served, np.ones(inside.size, dtype=bool))
