@@ -315,11 +315,10 @@ class SeparatedVariables(Coupler):
         v = math.exp(found[0])
         return State(q, scale * math.exp(found[1]), math.expm1(v), v)
 
-    def _from_table(self, table, scene, pts: Points, target):
-        """``(v, rise, served)`` of the positive ``target`` s the table's panels serve (arrays)."""
-        with np.errstate(divide="ignore"):
-            x = np.log(target) - self._log_norm(pts)
-        y, w, served = table.evaluate(x, self, scene)
+    def _from_table(self, table, scene, pts: Points, log_target):
+        """``(v, rise, served)`` of the targets :math:`e^{\text{log\_target}}` the table's panels
+        serve (arrays); the table's variable is ``log_target - ln(a^k mu)``."""
+        y, w, served = table.evaluate(log_target - self._log_norm(pts), self, scene)
         v = np.where(served, np.exp(y), 0.0)
         scale = pts.wall._pressure_scale()
         rise = np.where(served, np.exp(w) * scale, np.nan)
@@ -360,17 +359,19 @@ class SeparatedVariables(Coupler):
             if answer is not None:
                 return answer, None
         pts = scene.at(np.arange(q.size))
-        target = np.where(q == 0, 0.0, self.target(pts, q))
         v, rise = np.zeros(q.shape), np.zeros(q.shape)
-        todo = target > 0                      # (the points no route has answered yet)
+        todo = q > 0                           # (the points no route has answered yet)
         if table is not None:
-            v_t, rise_t, served = self._from_table(table, scene, pts, np.where(todo, target, 1.0))
+            # ln(L phi(q)) formed as _table_point forms it, in logarithms (no power of q)
+            log_target = pts.rheology._log_flow_factor(np.where(todo, q, 1.0)) + np.log(pts.length)
+            v_t, rise_t, served = self._from_table(table, scene, pts, log_target)
             served &= todo
             if served.all():                   # (every point: no gathers)
                 v, rise = v_t, rise_t
             else:
                 v[served], rise[served] = v_t[served], rise_t[served]
             todo &= ~served
+        target = np.where(todo, self.target(pts, np.where(todo, q, 1.0)), 0.0) if np.any(todo) else todo * 0.0
         solved = self._flow_direct(scene, q, target, todo, v)
         feasible = None
         if not np.all(solved.ok):
@@ -382,7 +383,7 @@ class SeparatedVariables(Coupler):
         if solved.points.size:
             rise[solved.points] = self.pressure_rise(scene, v[solved.points], solved.points)
             self._warn_near_a_lock(scene, v[solved.points], solved.points, rise[solved.points])
-        rise[target == 0] = 0.0
+        rise[q == 0] = 0.0
         strain = self.strain_at(pts, v) + 0.0 * v
         if feasible is not None:
             for values in (rise, strain, v):
@@ -485,7 +486,9 @@ class SeparatedVariables(Coupler):
         direct = (target > 0) & (frac < 1.0)
         table = self._table(scene, q.size)
         if table is not None:
-            v_t, rise_t, served = self._from_table(table, scene, pts, np.where(direct, target, 1.0))
+            with np.errstate(divide="ignore"):
+                log_target = np.log(np.where(direct, target, 1.0))
+            v_t, rise_t, served = self._from_table(table, scene, pts, log_target)
             served &= direct
             v[served] = np.minimum(v_t[served], v_in[served] if np.ndim(v_in) else v_in)
             rise[served] = rise_t[served]
