@@ -316,8 +316,8 @@ class SeparatedVariables(Coupler):
         return State(q, scale * math.exp(found[1]), math.expm1(v), v)
 
     def _from_table(self, table, scene, pts: Points, log_target):
-        """``(v, rise, served)`` of the targets :math:`e^{\text{log\_target}}` the table's panels
-        serve (arrays); the table's variable is ``log_target - ln(a^k mu)``."""
+        """``(v, rise, served)`` of the targets ``exp(log_target)`` the table's panels serve (arrays);
+        the table's variable is ``log_target - ln(a^k mu)``."""
         y, w, served = table.evaluate(log_target - self._log_norm(pts), self, scene)
         v = np.where(served, np.exp(y), 0.0)
         scale = pts.wall._pressure_scale()

@@ -97,7 +97,7 @@ def unit_scene(scene) -> Scene:
 
 
 class SeparatedTable:
-    """The panels of one key (module docstring); each immutable once built, built under a lock.
+    r"""The panels of one key (module docstring); each immutable once built, built under a lock.
 
     Below ``x_far = x_inf + ln(1 - 1/e)`` (``x_inf = ln J_hat(inf)``, the unit scene's largest
     target: ``inf`` where the wall has no maximum flow rate) the panels are ``[j, j + 1]`` in
