@@ -169,6 +169,14 @@ def _overridden(obj, name) -> bool:
     return len(owners) > 1 and owners[0] is not owners[-1]
 
 
+def _lower_slope(fit, output: int) -> float:
+    """The derivative of ``output`` of a fit at its lower end, from its first panel's Chebyshev
+    coefficients (T_k'(-1) = (-1)^(k+1) k^2): no derivative interpolant built for one number."""
+    c = fit.chebyshev[output, 0]
+    k = np.arange(c.size)
+    return float(np.dot(c, (-1.0) ** (k + 1) * k * k)) * 2.0 / float(fit.breaks[1] - fit.breaks[0])
+
+
 class _Panel:
     """One built panel ``j <= p <= j + 1``: its image ``[y_lo, y_hi]``, the inverse ``s(y)`` (None: a
     direct panel, solved exactly at each lookup) and the slopes ``dy/dp``, ``ds/dp`` at its lower end;
@@ -243,35 +251,40 @@ class FlowTable:
     def _build(self, j: int) -> _Panel:
         """Panel ``j`` from exact evaluations alone (module docstring)."""
         lo, hi = float(j), float(j + 1)
-        s_ends, y_ends, _ = self._exact(np.array([lo, hi]))
-        if not np.all(np.isfinite(y_ends)) or (self.mode == "rate" and self.yield_stress > 0 and lo < self._s_floor):
-            return _Panel(j, float(y_ends[0]), float(y_ends[1]), None, finite=False)
-        if not y_ends[1] > y_ends[0]:
+        if self.mode == "rate" and self.yield_stress > 0 and lo < self._s_floor:
+            return _Panel(j, math.nan, math.nan, None, finite=False)     # below the floor: nothing to evaluate
+        samples = []                           # (p, s, y, err) of every exact evaluation, the ends first
+
+        def forward(p):
+            # the panel's two ends ride along with the first batch of nodes: one quadrature call fewer,
+            # and the same values as alone (each point's quadrature is independent of its batch)
+            x = np.concatenate([[lo, hi], p]) if not samples else p
+            s, y, err = self._exact(x)
+            samples.append((x, s, y, err))
+            if len(samples) > 1:
+                return np.stack([y, s])
+            if not (np.all(np.isfinite(y[:2])) and y[1] > y[0]):
+                return np.full((2, np.size(p)), np.nan)    # no panel to fit (told apart below): the fit stops
+            return np.stack([y[2:], s[2:]])
+
+        fit, _ = fit_piecewise(forward, lo, hi, degree=16, tol=5e-15, panels=1, max_panels=64, relative=True)
+        (s_lo, s_hi), (y_lo, y_hi) = samples[0][1][:2].tolist(), samples[0][2][:2].tolist()
+        if not (math.isfinite(y_lo) and math.isfinite(y_hi)):
+            return _Panel(j, y_lo, y_hi, None, finite=False)
+        if not y_hi > y_lo:
             raise InvalidParameterError("rheology", "a shear stress increasing with the shear rate", self.rheology,
                                         f"its tube-flow function does not increase near ln(tau_w - tau_y) = "
-                                        f"{float(s_ends[0]):.6g}")
-        errors = []
+                                        f"{s_lo:.6g}")
         # TOL is a relative error of G: a relative error e of Gamma (a node's estimate) is one of
         # e (ds/dy) (tau_w - tau_y) / tau_w in G, ds/dy taken as the ends' secant (near yield the
         # quadrature's rounding floor, large in Gamma, is small in G)
-        gain = float(s_ends[1] - s_ends[0]) / float(y_ends[1] - y_ends[0])
-
-        samples = []
-
-        def forward(p):
-            s, y, err = self._exact(p)
-            samples.append((np.ravel(p), s.ravel(), y.ravel(), err.ravel()))
-            with np.errstate(all="ignore"):
-                share = 1.0 / (1.0 + self.yield_stress * np.exp(-s)) if self.yield_stress > 0 else 1.0
-                errors.append(gain * float(np.max(np.where(np.isfinite(s), err * share, err), initial=0.0)))
-            return np.stack([y, s])
-
-        fit, _ = fit_piecewise(forward, lo, hi, degree=16, tol=5e-15, panels=1, max_panels=64, relative=True)
-        y_lo, y_hi = float(y_ends[0]), float(y_ends[1])
-        node_error = max(errors) if errors else 0.0
+        _, s, _, err = (np.concatenate(column) for column in zip(*samples))
+        with np.errstate(all="ignore"):
+            share = 1.0 / (1.0 + self.yield_stress * np.exp(-s)) if self.yield_stress > 0 else 1.0
+            node_error = (s_hi - s_lo) / (y_hi - y_lo) * float(np.max(np.where(np.isfinite(s), err * share, err)))
         # a direct panel's slopes (for the asymptote below the lowest panel, and the steps toward
         # a load) are its ends' secant: its fit, if any, cannot be trusted
-        secant = {"slope_y": y_hi - y_lo, "slope_s": float(s_ends[1] - s_ends[0])}
+        secant = {"slope_y": y_hi - y_lo, "slope_s": s_hi - s_lo}
         if fit is None:                        # a kink (or noise): solved exactly at each lookup
             self._increasing(samples)
             return _Panel(j, y_lo, y_hi, None, error=node_error, **secant)
@@ -293,11 +306,8 @@ class FlowTable:
 
         inverse, _ = fit_piecewise(inverse_values, y_lo, y_hi, degree=8, tol=TOL, panels=4, max_panels=512,
                                    relative=True)
-        slope_y = float(slope(np.array([lo]))[0])
-        slope_s = 1.0 if self.mode == "rate" else float(fit.derivative(1)(np.array([lo]))[0])
-        if inverse is None:
-            return _Panel(j, y_lo, y_hi, None, error=node_error, slope_y=slope_y, slope_s=slope_s)
-        return _Panel(j, y_lo, y_hi, inverse, error=node_error, slope_y=slope_y, slope_s=slope_s)
+        slopes = {"slope_y": _lower_slope(fit, 0), "slope_s": 1.0 if self.mode == "rate" else _lower_slope(fit, 1)}
+        return _Panel(j, y_lo, y_hi, inverse, error=node_error, **slopes)
 
     def _increasing(self, samples) -> None:
         """Raise :class:`InvalidParameterError` where the exact values ``(p, s, y, err)`` of a direct
