@@ -80,7 +80,6 @@ KRONROD_WEIGHTS = 0.5 * np.concatenate([_WK[:-1], _WK[::-1]])
 GAUSS_WEIGHTS = 0.5 * np.concatenate([_WG, _WG[::-1]])
 
 _EPS = float(np.finfo(float).eps)
-_TINY = float(np.finfo(float).tiny)
 
 
 def _lagrange_at(nodes, point):
@@ -145,7 +144,7 @@ class Integral:
                         converged=self.converged & other.converged, panels=self.panels + other.panels)
 
 
-def _panel_rule(f, lo, hi, idx, noise, robust):
+def _panel_rule(f, lo, hi, idx, noise, robust, noise_absolute=False):
     """Kronrod values, error estimates and rounding floors of the panels ``[lo, hi]``."""
     h = hi - lo
     if robust:
@@ -169,7 +168,8 @@ def _panel_rule(f, lo, hi, idx, noise, robust):
             scaled = np.maximum(scaled, raw) + _END_GAP * (np.abs(rules[:, 2]) + np.abs(rules[:, 3]))
         floor = 2.0 * _EPS * magnitude                        # the rule's own rounding
         if noise is not None:                                 # and the integrand's, where known
-            floor = np.maximum(floor, rows_dot(ay * noise(x[:, inner], idx), KRONROD_WEIGHTS))
+            rounded = noise(x[:, inner], idx)
+            floor = np.maximum(floor, rows_dot(rounded if noise_absolute else ay * rounded, KRONROD_WEIGHTS))
         error = np.maximum(scaled, floor)
     return kron * h, error * np.abs(h), floor * np.abs(h)
 
@@ -186,7 +186,7 @@ def _initial_panels(lo_pt, hi_pt, count):
 
 
 def adaptive(f, lower, upper, *, rtol=1e-14, atol=0.0, panels=None, max_rounds=60, max_panels=2048,
-             noise=None, robust=False) -> Integral:
+             noise=None, noise_absolute=False, robust=False) -> Integral:
     r""":math:`\int_{lower}^{upper} f(x)\,dx` for each entry of ``lower``/``upper``, error-controlled.
 
     Parameters
@@ -207,6 +207,9 @@ def adaptive(f, lower, upper, *, rtol=1e-14, atol=0.0, panels=None, max_rounds=6
         ``noise(x, index)``: the relative rounding error of ``f`` at the nodes, where the caller
         knows it (a difference of nearly equal terms, a pole approached closer than the abscissae
         resolve). A point whose estimate is within twice its rounding floor is done.
+    noise_absolute : bool
+        ``noise`` gives the absolute rounding error of ``f``'s values instead (a difference of
+        nearly equal terms rounded to a fixed amount: no need to evaluate ``f`` again to scale it).
     robust : bool
         Estimates safe for integrands with kinks (module docstring).
 
@@ -226,7 +229,7 @@ def adaptive(f, lower, upper, *, rtol=1e-14, atol=0.0, panels=None, max_rounds=6
     count = np.ones(n, dtype=int) if panels is None else np.maximum(
         1, np.broadcast_to(np.asarray(panels, dtype=int), shape).ravel())
     idx, lo, hi = _initial_panels(lo_pt, hi_pt, count)
-    value, error, rounding = _panel_rule(f, lo, hi, idx, noise, robust)
+    value, error, rounding = _panel_rule(f, lo, hi, idx, noise, robust, noise_absolute)
     total = np.bincount(idx, value, minlength=n)
     err = np.bincount(idx, error, minlength=n)
     floor = np.bincount(idx, rounding, minlength=n)
@@ -263,7 +266,7 @@ def adaptive(f, lower, upper, *, rtol=1e-14, atol=0.0, panels=None, max_rounds=6
         s_idx = np.concatenate([idx[split], idx[split]])
         s_lo = np.concatenate([lo[split], mid])
         s_hi = np.concatenate([mid, hi[split]])
-        s_val, s_err, s_rnd = _panel_rule(f, s_lo, s_hi, s_idx, noise, robust)
+        s_val, s_err, s_rnd = _panel_rule(f, s_lo, s_hi, s_idx, noise, robust, noise_absolute)
         if robust:                             # a half keeps a third of its parent's true error
             parent = value[split]
             change = np.abs(parent - (s_val[:parent.size] + s_val[parent.size:])) / 3.0
@@ -360,12 +363,12 @@ def unit_integral(f, n: int, *, rtol: float = 1e-15, rounding=None, relative_rou
         def noise(z, idx):
             return relative_rounding(np.exp(-z), idx)
     elif rounding is not None:
-        def noise(z, idx):
-            with np.errstate(divide="ignore"):
-                return rounding(idx)[:, None] / np.maximum(np.abs(np.asarray(f(np.exp(-z), idx), dtype=float)), _TINY)
+        def noise(z, idx):              # g = f t: f's absolute rounding, times t
+            return rounding(idx)[:, None] * np.exp(-z)
 
     return adaptive(g, np.zeros(n), np.full(n, _Z_END), rtol=rtol, panels=np.full(n, _Z_PANELS),
-                    max_rounds=max_rounds, max_panels=max_panels, noise=noise, robust=True)
+                    max_rounds=max_rounds, max_panels=max_panels, noise=noise,
+                    noise_absolute=relative_rounding is None, robust=True)
 
 
 def warn_unconverged(what: str, result: Integral, where=None) -> None:
