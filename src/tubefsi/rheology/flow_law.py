@@ -27,9 +27,13 @@ stress-natural one, where :math:`\tau_w = \tau(e^p)` needs no root): panel :math
 :math:`y(p)` interpolated to 5e-15 (:func:`~tubefsi.numerics.chebyshev.fit_piecewise`), its inverse
 :math:`s(y)` interpolated to 1e-14 over the panel's image from Newton's method on it, both checked
 at points between their nodes — so what a panel holds depends on the fluid and :math:`j` alone.
-Panels are built where loads need them and kept (the table only grows, under a lock); which ones
-exist changes the time, never an answer. A law whose flow function cannot be interpolated on a
-panel (a kink) keeps that panel *direct*: its lookups solve :math:`y(p) = y` exactly there.
+Both tolerances are in :math:`G`: near yield, where :math:`G` carries :math:`\tau_y` and an error
+of :math:`s` or :math:`y` moves it only :math:`(\tau_w - \tau_y)/\tau_w` as much, they are divided
+by that share (the law's rounding there, ~eps :math:`\tau_y/(\tau_w - \tau_y)` in :math:`\Gamma`
+where it gets :math:`\tau`, would otherwise defeat every fit). Panels are built where loads need
+them and kept (the table only grows, under a lock); which ones exist changes the time, never an
+answer. A law whose flow function cannot be interpolated on a panel (a kink) keeps that panel
+*direct*: its lookups solve :math:`y(p) = y` exactly there.
 
 Below the lowest panel the law resolves (a yield-stress fluid near yield, where the law can no longer
 tell :math:`\tau_w - \tau_y`), :math:`s` follows the power-law asymptote of that panel's end: there
@@ -247,12 +251,27 @@ class FlowTable:
             tau = np.asarray(self.rheology._stress(np.exp(p)), dtype=float)
             return np.log(tau - self.yield_stress) if self.yield_stress > 0 else np.log(tau)
 
+    def _share(self, s):
+        """(tau_w - tau_y) / tau_w at s = ln(tau_w - tau_y): an error d of s is one of d times this
+        in G (1 without a yield stress)."""
+        with np.errstate(all="ignore"):
+            return 1.0 / (1.0 + self.yield_stress * np.exp(-s)) if self.yield_stress > 0 else np.ones(np.shape(s))
+
     # ------------------------------------------------------------ panels
     def _build(self, j: int) -> _Panel:
         """Panel ``j`` from exact evaluations alone (module docstring)."""
         lo, hi = float(j), float(j + 1)
         if self.mode == "rate" and self.yield_stress > 0 and lo < self._s_floor:
             return _Panel(j, math.nan, math.nan, None, finite=False)     # below the floor: nothing to evaluate
+        # TOL is a relative error of G. Near yield G carries tau_y: an error d of s = ln(tau_w - tau_y)
+        # is one of d (tau_w - tau_y) / tau_w in G (_share), and an error of y = ln Gamma one of that
+        # times ds/dy (below 1 near yield). So the fits' tolerances in y and s are divided by that share
+        # at the panel's top, where it is largest: the law's rounding near yield, large in y and s
+        # (~eps tau_y / (tau_w - tau_y) where the law gets tau, not the excess), is small in G. At most
+        # 1/sqrt(eps)-fold: a law that gets only tau is tabulated no closer to yield than that.
+        s_top = hi if self.mode == "rate" else float(self._exact_s(np.array([hi]))[0])
+        share = float(self._share(s_top))
+        relax = 1.0 / max(share if math.isfinite(share) else 1.0, math.sqrt(_EPS))
         samples = []                           # (p, s, y, err) of every exact evaluation, the ends first
 
         def forward(p):
@@ -267,7 +286,8 @@ class FlowTable:
                 return np.full((2, np.size(p)), np.nan)    # no panel to fit (told apart below): the fit stops
             return np.stack([y[2:], s[2:]])
 
-        fit, _ = fit_piecewise(forward, lo, hi, degree=16, tol=5e-15, panels=1, max_panels=64, relative=True)
+        fit, _ = fit_piecewise(forward, lo, hi, degree=16, tol=5e-15 * relax, panels=1, max_panels=64,
+                               relative=True)
         (s_lo, s_hi), (y_lo, y_hi) = samples[0][1][:2].tolist(), samples[0][2][:2].tolist()
         if not (math.isfinite(y_lo) and math.isfinite(y_hi)):
             return _Panel(j, y_lo, y_hi, None, finite=False)
@@ -275,13 +295,13 @@ class FlowTable:
             raise InvalidParameterError("rheology", "a shear stress increasing with the shear rate", self.rheology,
                                         f"its tube-flow function does not increase near ln(tau_w - tau_y) = "
                                         f"{s_lo:.6g}")
-        # TOL is a relative error of G: a relative error e of Gamma (a node's estimate) is one of
-        # e (ds/dy) (tau_w - tau_y) / tau_w in G, ds/dy taken as the ends' secant (near yield the
-        # quadrature's rounding floor, large in Gamma, is small in G)
+        # a relative error e of Gamma (a node's estimate) is one of e (ds/dy) (tau_w - tau_y) / tau_w in G,
+        # ds/dy taken as the ends' secant (near yield the quadrature's rounding floor, large in Gamma,
+        # is small in G)
         _, s, _, err = (np.concatenate(column) for column in zip(*samples))
         with np.errstate(all="ignore"):
-            share = 1.0 / (1.0 + self.yield_stress * np.exp(-s)) if self.yield_stress > 0 else 1.0
-            node_error = (s_hi - s_lo) / (y_hi - y_lo) * float(np.max(np.where(np.isfinite(s), err * share, err)))
+            node_error = (s_hi - s_lo) / (y_hi - y_lo) * float(np.max(np.where(np.isfinite(s), err * self._share(s),
+                                                                                 err)))
         # a direct panel's slopes (for the asymptote below the lowest panel, and the steps toward
         # a load) are its ends' secant: its fit, if any, cannot be trusted
         secant = {"slope_y": y_hi - y_lo, "slope_s": s_hi - s_lo}
@@ -304,7 +324,7 @@ class FlowTable:
                     break
             return p if self.mode == "rate" else self._exact_s(p)
 
-        inverse, _ = fit_piecewise(inverse_values, y_lo, y_hi, degree=8, tol=TOL, panels=4, max_panels=512,
+        inverse, _ = fit_piecewise(inverse_values, y_lo, y_hi, degree=8, tol=TOL * relax, panels=4, max_panels=512,
                                    relative=True)
         slopes = {"slope_y": _lower_slope(fit, 0), "slope_s": 1.0 if self.mode == "rate" else _lower_slope(fit, 1)}
         return _Panel(j, y_lo, y_hi, inverse, error=node_error, **slopes)
