@@ -365,10 +365,11 @@ def unit_integral(f, n: int, *, rtol: float = 1e-15, rounding=None, relative_rou
     in :math:`t = e^{-z}` over :math:`z \in [0, 40]` with 11 initial panels (ends 0, 1, 2, 3, 4,
     6, 8, 12, 16, 22, 30, 40): geometric grading toward :math:`t = 0`, where an algebraic
     singularity (:math:`t^{1/n}`, a yield point) becomes a smooth, exponentially decaying
-    integrand. The omitted :math:`(0, e^{-40})` is below 4e-18 of the integral for the bounded, monotone integrands it serves (the Rabinowitsch–Mooney
-    integral, velocity profiles). ``rounding(index)``, if given, is the absolute rounding error of
-    ``f``'s values per point (a difference of nearly equal terms), or ``relative_rounding(t, index)``
-    their relative rounding at the nodes. The rule is :func:`adaptive` with ``robust=True``.
+    integrand. The omitted :math:`(0, e^{-40})` is below 4e-18 of the integral for the bounded,
+    monotone integrands it serves (the Rabinowitsch–Mooney integral, velocity profiles).
+    ``rounding(index)``, if given, is the absolute rounding error of ``f``'s values per point (a
+    difference of nearly equal terms), or ``relative_rounding(t, index)`` their relative rounding
+    at the nodes. The rule is :func:`adaptive` with ``robust=True``.
     """
     def g(z, idx):
         t = np.exp(-z)
