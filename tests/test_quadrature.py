@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 
 from tubefsi.errors import AccuracyWarning
 from tubefsi.numerics.quadrature import (GAUSS_WEIGHTS, KRONROD_NODES, KRONROD_WEIGHTS, adaptive, adaptive_to_pole,
-                                         warn_unconverged)
+                                         unit_integral, warn_unconverged)
 from tubefsi.numerics.roots import solve_increasing
 from tubefsi.numerics.spectral import LOBATTO_NODES, solve_integral
 from tubefsi.testing.profiles import scaled
@@ -93,6 +93,31 @@ def test_noise_is_reported_not_hidden():
     with warnings.catch_warnings():   # only the points the caller asks about count
         warnings.simplefilter("error")
         warn_unconverged("the test integral", r, where=np.zeros(np.shape(r.converged), dtype=bool))
+
+
+@pytest.mark.parametrize("f, exact", [
+    (lambda t: 1.0 / (1.0 + t * t), mpmath.pi / 4),
+    (lambda t: np.sqrt(1.0 + t), (2 * mpmath.sqrt(8) - 2) / 3),
+    (lambda t: t ** (1 / 0.3), mpmath.mpf(0.3) / mpmath.mpf(1.3)),
+], ids=["1/(1+t^2)", "sqrt(1+t)", "t^(1/0.3)"])
+def test_a_smooth_unit_integral_takes_its_initial_panels_only(f, exact):
+    """unit_integral's initial panels (z = -ln t from 0 to 40: width 1 next to t = 1, wider toward
+    t = 0) meet 1e-15 for a smooth integrand without bisecting one; with an absolute rounding of
+    the integrand given as well (its floor taken without evaluating the integrand again)."""
+    for rounding in (None, lambda idx: np.full(idx.shape, 2 * np.finfo(float).eps)):
+        r = unit_integral(lambda t, i: f(t), 1, rounding=rounding)
+        assert r.converged[0] and r.panels[0] == 11
+        assert abs(r.value[0] - float(exact)) <= 2e-15 * float(exact)
+
+
+def test_graded_initial_panels_are_the_equal_ones_where_they_coincide():
+    """``adaptive(breaks=)`` at the ends of equal panels gives the bits of ``panels=``."""
+    def f(x, i):
+        return np.exp(-x) * np.cos(3 * x)
+
+    equal = adaptive(f, np.array([0.0, 1.0]), np.array([40.0, 5.0]), panels=4)
+    graded = adaptive(f, np.array([0.0, 1.0]), np.array([40.0, 5.0]), breaks=(0.0, 0.25, 0.5, 0.75, 1.0))
+    assert np.array_equal(equal.value, graded.value) and np.array_equal(equal.error, graded.error)
 
 
 def test_zero_width_and_reversed_intervals():

@@ -27,9 +27,13 @@ stress-natural one, where :math:`\tau_w = \tau(e^p)` needs no root): panel :math
 :math:`y(p)` interpolated to 5e-15 (:func:`~tubefsi.numerics.chebyshev.fit_piecewise`), its inverse
 :math:`s(y)` interpolated to 1e-14 over the panel's image from Newton's method on it, both checked
 at points between their nodes — so what a panel holds depends on the fluid and :math:`j` alone.
-Panels are built where loads need them and kept (the table only grows, under a lock); which ones
-exist changes the time, never an answer. A law whose flow function cannot be interpolated on a
-panel (a kink) keeps that panel *direct*: its lookups solve :math:`y(p) = y` exactly there.
+Both tolerances are in :math:`G`: near yield, where :math:`G` carries :math:`\tau_y` and an error
+of :math:`s` or :math:`y` moves it only :math:`(\tau_w - \tau_y)/\tau_w` as much, they are divided
+by that share (the law's rounding there, ~eps :math:`\tau_y/(\tau_w - \tau_y)` in :math:`\Gamma`
+where it gets :math:`\tau`, would otherwise defeat every fit). Panels are built where loads need
+them and kept (the table only grows, under a lock); which ones exist changes the time, never an
+answer. A law whose flow function cannot be interpolated on a panel (a kink) keeps that panel
+*direct*: its lookups solve :math:`y(p) = y` exactly there.
 
 Below the lowest panel the law resolves (a yield-stress fluid near yield, where the law can no longer
 tell :math:`\tau_w - \tau_y`), :math:`s` follows the power-law asymptote of that panel's end: there
@@ -169,6 +173,14 @@ def _overridden(obj, name) -> bool:
     return len(owners) > 1 and owners[0] is not owners[-1]
 
 
+def _lower_slope(fit, output: int) -> float:
+    """The derivative of ``output`` of a fit at its lower end, from its first panel's Chebyshev
+    coefficients (T_k'(-1) = (-1)^(k+1) k^2): no derivative interpolant built for one number."""
+    c = fit.chebyshev[output, 0]
+    k = np.arange(c.size)
+    return float(np.dot(c, (-1.0) ** (k + 1) * k * k)) * 2.0 / float(fit.breaks[1] - fit.breaks[0])
+
+
 class _Panel:
     """One built panel ``j <= p <= j + 1``: its image ``[y_lo, y_hi]``, the inverse ``s(y)`` (None: a
     direct panel, solved exactly at each lookup) and the slopes ``dy/dp``, ``ds/dp`` at its lower end;
@@ -239,39 +251,60 @@ class FlowTable:
             tau = np.asarray(self.rheology._stress(np.exp(p)), dtype=float)
             return np.log(tau - self.yield_stress) if self.yield_stress > 0 else np.log(tau)
 
+    def _share(self, s):
+        """(tau_w - tau_y) / tau_w at s = ln(tau_w - tau_y): an error d of s is one of d times this
+        in G (1 without a yield stress)."""
+        with np.errstate(all="ignore"):
+            return 1.0 / (1.0 + self.yield_stress * np.exp(-s)) if self.yield_stress > 0 else np.ones(np.shape(s))
+
     # ------------------------------------------------------------ panels
     def _build(self, j: int) -> _Panel:
         """Panel ``j`` from exact evaluations alone (module docstring)."""
         lo, hi = float(j), float(j + 1)
-        s_ends, y_ends, _ = self._exact(np.array([lo, hi]))
-        if not np.all(np.isfinite(y_ends)) or (self.mode == "rate" and self.yield_stress > 0 and lo < self._s_floor):
-            return _Panel(j, float(y_ends[0]), float(y_ends[1]), None, finite=False)
-        if not y_ends[1] > y_ends[0]:
-            raise InvalidParameterError("rheology", "a shear stress increasing with the shear rate", self.rheology,
-                                        f"its tube-flow function does not increase near ln(tau_w - tau_y) = "
-                                        f"{float(s_ends[0]):.6g}")
-        errors = []
-        # TOL is a relative error of G: a relative error e of Gamma (a node's estimate) is one of
-        # e (ds/dy) (tau_w - tau_y) / tau_w in G, ds/dy taken as the ends' secant (near yield the
-        # quadrature's rounding floor, large in Gamma, is small in G)
-        gain = float(s_ends[1] - s_ends[0]) / float(y_ends[1] - y_ends[0])
-
-        samples = []
+        if self.mode == "rate" and self.yield_stress > 0 and lo < self._s_floor:
+            return _Panel(j, math.nan, math.nan, None, finite=False)     # below the floor: nothing to evaluate
+        # TOL is a relative error of G. Near yield G carries tau_y: an error d of s = ln(tau_w - tau_y)
+        # is one of d (tau_w - tau_y) / tau_w in G (_share), and an error of y = ln Gamma one of that
+        # times ds/dy (below 1 near yield). So the fits' tolerances in y and s are divided by that share
+        # at the panel's top, where it is largest: the law's rounding near yield, large in y and s
+        # (~eps tau_y / (tau_w - tau_y) where the law gets tau, not the excess), is small in G. At most
+        # 1/sqrt(eps)-fold: a law that gets only tau is tabulated no closer to yield than that.
+        s_top = hi if self.mode == "rate" else float(self._exact_s(np.array([hi]))[0])
+        share = float(self._share(s_top))
+        relax = 1.0 / max(share if math.isfinite(share) else 1.0, math.sqrt(_EPS))
+        samples = []                           # (p, s, y, err) of every exact evaluation, the ends first
 
         def forward(p):
-            s, y, err = self._exact(p)
-            samples.append((np.ravel(p), s.ravel(), y.ravel(), err.ravel()))
-            with np.errstate(all="ignore"):
-                share = 1.0 / (1.0 + self.yield_stress * np.exp(-s)) if self.yield_stress > 0 else 1.0
-                errors.append(gain * float(np.max(np.where(np.isfinite(s), err * share, err), initial=0.0)))
-            return np.stack([y, s])
+            # the panel's two ends ride along with the first batch of nodes: one quadrature call fewer,
+            # and the same values as alone (each point's quadrature is independent of its batch)
+            x = np.concatenate([[lo, hi], p]) if not samples else p
+            s, y, err = self._exact(x)
+            samples.append((x, s, y, err))
+            if len(samples) > 1:
+                return np.stack([y, s])
+            if not (np.all(np.isfinite(y[:2])) and y[1] > y[0]):
+                return np.full((2, np.size(p)), np.nan)    # no panel to fit (told apart below): the fit stops
+            return np.stack([y[2:], s[2:]])
 
-        fit, _ = fit_piecewise(forward, lo, hi, degree=16, tol=5e-15, panels=1, max_panels=64, relative=True)
-        y_lo, y_hi = float(y_ends[0]), float(y_ends[1])
-        node_error = max(errors) if errors else 0.0
+        fit, _ = fit_piecewise(forward, lo, hi, degree=16, tol=5e-15 * relax, panels=1, max_panels=64,
+                               relative=True)
+        (s_lo, s_hi), (y_lo, y_hi) = samples[0][1][:2].tolist(), samples[0][2][:2].tolist()
+        if not (math.isfinite(y_lo) and math.isfinite(y_hi)):
+            return _Panel(j, y_lo, y_hi, None, finite=False)
+        if not y_hi > y_lo:
+            raise InvalidParameterError("rheology", "a shear stress increasing with the shear rate", self.rheology,
+                                        f"its tube-flow function does not increase near ln(tau_w - tau_y) = "
+                                        f"{s_lo:.6g}")
+        # a relative error e of Gamma (a node's estimate) is one of e (ds/dy) (tau_w - tau_y) / tau_w in G,
+        # ds/dy taken as the ends' secant (near yield the quadrature's rounding floor, large in Gamma,
+        # is small in G)
+        _, s, _, err = (np.concatenate(column) for column in zip(*samples))
+        with np.errstate(all="ignore"):
+            node_error = (s_hi - s_lo) / (y_hi - y_lo) * float(np.max(np.where(np.isfinite(s), err * self._share(s),
+                                                                                 err)))
         # a direct panel's slopes (for the asymptote below the lowest panel, and the steps toward
         # a load) are its ends' secant: its fit, if any, cannot be trusted
-        secant = {"slope_y": y_hi - y_lo, "slope_s": float(s_ends[1] - s_ends[0])}
+        secant = {"slope_y": y_hi - y_lo, "slope_s": s_hi - s_lo}
         if fit is None:                        # a kink (or noise): solved exactly at each lookup
             self._increasing(samples)
             return _Panel(j, y_lo, y_hi, None, error=node_error, **secant)
@@ -291,13 +324,10 @@ class FlowTable:
                     break
             return p if self.mode == "rate" else self._exact_s(p)
 
-        inverse, _ = fit_piecewise(inverse_values, y_lo, y_hi, degree=8, tol=TOL, panels=4, max_panels=512,
+        inverse, _ = fit_piecewise(inverse_values, y_lo, y_hi, degree=8, tol=TOL * relax, panels=4, max_panels=512,
                                    relative=True)
-        slope_y = float(slope(np.array([lo]))[0])
-        slope_s = 1.0 if self.mode == "rate" else float(fit.derivative(1)(np.array([lo]))[0])
-        if inverse is None:
-            return _Panel(j, y_lo, y_hi, None, error=node_error, slope_y=slope_y, slope_s=slope_s)
-        return _Panel(j, y_lo, y_hi, inverse, error=node_error, slope_y=slope_y, slope_s=slope_s)
+        slopes = {"slope_y": _lower_slope(fit, 0), "slope_s": 1.0 if self.mode == "rate" else _lower_slope(fit, 1)}
+        return _Panel(j, y_lo, y_hi, inverse, error=node_error, **slopes)
 
     def _increasing(self, samples) -> None:
         """Raise :class:`InvalidParameterError` where the exact values ``(p, s, y, err)`` of a direct
