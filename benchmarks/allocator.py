@@ -1,6 +1,6 @@
 """What the C allocator costs a large broadcast solve: ``python benchmarks/allocator.py``.
 
-The random-scene sweep of ``benchmarks/speed.py`` (row 4: 10^4 scenes, every parameter random,
+The random-scene sweep of ``benchmarks/speed.py`` (its "random scenes" row: 10^4 scenes, every parameter random,
 one broadcast call) is timed in two fresh processes that differ only in glibc's malloc settings:
 the defaults, and ``GLIBC_TUNABLES`` keeping freed memory in the process
 (``glibc.malloc.trim_threshold``, ``glibc.malloc.mmap_threshold``). With the defaults, glibc
@@ -72,7 +72,7 @@ def main(argv=None) -> int:
             result = run(rows[name], calls, points)
             got[name]["times"] += result["times"]
             got[name]["faults"] += result["faults"]
-    print(f"{points} random scenes (benchmarks/speed.py row 4), one broadcast call; {rounds} "
+    print(f"{points} random scenes (the "random scenes" row of benchmarks/speed.py), one broadcast call; {rounds} "
           f"process{'es' if rounds > 1 else ''} x {calls} calls each")
     print(f"{'malloc':<22}{'ms per call (median)':>22}{'range':>16}{'minor faults per call (median)':>34}")
     medians = {}

@@ -24,22 +24,22 @@ thick neo-Hookean wall, mu = 2 kPa.
 3. ``monte carlo``: one scalar solve with a fresh wall each call
    (``walls["thick-neo-hookean"](shear_modulus=mu_i)``, then ``solve(...).pressure_drop``)
    against one baseline ODE, per call;
-3b. ``numpy loop``: the loop everyone writes, ``for q in np.linspace(...): solve(..., flow_rate=q)``
+4. ``numpy loop``: the loop everyone writes, ``for q in np.linspace(...): solve(..., flow_rate=q)``
    (NumPy scalars) through one scene, against one baseline ODE per flow rate;
-4. ``random scenes``: 10^4 scenes with every parameter random (mu, m, n, a, t, L, q), one
+5. ``random scenes``: 10^4 scenes with every parameter random (mu, m, n, a, t, L, q), one
    broadcast ``solve`` (model parameters and ``Tube`` fields as arrays) against the baseline per
    scene. If the broadcast call raises, a Python loop of scalar solves (models built in the
    loop) is timed instead and the row says "loop";
-4b. ``infeasible scenes``: the same, with 10 % of the scenes given 1.1-2 times their maximum flow
+6. ``infeasible scenes``: the same, with 10 % of the scenes given 1.1-2 times their maximum flow
    rate and ``on_infeasible="nan"`` (the baseline per feasible scene: it has no answer for the
    others);
-5. ``carreau curve``: a 10^4-point Carreau-Yasuda curve (blood, Cho & Kensey constants) in the
+7. ``carreau curve``: a 10^4-point Carreau-Yasuda curve (blood, Cho & Kensey constants) in the
    thick wall against the power-law baseline at the same flow rates, per point;
-6. ``carreau scalar``: one scalar Carreau-Yasuda solve with fresh fluid parameters each call
+8. ``carreau scalar``: one scalar Carreau-Yasuda solve with fresh fluid parameters each call
    (absolute time: a new fluid builds its flow table);
-7. ``fit``: ``tubefsi.fit`` of 3 parameters (wall.shear_modulus, rheology.consistency,
+9. ``fit``: ``tubefsi.fit`` of 3 parameters (wall.shear_modulus, rheology.consistency,
    rheology.index) to 20 synthetic points with 1 % noise (absolute time);
-8. ``import``: ``import tubefsi`` wall time over ``import numpy`` wall time, each in a fresh
+10. ``import``: ``import tubefsi`` wall time over ``import numpy`` wall time, each in a fresh
    subprocess.
 
 How it is timed
@@ -70,7 +70,7 @@ import sys
 import time
 
 try:
-    import resource                     # (POSIX only: the page-fault count of row 4's note)
+    import resource                     # (POSIX only: the page-fault count in the random-scenes row's note)
 except ImportError:                     # pragma: no cover
     resource = None
 
