@@ -392,7 +392,7 @@ class SeparatedVariables(Coupler):
         ok = np.ones(q.shape, dtype=bool)
         # what the direct solve found at the points without a root: J at the answer, or J(inf)
         found = Integral.exact(np.zeros(q.shape))
-        points = np.zeros(0, dtype=int)
+        answered = np.zeros(q.shape, dtype=bool)
         if np.count_nonzero(todo) >= _CURVE_MIN_POINTS and scene.size == 1 and not scene.rheology.separable:
             sub = np.flatnonzero(todo)
             curve = self._curve(scene, q[sub])
@@ -400,14 +400,14 @@ class SeparatedVariables(Coupler):
                 v[sub] = curve
                 todo = todo.copy()
                 todo[sub] = False
-                points = sub
+                answered[sub] = True
         if np.any(todo):
             sub = np.flatnonzero(todo)
             v[sub], ok[sub], final = self._solve_J(scene, target[sub], sub, None if scene.rheology.separable else q[sub])
             found = found.replaced(sub, final)
             warn_unconverged("the separated-variables integral", final, where=ok[sub])
-            points = np.union1d(points, sub[ok[sub]])
-        return _Direct(points=points, ok=ok, found=found)
+            answered[sub] = ok[sub]
+        return _Direct(points=np.flatnonzero(answered), ok=ok, found=found)
 
     def _curve(self, scene: Scene, q):
         r"""The inlet log-stretches of a long curve through one scene without a table (a non-separable
