@@ -14,7 +14,7 @@ Every point takes the same steps whatever batch it comes in. The rest of the mod
 inlet log-stretch of a pressure drop (:func:`inlet_log_stretch`), the flow rate of a
 non-separable fluid at a given inlet (:func:`solve_flow_rate`), :math:`J(\infty)` and the maximum
 flow rate, whether a target is beyond :math:`J(\infty)` (:func:`beyond_limit`: a cheap screening
-estimate first), and what a point whose solve ran away is: beyond the maximum flow rate
+estimate first; :func:`clearly_beyond`: that screen alone, before any solve), and what a point whose solve ran away is: beyond the maximum flow rate
 (``NoSteadyStateError``) or beyond the solver's range (``StretchRangeError``).
 """
 
@@ -35,7 +35,7 @@ optimize = lazy_module("scipy.optimize", globals(), "optimize")
 elementwise = lazy_module("scipy.optimize.elementwise", globals(), "elementwise")
 
 __all__ = ["MAX_LOG_STRETCH", "newton", "one_batch", "inlet_log_stretch", "solve_flow_rate", "j_infinity",
-           "beyond_limit", "max_flow_rate", "classify_runaway", "log_stretch_cap"]
+           "beyond_limit", "clearly_beyond", "max_flow_rate", "classify_runaway", "log_stretch_cap"]
 
 #: Largest inlet stretch (relative to the outlet) a solve may reach: ln(1e15). Not a physical
 #: limit (``max_flow_rate`` is the one limit): beyond it ``StretchRangeError``.
@@ -311,6 +311,20 @@ def _limit(engine, scene, index, rtol=None) -> Integral:
                     converged=np.repeat(np.ravel(one.converged), n), panels=np.repeat(np.ravel(one.panels), n))
 
 
+def _screen(engine, scene, target, index):
+    """``(over, close, screen)``: the screening estimate of J(inf) at the points ``index``
+    (``_SCREEN_RTOL``), the targets it puts at or beyond J(inf) for certain, and those too close to
+    it to tell (NaN among them)."""
+    screen = _limit(engine, scene, index, _SCREEN_RTOL)
+    value = np.asarray(screen.value, dtype=float)
+    with np.errstate(invalid="ignore", over="ignore"):
+        margin = _SCREEN_SAFETY * (np.asarray(screen.error, dtype=float) + engine._RTOL * value)
+        margin = np.where(np.isfinite(value), margin, 0.0)        # (inf: no finite limit, exactly)
+        over = target >= value + margin
+        close = ~over & ~(target < (value - margin) * (1.0 - AT_THE_LIMIT))
+    return over, close, screen
+
+
 def beyond_limit(engine, scene, target, index):
     r"""``(over, j_inf)`` at the points ``index`` (a separable fluid): whether each positive target
     is at or beyond :math:`J(\infty)` (to :data:`AT_THE_LIMIT`), and the :math:`J(\infty)` that
@@ -318,19 +332,33 @@ def beyond_limit(engine, scene, target, index):
     the cost) tells every target farther from it than ``_SCREEN_SAFETY`` times its error estimate
     (and the coupler's own tolerance); :math:`J(\infty)` to the coupler's own tolerance tells the
     others. So the answer is the one :math:`J(\infty)` itself gives; only the time changes."""
-    screen = _limit(engine, scene, index, _SCREEN_RTOL)
-    value = np.asarray(screen.value, dtype=float)
-    with np.errstate(invalid="ignore", over="ignore"):
-        margin = _SCREEN_SAFETY * (np.asarray(screen.error, dtype=float) + engine._RTOL * value)
-        margin = np.where(np.isfinite(value), margin, 0.0)        # (inf: no finite limit, exactly)
-        over = target >= value + margin
-        close = ~over & ~(target < (value - margin) * (1.0 - AT_THE_LIMIT))  # (NaN: close)
+    over, close, screen = _screen(engine, scene, target, index)
     if not np.any(close):
         return over, screen
     sub = np.flatnonzero(close)
     own = _limit(engine, scene, index[sub])
     over[sub] = target[sub] >= own.value * (1.0 - AT_THE_LIMIT)
     return over, screen.replaced(sub, own)
+
+
+def clearly_beyond(engine, scene, target, index):
+    r"""``(positions, j_inf)``: the targets (a separable fluid) that the screening estimate of
+    :math:`J(\infty)` puts beyond it for certain (:func:`beyond_limit` without its second look,
+    which the solve's own check gives the others), and those estimates; asked before any solve.
+    Only a target the rigid tube (of the outlet's radius) would carry at or above the wall's limit
+    pressure is asked: :math:`\psi` falls as the radius grows, so
+    :math:`J(\infty) \ge (p_{lim} - p_{out})/\psi(a\lambda_{out})` and no other target is beyond
+    it; the others (in a sweep below the limit, all) cost one comparison."""
+    pts = scene.at(index)
+    with np.errstate(all="ignore"):
+        rise = np.asarray(pts.wall._limit_pressure(pts.tb), dtype=float) - pts.outlet_pressure + np.zeros(index.size)
+        rigid = target * pts.rheology._radius_factor(pts.radius * pts.outlet_stretch)
+        asked = np.flatnonzero(np.isfinite(rise) & (target > 0) & (rigid >= rise))
+    if asked.size == 0:
+        return asked, None
+    over, _, screen = _screen(engine, scene, target[asked], index[asked])
+    return asked[over], Integral(value=screen.value[over], error=screen.error[over],
+                                 converged=screen.converged[over], panels=screen.panels[over])
 
 
 def max_flow_rate(engine, scene, index):
