@@ -14,8 +14,9 @@ Every point takes the same steps whatever batch it comes in. The rest of the mod
 inlet log-stretch of a pressure drop (:func:`inlet_log_stretch`), the flow rate of a
 non-separable fluid at a given inlet (:func:`solve_flow_rate`), :math:`J(\infty)` and the maximum
 flow rate, whether a target is beyond :math:`J(\infty)` (:func:`beyond_limit`: a cheap screening
-estimate first; :func:`clearly_beyond`: that screen alone, before any solve), and what a point whose solve ran away is: beyond the maximum flow rate
-(``NoSteadyStateError``) or beyond the solver's range (``StretchRangeError``).
+estimate first; :func:`clearly_beyond`: that screen alone, before any solve), and what a point
+whose solve ran away is: beyond the maximum flow rate (``NoSteadyStateError``) or beyond the
+solver's range (``StretchRangeError``).
 """
 
 from __future__ import annotations
