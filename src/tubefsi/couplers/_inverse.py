@@ -13,8 +13,10 @@ solves :math:`J(v) = T` directly:
 Every point takes the same steps whatever batch it comes in. The rest of the module: the
 inlet log-stretch of a pressure drop (:func:`inlet_log_stretch`), the flow rate of a
 non-separable fluid at a given inlet (:func:`solve_flow_rate`), :math:`J(\infty)` and the maximum
-flow rate, and what a point whose solve ran away is: beyond the maximum flow rate
-(``NoSteadyStateError``) or beyond the solver's range (``StretchRangeError``).
+flow rate, whether a target is beyond :math:`J(\infty)` (:func:`beyond_limit`: a cheap screening
+estimate first; :func:`clearly_beyond`: that screen alone, before any solve), and what a point
+whose solve ran away is: beyond the maximum flow rate (``NoSteadyStateError``) or beyond the
+solver's range (``StretchRangeError``).
 """
 
 from __future__ import annotations
@@ -34,7 +36,7 @@ optimize = lazy_module("scipy.optimize", globals(), "optimize")
 elementwise = lazy_module("scipy.optimize.elementwise", globals(), "elementwise")
 
 __all__ = ["MAX_LOG_STRETCH", "newton", "one_batch", "inlet_log_stretch", "solve_flow_rate", "j_infinity",
-           "max_flow_rate", "classify_runaway", "log_stretch_cap"]
+           "beyond_limit", "clearly_beyond", "max_flow_rate", "classify_runaway", "log_stretch_cap"]
 
 #: Largest inlet stretch (relative to the outlet) a solve may reach: ln(1e15). Not a physical
 #: limit (``max_flow_rate`` is the one limit): beyond it ``StretchRangeError``.
@@ -44,6 +46,12 @@ _PROBE_LOG_STRETCH = math.log(1e8)
 #: A runaway solve within this relative distance of the maximum flow rate is at the limit (to the
 #: accuracy of q_max): beyond it, not beyond the solver's range.
 AT_THE_LIMIT = 1e-11
+#: :func:`beyond_limit` screens with J(inf) to this relative tolerance, from initial panels this
+#: wide (two Gauss-Kronrod panels on [0, ln 1e8], about 45 integrand values a point, where J(inf)
+#: to 1e-14 takes about 220; their estimate is typically 1e-4), and lets it decide where the target
+#: is farther from it than this many times its error estimate. (Measured over every registered
+#: wall's examples with a limit, n 0.3-0.99, t/a 0.02-3: the estimate exceeds the error 20-fold.)
+_SCREEN_RTOL, _SCREEN_PANEL_WIDTH, _SCREEN_SAFETY = 1e-2, 10.0, 10.0
 #: Newton on ln J stops after a step below this, relative to v and to the distance to a maximum
 #: stretch: its error is then ~(step)^2 / 2 relative to both, and the evaluation it came from,
 #: that close, is the answer's error estimate (:func:`tubefsi.numerics.roots.solve_increasing`).
@@ -115,8 +123,9 @@ def newton(engine, scene, target, index, q=None, upper=None):
     solve may reach. ``final`` is the :class:`~tubefsi.numerics.quadrature.Integral` of :math:`J`
     at the answer (the iteration's last evaluation where it stands for it, else evaluated once
     more). ``ok`` is False where no root exists there: ``v = inf`` where the target is at or beyond
-    :math:`J(\infty)` (without ``upper``, a wall with a limit pressure: checked before iterating,
-    ``final`` holding :math:`J(\infty)`), else the log-stretch the iteration ran to."""
+    :math:`J(\infty)` (without ``upper``, a wall with a limit pressure: checked before iterating by
+    :func:`beyond_limit`, ``final`` holding the :math:`J(\infty)` that told it), else the
+    log-stretch the iteration ran to."""
     target = np.asarray(target, dtype=float).ravel()
     index = np.asarray(index).ravel()
     n = target.size
@@ -131,8 +140,7 @@ def newton(engine, scene, target, index, q=None, upper=None):
         limited = np.isfinite(np.asarray(pts.wall._limit_pressure(pts.tb)) + np.zeros(todo.size))
         if np.any(limited):
             sub = todo[limited]
-            j_inf = engine._J_infinity(scene, index[sub], None if qflat is None else qflat[sub])
-            over = target[sub] >= j_inf.value * (1.0 - AT_THE_LIMIT)
+            over, j_inf = beyond_limit(engine, scene, target[sub], index[sub])
             where = sub[over]
             v[where], ok[where] = np.inf, False
             value[where], error[where], converged[where] = j_inf.value[over], j_inf.error[over], j_inf.converged[over]
@@ -237,12 +245,25 @@ def one_batch(engine, scene, target, index, bound):
     return v, solved
 
 
-def j_infinity(engine, scene, index, q=None) -> Integral:
+def _head(engine, scene, v, index, q, rtol) -> Integral:
+    """J(v) by the coupler's own rule, or (``rtol``) a screening estimate: the adaptive rule to
+    that looser tolerance from panels ``_SCREEN_PANEL_WIDTH`` wide (a fixed rule is its own)."""
+    if rtol is None or engine._coarse:
+        return engine._J(scene, v, index, q)
+
+    def f(u, i):
+        return engine.integrand(scene.at(index[i], column=True), u, None if q is None else q[i, None])
+
+    return engine.integrate(scene, f, v, index, panel_width=_SCREEN_PANEL_WIDTH, rtol=max(rtol, engine._RTOL))
+
+
+def j_infinity(engine, scene, index, q=None, rtol=None) -> Integral:
     r""":math:`J(\infty)` at the points ``index``: up to a maximum stretch where the tube law peaks
     there, else the quadrature to ln(1e8) plus the power-law tail of the integrand beyond it
     (:math:`sP' \sim s^{1-\kappa}`, :math:`\psi \sim R^{-\mu}`: a tail :math:`f(v_1)/\alpha`,
     :math:`\alpha = \kappa - 1 - \mu > 0`); ``inf`` where the wall has no limit pressure or the
-    integrand does not decay."""
+    integrand does not decay. With ``rtol``, a screening estimate (:func:`_head`): the same tail,
+    its quadrature to that looser tolerance (the error estimate says how loose)."""
     pts = scene.at(index)
     n = index.size
     value, error = np.full(n, np.inf), np.zeros(n)
@@ -252,7 +273,7 @@ def j_infinity(engine, scene, index, q=None) -> Integral:
     v_max = np.asarray(pts.log_stretch_max, dtype=float) + np.zeros(n)
     peak = limited & np.isfinite(v_max)
     if np.any(peak):      # the tube law ends at its pressure peak: J stays finite up to it
-        part = engine._J(scene, v_max[peak] * (1 - 8 * EPS), index[peak], None if qq is None else qq[peak])
+        part = _head(engine, scene, v_max[peak] * (1 - 8 * EPS), index[peak], None if qq is None else qq[peak], rtol)
         value[peak], error[peak], converged[peak] = part.value, part.error, part.converged
     far = np.flatnonzero(limited & ~peak)
     if far.size:
@@ -273,11 +294,72 @@ def j_infinity(engine, scene, index, q=None) -> Integral:
             ids = sub[decays]
             v1 = np.full(ids.size, _PROBE_LOG_STRETCH)
             qd = None if qq is None else qq[far][decays]
-            head = engine._J(scene, v1, ids, qd)
+            head = _head(engine, scene, v1, ids, qd, rtol)
             tail = engine.integrand(scene.at(ids), v1, qd) / alpha[decays]
             where = far[decays]
             value[where], error[where], converged[where] = head.value + tail, head.error, head.converged
     return Integral(value=value, error=error, converged=converged, panels=np.zeros(n, dtype=int))
+
+
+def _limit(engine, scene, index, rtol=None) -> Integral:
+    """``engine._J_infinity`` at the points ``index``: computed once for a scene of scalars (its
+    points share every quantity, so their J(inf) are the same to the bit)."""
+    if scene.size > 1 or index.size < 2:
+        return engine._J_infinity(scene, index, rtol=rtol)
+    one = engine._J_infinity(scene, index[:1], rtol=rtol)
+    n = index.size
+    return Integral(value=np.repeat(np.ravel(one.value), n), error=np.repeat(np.ravel(one.error), n),
+                    converged=np.repeat(np.ravel(one.converged), n), panels=np.repeat(np.ravel(one.panels), n))
+
+
+def _screen(engine, scene, target, index):
+    """``(over, close, screen)``: the screening estimate of J(inf) at the points ``index``
+    (``_SCREEN_RTOL``), the targets it puts at or beyond J(inf) for certain, and those too close to
+    it to tell (NaN among them)."""
+    screen = _limit(engine, scene, index, _SCREEN_RTOL)
+    value = np.asarray(screen.value, dtype=float)
+    with np.errstate(invalid="ignore", over="ignore"):
+        margin = _SCREEN_SAFETY * (np.asarray(screen.error, dtype=float) + engine._RTOL * value)
+        margin = np.where(np.isfinite(value), margin, 0.0)        # (inf: no finite limit, exactly)
+        over = target >= value + margin
+        close = ~over & ~(target < (value - margin) * (1.0 - AT_THE_LIMIT))
+    return over, close, screen
+
+
+def beyond_limit(engine, scene, target, index):
+    r"""``(over, j_inf)`` at the points ``index`` (a separable fluid): whether each positive target
+    is at or beyond :math:`J(\infty)` (to :data:`AT_THE_LIMIT`), and the :math:`J(\infty)` that
+    told it. A screening estimate (``engine._J_infinity(..., rtol=_SCREEN_RTOL)``, a fraction of
+    the cost) tells every target farther from it than ``_SCREEN_SAFETY`` times its error estimate
+    (and the coupler's own tolerance); :math:`J(\infty)` to the coupler's own tolerance tells the
+    others. So the answer is the one :math:`J(\infty)` itself gives; only the time changes."""
+    over, close, screen = _screen(engine, scene, target, index)
+    if not np.any(close):
+        return over, screen
+    sub = np.flatnonzero(close)
+    own = _limit(engine, scene, index[sub])
+    over[sub] = target[sub] >= own.value * (1.0 - AT_THE_LIMIT)
+    return over, screen.replaced(sub, own)
+
+
+def clearly_beyond(engine, scene, target, index):
+    r"""``(positions, j_inf)``: the targets (a separable fluid) that the screening estimate of
+    :math:`J(\infty)` puts beyond it for certain (:func:`beyond_limit` without its second look,
+    which the solve's own check gives the others), and those estimates; asked before any solve.
+    Only a target the rigid tube (of the outlet's radius) would carry at or above the wall's limit
+    pressure is asked: :math:`\psi` falls as the radius grows, so
+    :math:`J(\infty) \ge (p_{lim} - p_{out})/\psi(a\lambda_{out})` and no other target is beyond
+    it; the others (in a sweep below the limit, all) cost one comparison."""
+    pts = scene.at(index)
+    with np.errstate(all="ignore"):
+        rise = np.asarray(pts.wall._limit_pressure(pts.tb), dtype=float) - pts.outlet_pressure + np.zeros(index.size)
+        rigid = target * pts.rheology._radius_factor(pts.radius * pts.outlet_stretch)
+        asked = np.flatnonzero(np.isfinite(rise) & (target > 0) & (rigid >= rise))
+    if asked.size == 0:
+        return asked, None
+    over, _, screen = _screen(engine, scene, target[asked], index[asked])
+    return asked[over], Integral(value=screen.value[over], error=screen.error[over],
+                                 converged=screen.converged[over], panels=screen.panels[over])
 
 
 def max_flow_rate(engine, scene, index):
@@ -350,22 +432,18 @@ def _max_flow_rate_point(engine, scene, i):
     return math.exp(optimize.brentq(excess, lo, hi, xtol=1e-15, rtol=4 * np.finfo(float).eps))
 
 
-def classify_runaway(engine, scene, q, bad, v, final, *, raise_):
+def classify_runaway(engine, scene, q, bad, v, *, raise_):
     r"""What the points ``bad`` (positions) whose solve found no root are. Where the solve found the
-    target at or beyond :math:`J(\infty)` (``v = inf``, ``final.value`` the integral there) the
-    point is beyond its maximum flow rate; elsewhere (the iteration ran away) the maximum flow
-    rate decides (to its accuracy, :data:`AT_THE_LIMIT`). Points beyond it are returned (with
-    ``raise_``, the first is a ``NoSteadyStateError``); any other is beyond the solver's range: a
-    ``StretchRangeError`` or, below a maximum stretch, a ``NoSteadyStateError`` giving the flow rate
-    that reaches it."""
+    target at or beyond :math:`J(\infty)` (``v = inf``) the point is beyond its maximum flow rate;
+    elsewhere (the iteration ran away) the maximum flow rate decides (to its accuracy,
+    :data:`AT_THE_LIMIT`). Points beyond it are returned (with ``raise_``, the first is a
+    ``NoSteadyStateError``, its limit computed for the message); any other is beyond the solver's
+    range: a ``StretchRangeError`` or, below a maximum stretch, a ``NoSteadyStateError`` giving the
+    flow rate that reaches it."""
     bad = np.asarray(bad)
     q_bad = q[bad]
     q_max = np.full(bad.size, np.nan)
     known = np.isinf(v[bad])          # (a root beyond J(inf): v = inf)
-    if np.any(known) and scene.rheology.separable:     # beyond J(inf): the limit follows from it
-        sp = scene.at(bad[known])
-        with np.errstate(over="ignore"):
-            q_max[known] = sp.rheology._flow_factor_inverse(final.value[bad[known]] / sp.length)
     if not np.all(known):
         rest = bad[~known]
         q_max[~known] = np.broadcast_to(np.asarray(engine.max_flow_rate(scene.take(rest) if scene.size > 1 else scene),
@@ -373,7 +451,7 @@ def classify_runaway(engine, scene, q, bad, v, final, *, raise_):
     beyond = known | (np.isfinite(q_max) & (q_bad >= q_max * (1.0 - AT_THE_LIMIT)))
     if raise_ and np.any(beyond):
         i = int(np.argmax(beyond))
-        if np.isnan(q_max[i]):          # a non-separable fluid: its limit, for the message
+        if np.isnan(q_max[i]):          # known beyond J(inf): its limit, for the message
             q_max[i] = float(engine.max_flow_rate(scene.point(int(bad[i]))))
         detail = "the tube inflates without bound" + ("" if q_bad[i] >= q_max[i] else (
             f" (this flow rate is the maximum one to within {AT_THE_LIMIT:.0e}, its accuracy)"))

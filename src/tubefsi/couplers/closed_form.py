@@ -44,7 +44,7 @@ class ClosedForm(SeparatedVariables):
         return exact(pts.radius**k * pts.wall._power_law_integral(np.asarray(v, dtype=float), pts.outlet_stretch, k,
                                                                   pts.tb))
 
-    def _J_infinity(self, scene, index, q=None):
+    def _J_infinity(self, scene, index, q=None, rtol=None):      # exact: no screening estimate
         index = np.asarray(index)
         return exact(self._J(scene, np.full(index.shape, np.inf), index).value + np.zeros(index.shape))
 

@@ -4,7 +4,8 @@ r"""``quadrature``: any rheology with any wall, by the separated-variables ident
 in the log-stretch :math:`u` with an a-posteriori error estimate per point (``docs/theory.md``,
 section "Coupling without an ODE"). The inlet log-stretch is found from one batch of integrand
 values per point where a Chebyshev interpolant's tail vouches for it, else by safeguarded Newton
-iteration (:mod:`tubefsi.couplers._inverse`). No ODE is integrated. Toward a wall's locking
+iteration (:mod:`tubefsi.couplers._inverse`); a target that a cheap estimate of :math:`J(\infty)`
+puts beyond it is told so before either. No ODE is integrated. Toward a wall's locking
 stretch the integral is graded in :math:`\ln(v_{max} - u)`.
 """
 
@@ -85,19 +86,28 @@ class Quadrature(SeparatedVariables):
         return self.integrate(scene, f, v, index, order=self.order, panel_width=self.panel_width)
 
     def _solve_J(self, scene, target, index, q=None, upper=None):
-        """One batch of integrand values per point first (a separable fluid, the adaptive rule),
-        safeguarded Newton for the points it cannot vouch for."""
+        """The targets a screen of J(inf) puts beyond it first, before any solve (a separable fluid,
+        the adaptive rule, no upper bound); one batch of integrand values per point for the
+        others, safeguarded Newton for the points it cannot vouch for."""
         target = np.asarray(target, dtype=float).ravel()
         index = np.asarray(index).ravel()
         if self._coarse or not scene.rheology.separable or not np.any(target > 0):
             return super()._solve_J(scene, target, index, q, upper)
+        ok = np.ones(target.size, dtype=bool)
+        final = Integral.exact(target)              # (where solved: the interpolant's tail met the tolerance)
+        beyond = np.zeros(0, dtype=int)
+        if upper is None:
+            beyond, limit = _inverse.clearly_beyond(self, scene, target, index)
+            if beyond.size:
+                ok[beyond] = False
+                final = final.replaced(beyond, limit)
+        live = np.where(ok, target, 0.0)            # (a zero target: no solve)
         bound = 0.5 * _inverse.log_stretch_cap(scene, index)
         if upper is not None:
             bound = np.minimum(bound, upper)
-        v, solved = _inverse.one_batch(self, scene, target, index, bound)
-        ok = np.ones(target.size, dtype=bool)
-        final = Integral.exact(target)              # the interpolant's tail met the tolerance
-        rest = np.flatnonzero(~solved & (target > 0))
+        v, solved = _inverse.one_batch(self, scene, live, index, bound)
+        v[beyond] = np.inf
+        rest = np.flatnonzero(~solved & (live > 0))
         if rest.size:
             up = None if upper is None else np.broadcast_to(np.asarray(upper, dtype=float), target.shape)[rest]
             v[rest], ok[rest], part = super()._solve_J(scene, target[rest], index[rest], None, up)

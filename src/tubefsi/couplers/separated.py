@@ -119,12 +119,11 @@ def _rigid_state(scene: Scene, *, flow_rate=None, pressure_drop=None) -> State:
 
 
 class _Direct(NamedTuple):
-    """What :meth:`SeparatedVariables._flow_direct` solved: the points it answered, whether each
-    point has a root (False: none below the solver's range) and J at the answer or J(inf)."""
+    """What :meth:`SeparatedVariables._flow_direct` solved: the points it answered and whether each
+    point has a root (False: none below the solver's range)."""
 
     points: np.ndarray
     ok: np.ndarray
-    found: Integral
 
 
 class SeparatedVariables(Coupler):
@@ -133,9 +132,10 @@ class SeparatedVariables(Coupler):
     Hooks: ``_J(scene, v, index, q)`` (required: :math:`\\int_0^v` of the separated integrand at
     the points ``index`` of a flat scene, ``q`` only for a non-separable rheology, as an
     :class:`~tubefsi.numerics.quadrature.Integral` with its error estimate), ``_J_infinity(scene,
-    index, q)`` (optional: :math:`J(\\infty)`, for the maximum flow rate), ``_solve_J(scene, target,
-    index, q, upper)`` (optional: :math:`v` with :math:`J(v) = T`; default safeguarded Newton) and
-    ``_table_options()`` (the plain values that tell its tables apart; None: no tables).
+    index, q, rtol)`` (optional: :math:`J(\\infty)`, for the maximum flow rate; ``rtol`` asks for a
+    cheaper screening estimate), ``_solve_J(scene, target, index, q, upper)`` (optional: :math:`v`
+    with :math:`J(v) = T`; default safeguarded Newton) and ``_table_options()`` (the plain values
+    that tell its tables apart; None: no tables).
     """
 
     __slots__ = ()
@@ -261,10 +261,12 @@ class SeparatedVariables(Coupler):
         r""":math:`\int_0^v` of the separated integrand at the points ``index`` (``q`` only if
         non-separable), with its error estimate."""
 
-    def _J_infinity(self, scene: Scene, index, q=None) -> Integral:
+    def _J_infinity(self, scene: Scene, index, q=None, rtol=None) -> Integral:
         r""":math:`J(\infty)` at the points ``index``: finite only for a wall with a limit pressure
-        and a fast enough decay of :math:`s P'(s)/\psi(as)`; for the maximum flow rate."""
-        return _inverse.j_infinity(self, scene, np.asarray(index), q)
+        and a fast enough decay of :math:`s P'(s)/\psi(as)`; for the maximum flow rate. ``rtol``: a
+        cheaper screening estimate to that looser tolerance, its error estimate saying how loose
+        (an exact :math:`J(\infty)` may ignore it)."""
+        return _inverse.j_infinity(self, scene, np.asarray(index), q, rtol)
 
     def _solve_J(self, scene: Scene, target, index, q=None, upper=None):
         """``(v, ok, final)``: the log-stretches with ``J(v) = target`` at the points ``index`` below
@@ -375,8 +377,7 @@ class SeparatedVariables(Coupler):
         solved = self._flow_direct(scene, q, target, todo, v)
         feasible = None
         if not np.all(solved.ok):
-            beyond = _inverse.classify_runaway(self, scene, q, np.flatnonzero(~solved.ok), v, solved.found,
-                                               raise_=raise_)
+            beyond = _inverse.classify_runaway(self, scene, q, np.flatnonzero(~solved.ok), v, raise_=raise_)
             feasible = np.ones(q.shape, dtype=bool)
             feasible[beyond] = False
             v[~solved.ok] = 0.0
@@ -394,9 +395,7 @@ class SeparatedVariables(Coupler):
         """Solve the points ``todo`` without a table (into ``v``): a long curve of a non-separable
         fluid by interpolation between direct solves, the others directly."""
         ok = np.ones(q.shape, dtype=bool)
-        # what the direct solve found at the points without a root: J at the answer, or J(inf)
-        found = Integral.exact(np.zeros(q.shape))
-        points = np.zeros(0, dtype=int)
+        answered = np.zeros(q.shape, dtype=bool)
         if np.count_nonzero(todo) >= _CURVE_MIN_POINTS and scene.size == 1 and not scene.rheology.separable:
             sub = np.flatnonzero(todo)
             curve = self._curve(scene, q[sub])
@@ -404,14 +403,13 @@ class SeparatedVariables(Coupler):
                 v[sub] = curve
                 todo = todo.copy()
                 todo[sub] = False
-                points = sub
+                answered[sub] = True
         if np.any(todo):
             sub = np.flatnonzero(todo)
             v[sub], ok[sub], final = self._solve_J(scene, target[sub], sub, None if scene.rheology.separable else q[sub])
-            found = found.replaced(sub, final)
             warn_unconverged("the separated-variables integral", final, where=ok[sub])
-            points = np.union1d(points, sub[ok[sub]])
-        return _Direct(points=points, ok=ok, found=found)
+            answered[sub] = ok[sub]
+        return _Direct(points=np.flatnonzero(answered), ok=ok)
 
     def _curve(self, scene: Scene, q):
         r"""The inlet log-stretches of a long curve through one scene without a table (a non-separable
