@@ -72,7 +72,7 @@ def main(argv=None) -> int:
             result = run(rows[name], calls, points)
             got[name]["times"] += result["times"]
             got[name]["faults"] += result["faults"]
-    print(f"{points} random scenes (the "random scenes" row of benchmarks/speed.py), one broadcast call; {rounds} "
+    print(f"{points} random scenes (the random-scenes row of benchmarks/speed.py), one broadcast call; {rounds} "
           f"process{'es' if rounds > 1 else ''} x {calls} calls each")
     print(f"{'malloc':<22}{'ms per call (median)':>22}{'range':>16}{'minor faults per call (median)':>34}")
     medians = {}
