@@ -16,7 +16,7 @@ LATEST := .venv-latest
 UV_VERSION := 0.13.9
 LOCK_FLAGS ?= --upgrade
 
-.PHONY: demo test test-explore fuzz docs install test-latest lock clean
+.PHONY: demo test test-all test-explore fuzz docs install test-latest lock clean
 
 $(STAMP): $(LOCK) pyproject.toml $(PLUGINS)
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -35,8 +35,13 @@ demo: $(STAMP)
 # test-explore` draws new random examples on every run, ten times each test's own number, and
 # keeps failures in .hypothesis/ to replay them first; `make test-explore PYTEST_ARGS=tests/test_limits.py`
 # explores a part
+# `make test` leaves out the tests marked slow (long reference checks, the plugins' fuzz
+# contracts: a few minutes more); `make test-all` runs them too
 PYTEST_ARGS ?=
 test: $(STAMP)
+	TUBEFSI_HYPOTHESIS_PROFILE=ci MPLBACKEND=Agg $(PY) -m pytest -q -p no:cacheprovider -m "not slow" $(PYTEST_ARGS)
+
+test-all: $(STAMP)
 	TUBEFSI_HYPOTHESIS_PROFILE=ci MPLBACKEND=Agg $(PY) -m pytest -q -p no:cacheprovider $(PYTEST_ARGS)
 
 test-explore: $(STAMP)

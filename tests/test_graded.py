@@ -321,6 +321,7 @@ def test_other_typed_errors():
         tubefsi.sampled([0, L], [A0, A1], kind="cubic")
 
 
+@pytest.mark.slow
 def test_graded_beyond_the_limit_is_no_steady_state():
     """A graded shear-thinning flow above what the tube carries: the integration along z fails, and
     the NoSteadyStateError gives the maximum flow rate (that of
@@ -469,6 +470,7 @@ def _touch_reference(mu_of, n, m, q0, q1, a=A0, tb=TB, length=L):
     raise AssertionError("the reference did not converge")
 
 
+@pytest.mark.slow
 def test_graded_max_flow_rate_at_the_inlet():
     r"""A modulus rising along the tube, :math:`\mu = \mu_0(1 + z/L)`, with a shear-thinning fluid
     (n = 0.5): the pressure first reaches the local limit at the inlet; the maximum flow rate
@@ -492,6 +494,7 @@ def test_graded_max_flow_rate_at_the_inlet():
     assert sol.pressure_drop[0] < MU * math.log(1 + TB)
 
 
+@pytest.mark.slow
 def test_graded_pressure_beyond_a_soft_section_is_no_steady_state():
     r"""A sampled modulus dipping to half at mid-tube (a breakpoint): the pressure first touches the
     local limit there, so the largest inlet pressure with a steady state is that of the maximum

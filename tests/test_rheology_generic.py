@@ -329,6 +329,7 @@ def test_two_kinks_are_integrated_to_the_tolerance(tw):
 
 
 # ---------------------------------------------------------------- the flow table
+@pytest.mark.slow
 @pytest.mark.parametrize("law", [CarreauLike(), NewtonianBelow(), KinkedPowerLaw(),
                                  NewtonianBelow(eta0=1.0, index=1.8, tau_c=0.3)], ids=repr)
 def test_table_against_direct_integrals_over_many_decades(law):

@@ -83,6 +83,7 @@ def test_gent_stretch_beyond_the_lock_is_rejected():
         wall.stretch(1e3 * top, 0.3)
 
 
+@pytest.mark.slow
 class TestFuzz(FuzzContract):                  # typed errors or checked finite values, in bounded time
     rheologies = ()
     walls = tuple(NAMES)

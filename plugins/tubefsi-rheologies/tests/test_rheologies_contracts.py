@@ -94,6 +94,7 @@ def test_whole_curve_is_one_vectorized_call():
         assert single == pytest.approx(curve.pressure_drop[i], rel=1e-12)
 
 
+@pytest.mark.slow
 class TestFuzz(FuzzContract):                  # typed errors or checked finite values, in bounded time
     rheologies = tuple(NAMES)
     walls = ()
