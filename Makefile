@@ -36,16 +36,18 @@ demo: $(STAMP)
 # keeps failures in .hypothesis/ to replay them first; `make test-explore PYTEST_ARGS=tests/test_limits.py`
 # explores a part
 # `make test` leaves out the tests marked slow (long reference checks, the plugins' fuzz
-# contracts: a few minutes more); `make test-all` runs them too
+# contracts); `make test-all` runs them too. Tests run in one process per core (pytest-xdist;
+# `make test WORKERS=0` runs them in this process)
 PYTEST_ARGS ?=
+WORKERS ?= auto
 test: $(STAMP)
-	TUBEFSI_HYPOTHESIS_PROFILE=ci MPLBACKEND=Agg $(PY) -m pytest -q -p no:cacheprovider -m "not slow" $(PYTEST_ARGS)
+	TUBEFSI_HYPOTHESIS_PROFILE=ci MPLBACKEND=Agg $(PY) -m pytest -q -p no:cacheprovider -n $(WORKERS) -m "not slow" $(PYTEST_ARGS)
 
 test-all: $(STAMP)
-	TUBEFSI_HYPOTHESIS_PROFILE=ci MPLBACKEND=Agg $(PY) -m pytest -q -p no:cacheprovider $(PYTEST_ARGS)
+	TUBEFSI_HYPOTHESIS_PROFILE=ci MPLBACKEND=Agg $(PY) -m pytest -q -p no:cacheprovider -n $(WORKERS) $(PYTEST_ARGS)
 
 test-explore: $(STAMP)
-	TUBEFSI_HYPOTHESIS_PROFILE=explore MPLBACKEND=Agg $(PY) -m pytest -q -p no:cacheprovider $(PYTEST_ARGS)
+	TUBEFSI_HYPOTHESIS_PROFILE=explore MPLBACKEND=Agg $(PY) -m pytest -q -p no:cacheprovider -n $(WORKERS) $(PYTEST_ARGS)
 
 # the long fuzz campaign (docs/verification.md, "Fuzzing"): every bad-input probe of every
 # registered model and entry point and FUZZ_SCENES random valid scenes; prints the counts per
@@ -67,7 +69,7 @@ test-latest:
 	$(LATEST)/bin/python -m pip install --quiet --upgrade pip setuptools wheel
 	$(LATEST)/bin/python -m pip install --quiet --upgrade --upgrade-strategy eager \
 	  -e '.[test,verify,fem,docs,network,pandas,xarray,progress,units,parallel]' $(foreach p,$(PLUGINS),-e $(dir $(p)))
-	TUBEFSI_HYPOTHESIS_PROFILE=ci MPLBACKEND=Agg $(LATEST)/bin/python -m pytest -q -p no:cacheprovider
+	TUBEFSI_HYPOTHESIS_PROFILE=ci MPLBACKEND=Agg $(LATEST)/bin/python -m pytest -q -p no:cacheprovider -n $(WORKERS) -m "not slow"
 
 # uv, at a fixed version in a throw-away venv, writes the lock from PyPI (not pip's indexes)
 lock:
