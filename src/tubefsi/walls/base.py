@@ -91,7 +91,8 @@ class WallModel(abc.ABC):
                                                             :class:`~tubefsi.numerics.quadrature.Integral`;
                                                             a law that integrates returns its estimate
                                                             (the root finders warn only at the answer)
-    ``_shape_key()``, ``_pressure_scale()``, ``_unit_wall()``  None, 1, None: the opt-in split
+    ``_shape_key()``                                        None; with ``_pressure_scale()`` (1) and
+                                                            ``_unit_wall()`` (None), the opt-in split
                                                             ``P = scale * P_hat(stretch; tb, shape)`` that
                                                             lets one table serve every modulus (see below)
     ======================================================  ==============================================
