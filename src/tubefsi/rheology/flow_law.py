@@ -372,70 +372,86 @@ class FlowTable:
         each is held, or lies below the lowest panel the law resolves (the asymptote serves it)."""
         lowest = self._lowest()
         if not any(panel.finite for panel in self._panels.values()):
-            j = self._start(float(np.median(y)))
-            if not self._panel(j).finite:
-                # the secant landed outside the law's range (the finite panels are one run): past
-                # its end (the flow function overflows) back into it by steps doubling downward,
-                # then the run's last panel by bisection; below its floor, upward
-                beyond, step = j, 1
-                while j > lowest and not self._panel(j).finite:
-                    beyond, j, step = j, max(j - step, lowest), 2 * step
-                if not self._panel(j).finite:
-                    j, beyond = lowest, None
-                    while j < _P_LIMIT - 1 and not self._panel(j).finite:
-                        j += 1
-                while beyond is not None and beyond - j > 1 and self._panel(j).finite:
-                    mid = (j + beyond) // 2
-                    j, beyond = (mid, beyond) if self._panel(mid).finite else (j, mid)
-                if not self._panel(j).finite:
-                    raise InvalidParameterError(
-                        "rheology", "a law whose tube-flow function is finite somewhere", self.rheology,
-                        f"its tube-flow function is not finite for any natural parameter in [{lowest}, {_P_LIMIT}]")
+            self._first_finite(self._start(float(np.median(y))), lowest)
         for _ in range(4 * _P_LIMIT):
             run = sorted((panel for panel in self._panels.values() if panel.finite), key=lambda panel: panel.j)
-            lo = np.array([panel.y_lo for panel in run])
-            hi = np.array([panel.y_hi for panel in run])
-            k = np.clip(np.searchsorted(lo, y, side="right") - 1, 0, len(run) - 1)
-            # a panel holds lo <= y < hi (its upper end too where no panel can follow it): a load on
-            # the common end of two panels gets the upper one, whether or not it was built before
-            last = np.array([panel.j + 1 >= _P_LIMIT or not self._panels.get(panel.j + 1, panel).finite
-                             for panel in run])
-            held = (y >= lo[k]) & ((y < hi[k]) | ((y == hi[k]) & last[k]))
-            # below the first panel, and nothing resolvable below it: the asymptote's (the panel
-            # below is built only when a load needs it)
-            below = y < lo[0]
-            if np.any(below) and not (run[0].j <= lowest or not self._panel(run[0].j - 1).finite):
-                below[:] = False
-            above = y > hi[-1]
-            if np.any(above) and not (run[-1].j >= _P_LIMIT - 1 or not self._panel(run[-1].j + 1).finite):
-                above[:] = False
-            if np.any(above):
-                raise InvalidParameterError(
-                    "flow_rate", "a range the fluid can carry", None,
-                    f"4 q / (pi R^3) = {math.exp(min(float(y[above][0]), 709.0)):.6g} 1/s needs a wall shear stress "
-                    "beyond where its flow function ends")
-            wanted = set()
-            for i in np.unique(k[~held & ~below]):
-                targets = y[(k == i) & ~held & ~below]
-                panel = run[i]
-                if targets.max() >= panel.y_hi:        # above panel i: toward run[i + 1] (or beyond the last)
-                    step = (float(targets.max()) - panel.y_hi) / max(panel.slope_y, 1e-3)
-                    j = panel.j + 1 + int(step)
-                    if i + 1 < len(run):       # not past the next built panel: the secant between the two
-                        upper = run[i + 1]
-                        gap = upper.y_lo - panel.y_hi
-                        share = (float(targets.max()) - panel.y_hi) / gap if gap > 0 else 0.0
-                        j = min(j, panel.j + 1 + int(share * (upper.j - panel.j - 1)))
-                    wanted.add(min(max(j, panel.j + 1), _P_LIMIT - 1))
-                if targets.min() < panel.y_lo:         # below the first panel
-                    step = (panel.y_lo - float(targets.min())) / max(panel.slope_y, 1e-3)
-                    wanted.add(max(panel.j - 1 - int(step), lowest))
+            k, held, below = self._held(run, y, lowest)
+            wanted = self._wanted(run, y, k, ~held & ~below, lowest)
             if not wanted:
                 return run, k, below
             for j in wanted:
                 self._panel(j)
         raise ConvergenceError(f"the flow table of {self.rheology!r} does not reach ln Gamma in "
                                f"[{float(y.min()):.6g}, {float(y.max()):.6g}]")
+
+    def _first_finite(self, j, lowest):
+        """Build a first finite panel from the secant's guess ``j``: where the guess landed outside
+        the law's range (the finite panels are one run), past its end (the flow function overflows)
+        back into it by steps doubling downward, then the run's last panel by bisection; below its
+        floor, upward."""
+        if self._panel(j).finite:
+            return
+        beyond, step = j, 1
+        while j > lowest and not self._panel(j).finite:
+            beyond, j, step = j, max(j - step, lowest), 2 * step
+        if not self._panel(j).finite:
+            j, beyond = lowest, None
+            while j < _P_LIMIT - 1 and not self._panel(j).finite:
+                j += 1
+        while beyond is not None and beyond - j > 1 and self._panel(j).finite:
+            mid = (j + beyond) // 2
+            j, beyond = (mid, beyond) if self._panel(mid).finite else (j, mid)
+        if not self._panel(j).finite:
+            raise InvalidParameterError(
+                "rheology", "a law whose tube-flow function is finite somewhere", self.rheology,
+                f"its tube-flow function is not finite for any natural parameter in [{lowest}, {_P_LIMIT}]")
+
+    def _held(self, run, y, lowest):
+        """``(k, held, below)``: the panel of ``run`` each load falls in, whether it holds it, and
+        whether it is below the lowest panel the law resolves; a load above the last one is an error."""
+        lo = np.array([panel.y_lo for panel in run])
+        hi = np.array([panel.y_hi for panel in run])
+        k = np.clip(np.searchsorted(lo, y, side="right") - 1, 0, len(run) - 1)
+        # a panel holds lo <= y < hi (its upper end too where no panel can follow it): a load on
+        # the common end of two panels gets the upper one, whether or not it was built before
+        last = np.array([panel.j + 1 >= _P_LIMIT or not self._panels.get(panel.j + 1, panel).finite
+                         for panel in run])
+        held = (y >= lo[k]) & ((y < hi[k]) | ((y == hi[k]) & last[k]))
+        # below the first panel, and nothing resolvable below it: the asymptote's (the panel
+        # below is built only when a load needs it)
+        below = y < lo[0]
+        if np.any(below) and not (run[0].j <= lowest or not self._panel(run[0].j - 1).finite):
+            below[:] = False
+        above = y > hi[-1]
+        if np.any(above) and (run[-1].j >= _P_LIMIT - 1 or not self._panel(run[-1].j + 1).finite):
+            raise InvalidParameterError(
+                "flow_rate", "a range the fluid can carry", None,
+                f"4 q / (pi R^3) = {math.exp(min(float(y[above][0]), 709.0)):.6g} 1/s needs a wall shear stress "
+                "beyond where its flow function ends")
+        return k, held, below
+
+    @staticmethod
+    def _wanted(run, y, k, missing, lowest) -> set:
+        """The panels to build next for the loads ``missing``: per panel of ``run`` that misses
+        some, the one its slope points at above it (not past the next built panel: the secant
+        between the two) or below the first panel."""
+        wanted = set()
+        for i in np.unique(k[missing]):
+            targets = y[(k == i) & missing]
+            panel = run[i]
+            if targets.max() >= panel.y_hi:            # above panel i: toward run[i + 1] (or beyond the last)
+                step = (float(targets.max()) - panel.y_hi) / max(panel.slope_y, 1e-3)
+                j = panel.j + 1 + int(step)
+                if i + 1 < len(run):
+                    upper = run[i + 1]
+                    gap = upper.y_lo - panel.y_hi
+                    share = (float(targets.max()) - panel.y_hi) / gap if gap > 0 else 0.0
+                    j = min(j, panel.j + 1 + int(share * (upper.j - panel.j - 1)))
+                wanted.add(min(max(j, panel.j + 1), _P_LIMIT - 1))
+            if targets.min() < panel.y_lo:             # below the first panel
+                step = (panel.y_lo - float(targets.min())) / max(panel.slope_y, 1e-3)
+                wanted.add(max(panel.j - 1 - int(step), lowest))
+        return wanted
 
     # ------------------------------------------------------------ lookups
     def wall_stress(self, rheology, apparent_rate):
