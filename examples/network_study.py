@@ -95,7 +95,7 @@ def run(samples, batch, serial=False):
     except ImportError:
         return [row for part in parts for row in solve_batch(part)], "serially in this process"
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
-            Client(cluster) as client:
+            Client(cluster):
         bag = db.from_sequence(parts, npartitions=len(parts))
         rows = bag.map(solve_batch).flatten().compute()      # on the client's cluster
     return sorted(rows), "on a dask LocalCluster of 2 workers"
