@@ -55,6 +55,10 @@ class State(NamedTuple):
         """Every field as a float array of ``n`` entries (broadcast, not copied), by name."""
         return {name: np.broadcast_to(np.asarray(value, dtype=float), (n,)) for name, value in zip(self._fields, self)}
 
+    def first(self) -> State:
+        """The state of the first (for one point: the only) entry of its arrays, as floats."""
+        return State(*(float(np.ravel(value)[0]) for value in self))
+
     def take(self, index) -> State:
         """The state at the entries ``index`` of its (flat) arrays."""
         n = np.size(self.flow_rate)

@@ -223,7 +223,7 @@ def _solve_point(runner, scene, chosen, name, controlled, load, on_infeasible, d
             state = runner.flow_controlled_point(scene, load)
         else:
             state, feasible = _run(runner, scene, controlled, np.array([load], dtype=float), on_infeasible)
-            state = State(*(float(np.ravel(value)[0]) for value in state))
+            state = state.first()
             feasible = None if feasible is None else bool(np.ravel(feasible)[0])
     except OverflowError:                  # a scene beyond double precision: a typed error
         raise _beyond_range(controlled, load, "an intermediate quantity overflows") from None

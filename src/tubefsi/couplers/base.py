@@ -53,8 +53,6 @@ from ..scene import State
 
 __all__ = ["Coupler"]
 
-_STATE_FIELDS = State._fields
-
 
 def _flow_index(rheology, flow_rate, radius):
     return rheology._flow_index(flow_rate, radius)
@@ -89,8 +87,7 @@ class Coupler(abc.ABC):
         """One flow rate (a float) through a scene of scalars: a ``State`` of floats. The default is
         :meth:`flow_controlled` of a one-point array; a coupler with a cheaper way for one point
         overrides it (it must give the bits :meth:`flow_controlled` gives a one-point array)."""
-        state = self.flow_controlled(scene, np.array([flow_rate], dtype=float))
-        return State(*(float(np.ravel(getattr(state, name))[0]) for name in _STATE_FIELDS))
+        return self.flow_controlled(scene, np.array([flow_rate], dtype=float)).first()
 
     @abc.abstractmethod
     def pressure_controlled(self, scene, pressure_drop):
