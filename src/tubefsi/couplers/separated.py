@@ -304,9 +304,13 @@ class SeparatedVariables(Coupler):
         k = points.rheology.radius_exponent
         return k * np.log(points.radius) + np.log(points.wall._pressure_scale())
 
-    def _table_point(self, scene: Scene, table, q: float):
-        """``(q, rise, strain, v)`` of one positive flow rate through a scene of scalars from its
-        table, in plain Python (floats), or None where the table leaves it to the direct path."""
+    def _table_point(self, scene: Scene, q: float):
+        """The :class:`State` of one positive flow rate through a scene of scalars from its table,
+        in plain Python (floats), or None where it has none or the table leaves it to the direct
+        path."""
+        table = self._table(scene, 1)
+        if table is None:
+            return None
         rheology, tube = scene.rheology, scene.tube
         scale = scene.wall._pressure_scale()
         x = (rheology._log_flow_factor(q) + math.log(tube.length) - rheology.radius_exponent * math.log(tube.radius)
@@ -336,11 +340,9 @@ class SeparatedVariables(Coupler):
         """One flow rate through a scene of scalars: from its table in plain Python where it has one
         (the operations of :meth:`flow_controlled` on a one-point array), else as that array."""
         if flow_rate > 0.0 and not scene.wall.is_rigid:
-            key = table_key(self, scene)
-            if key is not None:
-                answer = self._table_point(scene, TABLES.get(key, SeparatedTable), flow_rate)
-                if answer is not None:
-                    return answer
+            answer = self._table_point(scene, flow_rate)
+            if answer is not None:
+                return answer
         return super().flow_controlled_point(scene, flow_rate)
 
     def solve_feasible(self, scene: Scene, load, controlled: str):
@@ -355,11 +357,11 @@ class SeparatedVariables(Coupler):
         (a long curve of a non-separable fluid), else the direct solution."""
         if scene.wall.is_rigid:
             return _rigid_state(scene, flow_rate=q), None
-        table = self._table(scene, q.size)
-        if table is not None and q.size == 1 and scene.size == 1 and q.reshape(-1)[0] > 0.0:
-            answer = self._table_point(scene, table, float(q.reshape(-1)[0]))
+        if q.size == 1 and scene.size == 1 and q.reshape(-1)[0] > 0.0:     # (flow_controlled_point's route)
+            answer = self._table_point(scene, float(q.reshape(-1)[0]))
             if answer is not None:
                 return answer, None
+        table = self._table(scene, q.size)
         pts = scene.at(np.arange(q.size))
         v, rise = np.zeros(q.shape), np.zeros(q.shape)
         todo = q > 0                           # (the points no route has answered yet)
