@@ -130,10 +130,6 @@ class Registry(Mapping):
             return entries.get(name)
 
     def __getitem__(self, name: str) -> type:
-        entries = self._entries                  # a resolved name: one dictionary lookup, no lock
-        obj = None if entries is None else entries.get(name)
-        if obj is not None:
-            return obj
         obj = self._get(name)
         if obj is None:
             raise KeyError(f"{name!r} is not a registered {self.group.split('.')[-1][:-1]}; "
