@@ -40,6 +40,7 @@ import numpy as np
 
 from ._units import is_quantity, to_si
 from .errors import InvalidParameterError
+from .numerics.cache import keep_on_class
 from .profiles import Profile, as_profile
 
 __all__ = ["real", "positive", "nonnegative", "choice", "Parameter", "parameters", "parameter_shape",
@@ -245,17 +246,14 @@ def parameters(model) -> tuple[Parameter, ...]:
 # ------------------------------------------------------------------------- arrays of parameters
 def _array_fields(cls) -> tuple[str, ...]:
     """The names of the fields of ``cls`` that may hold arrays (declared with :func:`real`), read
-    off attrs' field list once and kept on the class itself, as attrs keeps that list (no
-    module-level cache, which would keep a class made at run time alive)."""
+    off attrs' field list once and kept on the class
+    (:func:`~tubefsi.numerics.cache.keep_on_class`)."""
     found = cls.__dict__.get("_tubefsi_array_fields")
-    if found is None:
-        fields = getattr(cls, "__attrs_attrs__", None)
-        found = () if fields is None else tuple(f.name for f in fields if f.metadata.get("array"))
-        try:
-            type.__setattr__(cls, "_tubefsi_array_fields", found)
-        except TypeError:                  # a class that takes no attributes: computed each time
-            pass
-    return found
+    if found is not None:
+        return found
+    fields = getattr(cls, "__attrs_attrs__", None)
+    return keep_on_class(cls, "_tubefsi_array_fields",
+                         () if fields is None else tuple(f.name for f in fields if f.metadata.get("array")))
 
 
 def parameter_shape(model) -> tuple[int, ...]:

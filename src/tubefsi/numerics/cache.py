@@ -15,7 +15,7 @@ import threading
 
 import attrs
 
-__all__ = ["TableCache", "CacheInfo", "TABLES", "plain", "instance_values"]
+__all__ = ["TableCache", "CacheInfo", "TABLES", "plain", "instance_values", "keep_on_class"]
 
 _PLAIN = (float, int, str, bool, type(None))
 
@@ -31,23 +31,30 @@ def plain(value) -> bool:
     return type(value) in _PLAIN
 
 
+def keep_on_class(cls, name: str, value):
+    """Keep ``value``, derived from the class ``cls`` alone, on the class itself as ``name`` (as
+    attrs keeps its field list there: no module-level cache, which would keep a class made at run
+    time alive) and return it. A caller reads it back with ``cls.__dict__.get(name)`` (the class's
+    own, not a base's); a class that takes no attributes has it computed on every call."""
+    try:
+        type.__setattr__(cls, name, value)
+    except TypeError:
+        pass
+    return value
+
+
 def _slot_names(cls) -> tuple:
-    """The names of the slots the instances of ``cls`` have, across its classes (kept on the class,
-    as :func:`tubefsi.fields._array_fields` keeps its list)."""
+    """The names of the slots the instances of ``cls`` have, across its classes."""
     found = cls.__dict__.get("_tubefsi_slot_names")
-    if found is None:
-        names = []
-        for klass in reversed(cls.__mro__):
-            slots = klass.__dict__.get("__slots__", ())
-            for name in ((slots,) if isinstance(slots, str) else slots):
-                if name not in ("__dict__", "__weakref__") and name not in names:
-                    names.append(name)
-        found = tuple(names)
-        try:
-            type.__setattr__(cls, "_tubefsi_slot_names", found)
-        except TypeError:                  # a class that takes no attributes: computed each time
-            pass
-    return found
+    if found is not None:
+        return found
+    names = []
+    for klass in reversed(cls.__mro__):
+        slots = klass.__dict__.get("__slots__", ())
+        for name in ((slots,) if isinstance(slots, str) else slots):
+            if name not in ("__dict__", "__weakref__") and name not in names:
+                names.append(name)
+    return keep_on_class(cls, "_tubefsi_slot_names", tuple(names))
 
 
 def instance_values(obj):
