@@ -229,7 +229,8 @@ class HyperelasticWall(WallModel):
     ================================  ================================================================
 
     The theory (:class:`ThinWall` with a ``thickness_convention``, or :class:`ThickWall`) gives
-    ``_pressure_at_strain`` and ``_stiffness``; the :class:`~tubefsi.walls.WallModel` hooks
+    ``_integral_pressure`` (the pressure with its error estimate, from which ``_pressure_at_strain``
+    follows unless a closed form overrides it) and ``_stiffness``; the :class:`~tubefsi.walls.WallModel` hooks
     (``_limit_pressure``, ``_max_stretch``, ...) may be overridden as for any wall.
     """
 
@@ -432,8 +433,22 @@ class HyperelasticWall(WallModel):
             return True
         return self._uses_invariants() and type(self)._W_second is not HyperelasticWall._W_second
 
+    #: What the theory's integral is called in an ``AccuracyWarning`` (:class:`ThinWall`, :class:`ThickWall`).
+    _INTEGRAL = "the wall's integral"
+
+    def _pressure_at_strain(self, strain, tb):
+        result = self._integral_pressure(strain, tb)
+        warn_unconverged(self._INTEGRAL, result)
+        return result.value
+
+    def _pressure_estimate(self, strain, tb):
+        if type(self)._pressure_at_strain is not HyperelasticWall._pressure_at_strain:   # a closed form overrides it
+            return Integral.exact(self._pressure_at_strain(strain, tb))
+        return self._integral_pressure(strain, tb)
+
     @abc.abstractmethod
-    def _pressure_at_strain(self, strain, tb): ...
+    def _integral_pressure(self, strain, tb) -> Integral:
+        """The pressure at hoop strain by the theory's own formula, with its error estimate."""
 
 
 @attrs.frozen(kw_only=True, slots=False)
@@ -461,14 +476,9 @@ class ThinWall(HyperelasticWall):
     #: Below this hoop strain, :math:`\hat W'(1 + \varepsilon)` is integrated from the strain itself.
     _SMALL_STRAIN = 0.1
 
-    def _pressure_at_strain(self, strain, tb):
-        result = self._pressure_estimate(strain, tb)
-        warn_unconverged("the thin-wall law at small strain", result)
-        return result.value
+    _INTEGRAL = "the thin-wall law at small strain"
 
-    def _pressure_estimate(self, strain, tb):
-        if type(self)._pressure_at_strain is not ThinWall._pressure_at_strain:     # a closed form overrides it
-            return Integral.exact(self._pressure_at_strain(strain, tb))
+    def _integral_pressure(self, strain, tb):
         lam = 1.0 + strain
         dw = self._dW_at_strain(strain)
         p = tb * dw.value
@@ -535,14 +545,9 @@ class ThickWall(HyperelasticWall):
     #: Relative tolerance of the Lamé integral (its error estimate is checked, ``AccuracyWarning`` beyond).
     _RTOL = 1e-14
 
-    def _pressure_at_strain(self, strain, tb):
-        result = self._lame(strain, tb)
-        warn_unconverged("the thick-wall (Lamé) integral", result)
-        return result.value
+    _INTEGRAL = "the thick-wall (Lamé) integral"
 
-    def _pressure_estimate(self, strain, tb):
-        if type(self)._pressure_at_strain is not ThickWall._pressure_at_strain:     # a closed form overrides it
-            return Integral.exact(self._pressure_at_strain(strain, tb))
+    def _integral_pressure(self, strain, tb):
         return self._lame(strain, tb)
 
     def _lame(self, strain, tb) -> Integral:
