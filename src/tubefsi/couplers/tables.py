@@ -142,9 +142,7 @@ class SeparatedTable:
         """``(y, w)`` at one float ``x``, or None where its panel leaves it to the direct path."""
         x_inf, x_far, u_far = self.limit(coupler, scene)
         if -745.0 < x < x_far and x < 710.0:
-            found = self._panels.get(("x", math.floor(x)), self)
-            if found is self:
-                found = self.panel("x", math.floor(x), coupler, scene)
+            found = self.panel("x", math.floor(x), coupler, scene)
             return None if found is None else found.scalar(x)
         if not x_far <= x < x_inf:
             return None
