@@ -140,11 +140,11 @@ class Scene:
             else:
                 gauge = np.add(p_out, p_e)
                 gauge = float(gauge) if np.ndim(gauge) == 0 else gauge
-            object.__setattr__(self, "gauge_outlet_pressure", gauge)
+            self.gauge_outlet_pressure = gauge
         shapes = [parameter_shape(self.rheology), parameter_shape(self.wall), parameter_shape(self.tube)]
         shapes += [np.shape(v) for v in (p_out, p_e, self.gauge_outlet_pressure) if type(v) is not float]
-        object.__setattr__(self, "shape", np.broadcast_shapes(*shapes) if any(shapes) else ())
-        object.__setattr__(self, "graded", self.tube.graded or varies(self.wall))
+        self.shape = np.broadcast_shapes(*shapes) if any(shapes) else ()
+        self.graded = self.tube.graded or varies(self.wall)
         if self.graded:                     # the outlet state of the tube law at z = L
             wall, tb = self.at_outlet()
             strain = wall.strain(p_out, tb) if np.any(np.asarray(p_out) != 0) else 0.0
@@ -152,15 +152,15 @@ class Scene:
         else:                               # the outlet state, once: every J evaluation needs it
             strain = self._outlet_strain()
             lam_max = self._max_stretch()
-        object.__setattr__(self, "outlet_strain", strain)
-        object.__setattr__(self, "outlet_stretch", 1.0 + strain)
+        self.outlet_strain = strain
+        self.outlet_stretch = 1.0 + strain
         if type(lam_max) is float and type(strain) is float:
             v_max = math.log(lam_max / (1.0 + strain)) if lam_max < math.inf else math.inf
         else:
             with np.errstate(divide="ignore"):
                 v_max = np.log(np.asarray(lam_max, dtype=float) / (1.0 + np.asarray(strain)))
             v_max = float(v_max) if v_max.ndim == 0 else v_max
-        object.__setattr__(self, "log_stretch_max", v_max)
+        self.log_stretch_max = v_max
 
     def _outlet_strain(self):
         """The hoop strain under the (transmural) outlet pressure: 0 where it is 0."""
@@ -284,7 +284,7 @@ class Scene:
                 if any(getattr(self, name) is m for m in grouped):
                     model = getattr(part, name)
                     scalar = _replace(model, {k: float(v[0]) for k, v in _array_values(model).items()})
-                    object.__setattr__(part, name, scalar)
+                    setattr(part, name, scalar)
             parts.append((index, _refresh(part)))
         return parts
 
@@ -320,14 +320,14 @@ def _evolve_arrays(scene, transform):
     new = object.__new__(Scene)
     for name, value in (("rheology", models(scene.rheology)), ("wall", models(scene.wall)),
                         ("tube", models(scene.tube))):
-        object.__setattr__(new, name, value)
+        setattr(new, name, value)
     for name in ("outlet_pressure", "external_pressure", "gauge_outlet_pressure", "outlet_strain", "outlet_stretch",
                  "log_stretch_max"):
         value = getattr(scene, name)
-        object.__setattr__(new, name, transform(np.asarray(value)) if np.ndim(value) else value)
+        setattr(new, name, transform(np.asarray(value)) if np.ndim(value) else value)
     probe = transform(np.zeros(scene.shape)) if scene.shape else None
-    object.__setattr__(new, "shape", np.shape(probe) if probe is not None else ())
-    object.__setattr__(new, "graded", scene.graded)
+    new.shape = np.shape(probe) if probe is not None else ()
+    new.graded = scene.graded
     return new
 
 
@@ -337,7 +337,7 @@ def _refresh(scene):
                                 parameter_shape(scene.tube), np.shape(scene.outlet_pressure),
                                 np.shape(scene.external_pressure), np.shape(scene.gauge_outlet_pressure),
                                 np.shape(scene.outlet_strain), np.shape(scene.log_stretch_max))
-    object.__setattr__(scene, "shape", shape)
+    scene.shape = shape
     return scene
 
 
