@@ -113,10 +113,10 @@ class SeparatedTable:
         self._panels = {}               # ("x", j) or ("u", i) -> PiecewisePolynomial of (y, w), or None
         self._lock = threading.Lock()
         self._view = None               # the x-panels last evaluated together, joined (evaluate)
-        self._limit = None              # (x_inf, x_far, u_far), from the unit scene's J(inf)
+        self._limit = None              # (x_inf, x_far), from the unit scene's J(inf)
 
     def limit(self, coupler, scene) -> tuple:
-        """``(x_inf, x_far, u_far)`` of this key (computed once, on the unit scene)."""
+        """``(x_inf, x_far)`` of this key (computed once, on the unit scene)."""
         found = self._limit
         if found is None:
             with self._lock:
@@ -140,13 +140,13 @@ class SeparatedTable:
 
     def scalar(self, x: float, coupler, scene):
         """``(y, w)`` at one float ``x``, or None where its panel leaves it to the direct path."""
-        x_inf, x_far, u_far = self.limit(coupler, scene)
+        x_inf, x_far = self.limit(coupler, scene)
         if -745.0 < x < x_far and x < 710.0:
             found = self.panel("x", math.floor(x), coupler, scene)
             return None if found is None else found.scalar(x)
         if not x_far <= x < x_inf:
             return None
-        u = -math.log(-math.expm1(x - x_inf)) - u_far
+        u = -math.log(-math.expm1(x - x_inf)) - _U_FAR
         if not u < _RUNAWAY_PANELS:
             return None
         found = self.panel("u", math.floor(u), coupler, scene)
@@ -157,7 +157,7 @@ class SeparatedTable:
         Where every ``x``-panel the points need is accepted, one lookup over their joined panels
         (:meth:`~tubefsi.numerics.chebyshev.PiecewisePolynomial.join`: the same coefficients,
         the same bits), else one pass per panel; the runaway panels one pass per panel."""
-        x_inf, x_far, u_far = self.limit(coupler, scene)
+        x_inf, x_far = self.limit(coupler, scene)
         y, w = np.zeros(x.shape), np.zeros(x.shape)
         served = np.zeros(x.shape, dtype=bool)
         near = (x >= x_far) & (x < x_inf)
@@ -167,7 +167,7 @@ class SeparatedTable:
         near = np.flatnonzero(near)
         if near.size:
             with np.errstate(divide="ignore"):
-                u = -np.log(-np.expm1(x[near] - x_inf)) - u_far
+                u = -np.log(-np.expm1(x[near] - x_inf)) - _U_FAR
             self._evaluate_panels("u", u, near, coupler, scene, y, w, served, u < _RUNAWAY_PANELS)
         return y, w, served
 
@@ -211,30 +211,30 @@ _U_FAR = 1.0
 
 
 def _limit(coupler, unit) -> tuple:
-    """``(x_inf, x_far, u_far)``: ``ln J_hat(inf)`` of the unit scene (``inf`` where it is not
-    finite or not converged: then every panel is in ``x``) and where the runaway panels start, in
-    ``x`` and in ``u`` (at ``u = 1``: closer to ``x_inf`` the ``x``-panels would need ever more
+    """``(x_inf, x_far)``: ``ln J_hat(inf)`` of the unit scene (``inf`` where it is not finite or
+    not converged: then every panel is in ``x``) and where the runaway panels start in ``x``
+    (at ``u = _U_FAR = 1``: closer to ``x_inf`` the ``x``-panels would need ever more
     subpanels, and closer to ``x_far`` the ``u``-panels, as ``u ~ ln(x_inf - x)`` there)."""
     with np.errstate(all="ignore"):
         found = coupler._J_infinity(unit, np.zeros(1, dtype=int))
     value = float(np.ravel(found.value)[0])
     if not (0.0 < value < math.inf and bool(np.all(found.converged))):
-        return math.inf, math.inf, math.inf
+        return math.inf, math.inf
     x_inf = math.log(value)
-    return x_inf, x_inf + math.log(-math.expm1(-_U_FAR)), _U_FAR
+    return x_inf, x_inf + math.log(-math.expm1(-_U_FAR))
 
 
 def _build(coupler, unit, kind, i, limit):
     """The interpolant of ``(ln v, ln P_hat)`` on panel ``i`` in ``x`` (``[i, i + 1]``, the last one
-    ending at ``x_far``) or in the runaway variable ``u`` (``[u_far + i, u_far + i + 1]``, shifted
+    ending at ``x_far``) or in the runaway variable ``u`` (``[1 + i, 2 + i]``, shifted
     to ``[i, i + 1]``) from ``coupler``'s direct answers on the unit scene, or None where it
     cannot be accepted."""
     tb = unit.tb
-    x_inf, x_far, u_far = limit
+    x_inf, x_far = limit
     j_inf = math.exp(x_inf) if x_inf < math.inf else math.inf
 
     def answers(t):
-        target = np.exp(t) if kind == "x" else -j_inf * np.expm1(-(t + u_far))
+        target = np.exp(t) if kind == "x" else -j_inf * np.expm1(-(t + _U_FAR))
         v, ok, final = coupler._solve_J(unit, target, np.zeros(t.size, dtype=int))
         estimate = unit.wall._pressure_estimate(np.expm1(v), tb)
         good = ok & np.asarray(final.converged) & np.asarray(estimate.converged) & (v > 0)
@@ -244,7 +244,7 @@ def _build(coupler, unit, kind, i, limit):
     hi = min(float(i + 1), x_far) if kind == "x" else float(i + 1)
     # in u, the answers themselves are only as accurate as J (relative 1e-14) allows: the problem's
     # condition number, 1/(1 - T/J_inf) = e^u, amplifies it; the panel's tolerance follows
-    tol = TOL if kind == "x" else TOL * math.exp(u_far + hi)
+    tol = TOL if kind == "x" else TOL * math.exp(_U_FAR + hi)
     with np.errstate(all="ignore"):
         fitted, _ = fit_piecewise(answers, float(i), hi, degree=8, tol=tol, panels=2, max_panels=_MAX_SUBPANELS)
     return fitted
