@@ -451,12 +451,13 @@ def test_huge_loads_take_a_bounded_number_of_evaluations(law):
 
 
 def test_loads_beyond_the_flow_functions_range_cost_little():
-    """Where the law's flow function overflows (its Rabinowitsch–Mooney integral, beyond ~1e58 Pa)
-    the table ends: a huge load is an InvalidParameterError after a bounded number of evaluations.
-    The first panel's secant lands beyond the range; the table steps back by doubling steps and
-    bisects for the range's last panel: at most ~21 panels tried (2 evaluations each where the
-    flow function is not finite, up to 25 where it is), 110 measured."""
-    law = RateOnlyHerschelBulkley(consistency=0.31)
+    """Where the law's flow function overflows (a shear-thickening law, index 2: its shear rate
+    beyond ~1e154 Pa) the table ends: a huge load is an InvalidParameterError after a bounded number
+    of evaluations. The first panel's secant lands beyond the range; the table steps back by
+    doubling steps and bisects for the range's last panel: at most ~21 panels tried (2 evaluations
+    each where the flow function is not finite, up to 25 where it is), 324 measured. (A thinning law
+    no longer ends before its apparent shear rate does: the integrand is scaled by the wall stress.)"""
+    law = RateOnlyHerschelBulkley(consistency=0.31, index=2.0)
     with pytest.raises(InvalidParameterError, match="flow_rate"):
         law.pressure_gradient(1e200, 1e-4)
     assert flow_table(law).evaluations <= 2 + 21 * 25

@@ -108,26 +108,32 @@ class Rheology(abc.ABC):
     def stress(self, shear_rate):
         """Shear stress (Pa) at shear rate ``shear_rate`` (1/s, >= 0)."""
         g = as_array("shear_rate", shear_rate, "[0, inf)", lambda a: a >= 0)
-        return self._evaluate(lambda m, g: _masked(m, "_stress", g > 0, g), g)
+        with _quiet():
+            return _finite_result("shear_rate", g, "stress",
+                                  self._evaluate(lambda m, g: _masked(m, "_stress", g > 0, g), g))
 
     def shear_rate(self, stress):
         """Shear rate (1/s) at shear stress ``stress`` (Pa, >= 0)."""
         t = as_array("stress", stress, "[0, inf)", lambda a: a >= 0)
-        return self._evaluate(lambda m, t: _masked(m, "_shear_rate", t > 0, t), t)
+        with _quiet():
+            return _finite_result("stress", t, "shear rate",
+                                  self._evaluate(lambda m, t: _masked(m, "_shear_rate", t > 0, t), t))
 
     def apparent_viscosity(self, shear_rate):
         r"""Apparent viscosity :math:`\eta = \tau/\dot\gamma` (Pa s), shear rate > 0."""
         g = as_array("shear_rate", shear_rate, "(0, inf)", lambda a: a > 0)
-        return self._evaluate(lambda m, g: m._stress(g) / g, g)
+        with _quiet():
+            return _finite_result("shear_rate", g, "apparent viscosity",
+                                  self._evaluate(lambda m, g: m._stress(g) / g, g))
 
     def flow_rate(self, radius, pressure_gradient):
         r"""Flow rate :math:`q(R, G)` (m^3/s) in a rigid tube of radius ``radius`` (m)
         under pressure gradient :math:`G = -dp/dz` (Pa/m)."""
         r = as_array("radius", radius, "(0, inf)", lambda a: a > 0)
         g = as_array("pressure_gradient", pressure_gradient, "[0, inf)", lambda a: a >= 0)
-        out = self._evaluate(lambda m, r, g: _masked(m, "_flow_rate", g > 0, r, g), r, g)
-        _finite_result("pressure_gradient", g, "flow rate", out)
-        return out
+        with _quiet():
+            out = self._evaluate(lambda m, r, g: _masked(m, "_flow_rate", g > 0, r, g), r, g)
+        return _finite_result("pressure_gradient", g, "flow rate", out)
 
     def pressure_gradient(self, flow_rate, radius):
         r"""Pressure gradient :math:`G(q, R) = -dp/dz` (Pa/m) that drives ``flow_rate`` (m^3/s)."""
@@ -145,8 +151,10 @@ class Rheology(abc.ABC):
         rb, bb = np.broadcast_arrays(rr, big_r)
         if np.any(rb > bb * (1 + 1e-12)):
             raise _invalid("r", "[0, radius]", rb[rb > bb * (1 + 1e-12)].flat[0])
-        return self._evaluate(lambda m, rr, big_r, g: _masked(
-            m, "_velocity", g > 0, np.minimum(rr, big_r), big_r, g), rr, big_r, g)
+        with _quiet():
+            out = self._evaluate(lambda m, rr, big_r, g: _masked(
+                m, "_velocity", g > 0, np.minimum(rr, big_r), big_r, g), rr, big_r, g)
+        return _finite_result("pressure_gradient", g, "velocity", out)
 
     # ------------------------------------------------------------------ hooks
     def _stress(self, shear_rate):
@@ -175,7 +183,12 @@ class Rheology(abc.ABC):
     def _flow_rate(self, radius, pressure_gradient):
         if self.separable:
             return self._flow_factor_inverse(pressure_gradient / self._radius_factor(radius))
-        return 0.25 * math.pi * radius**3 * self._apparent_shear_rate(0.5 * pressure_gradient * radius)
+        tau_w = 0.5 * pressure_gradient * radius
+        with np.errstate(invalid="ignore"):
+            rate = self._apparent_shear_rate(tau_w)
+        # a wall stress beyond the doubles carries a flow beyond them (inf, where the closed forms'
+        # ratios of stresses are inf/inf): the caller's typed error, not a NaN that reads as no flow
+        return 0.25 * math.pi * radius**3 * np.where(tau_w == math.inf, math.inf, rate)
 
     def _rabinowitsch_mooney(self, radius, pressure_gradient):
         """The generic flow function (quadrature), whatever the subclass overrides."""
@@ -275,12 +288,14 @@ class Rheology(abc.ABC):
             span = rate_w - rate_r
 
             def f(u, idx):
-                return tw[idx, None] - self._stress(_positive(rate_r[idx, None] + span[idx, None] * u))
+                # tau(g) <= tau_w inside the tube: a rounding above it counts nothing (no negative velocity)
+                return np.maximum(tw[idx, None] - self._stress(_positive(rate_r[idx, None] + span[idx, None] * u)), 0.0)
 
             # tau_w - tau(g) is rounded to a few eps tau_w: near the wall that is all there is of it
             res = unit_integral(f, live.size, rounding=lambda idx: 4.0 * np.finfo(float).eps * tw[idx])
-            gap = 0.5 * g[live] * (radius[live] - r[live])          # tau_w - tau_r, exactly
-            out[live] = (2.0 / g[live]) * (span * res.value + rate_r * gap)
+            # (2/G) times each term, with 2 gap / G = R - r: no product of a shear rate and a
+            # stress, which leaves the doubles long before the velocity does
+            out[live] = span * (2.0 * (res.value / g[live])) + rate_r * (radius[live] - r[live])
             check("the velocity integral", (res, live))
         return out.reshape(shape)
 
@@ -350,14 +365,22 @@ def _masked(model, hook, mask, *args):
     return out
 
 
+def _quiet():
+    """The public methods evaluate the law quietly: a result beyond the doubles is a typed error
+    (:func:`_finite_result`), and an intermediate overflow of a form that stays finite is no news."""
+    return np.errstate(over="ignore", invalid="ignore", divide="ignore")
+
+
 def _finite_result(name, value, what, result):
-    """Raise :class:`InvalidParameterError` naming ``name`` where ``result`` is not a finite double."""
+    """``result``; :class:`InvalidParameterError` naming ``name`` where it is not a finite double
+    (the true value leaves double precision: the forms are written to stay finite wherever it does)."""
     ok = np.isfinite(result)
-    if not np.all(ok):
-        i = int(np.argmax(~np.ravel(ok)))
-        raise InvalidParameterError(name, f"values whose {what} is a finite double",
-                                    float(np.broadcast_to(value, np.shape(result)).ravel()[i]),
-                                    f"the {what} would be {np.ravel(result)[i]!r}")
+    if np.all(ok):
+        return result
+    i = int(np.argmax(~np.ravel(ok)))
+    raise InvalidParameterError(name, f"values whose {what} is a finite double",
+                                float(np.broadcast_to(value, np.shape(result)).ravel()[i]),
+                                f"the {what} would be {np.ravel(result)[i]!r}")
 
 
 def _positive(x):

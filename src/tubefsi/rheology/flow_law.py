@@ -108,8 +108,11 @@ def rate_natural_rate(rheology, wall_stress, excess=None, *, rtol: float = RTOL)
     el, tl = ex[live], tw[live]
 
     def f(u, idx):
+        # tau^2 over tau_w^2 (the integral is over the unit interval): no square of a stress
+        # beyond the doubles however large tau_w
         tau = tau_y + el[idx, None] * u
-        return tau * tau * rheology._shear_rate(tau)
+        ratio = tau / tl[idx, None]
+        return ratio * ratio * rheology._shear_rate(tau)
 
     def rounding(u, idx):
         # the law gets tau, not tau - tau_y: its shear rate carries the rounding of tau_y + excess u,
@@ -117,7 +120,7 @@ def rate_natural_rate(rheology, wall_stress, excess=None, *, rtol: float = RTOL)
         return 4.0 * _EPS * tau_y / np.maximum(el[idx, None] * u, _TINY)
 
     res = unit_integral(f, live.size, rtol=rtol, relative_rounding=rounding)
-    out[live] = 4.0 * el * res.value / tl**3
+    out[live] = 4.0 * el * res.value / tl
     return out.reshape(shape), (res, live)
 
 
@@ -137,7 +140,9 @@ def stress_natural_rate(rheology, wall_rate, wall_stress, *, rtol: float = RTOL)
 
     def f(t, idx):
         ratio = rheology._stress(_positive(rl[idx, None] * t)) / tl[idx, None]
-        return 1.0 - ratio * ratio * ratio
+        # tau(rate_w t) <= tau_w in the tube: a ratio a rounding above 1 (the wall rate is a root
+        # of tau(rate) = tau_w to a few eps) counts nothing, not a negative flow
+        return np.maximum(1.0 - ratio * ratio * ratio, 0.0)
 
     # 1 - ratio^3 is rounded to a few eps absolute where ratio ~ 1: near yield it is small
     # everywhere, and this floor is all the accuracy there is
@@ -212,7 +217,8 @@ class FlowTable:
         # a yield-stress fluid's table ends where tau_w - tau_y is below eps tau_y / 8 (a closed
         # form, given the excess) or sqrt(eps) tau_y (a law that gets or gives only tau)
         floor = _EPS / 8.0 if self.closed_form else math.sqrt(_EPS)
-        self._s_floor = math.log(self.yield_stress * floor) if self.yield_stress > 0 else -float(_P_LIMIT)
+        # (a sum of logs: the product underflows for a subnormal yield stress)
+        self._s_floor = math.log(self.yield_stress) + math.log(floor) if self.yield_stress > 0 else -float(_P_LIMIT)
 
     # ------------------------------------------------------------ exact flow function
     def _exact(self, p):

@@ -143,10 +143,14 @@ class _PowerLawForms(Rheology):
         return super()._log_gradient_derivative(parameter, flow_rate, radius)
 
     def _velocity(self, r, radius, pressure_gradient):
+        # v = n/(n+1) R (tau_w/m)^(1/n) (1 - (r/R)^k), tau_w = G R/2, k = 1 + 1/n: the powers of the
+        # wall stress and of r/R (<= 1) only, so a double wherever v is (R^k alone overflows at
+        # R = 1e300, (G/2m)^(1/n) at G = 1e300 and n < 1)
         n = self.index
         k = 1.0 + 1.0 / n
-        return n / (n + 1.0) * (pressure_gradient / (2.0 * self.consistency)) ** (1.0 / n) * (
-            radius**k - r**k)
+        with np.errstate(divide="ignore"):
+            shell = -np.expm1(k * np.log(r / radius))
+        return n / (n + 1.0) * radius * (0.5 * pressure_gradient * radius / self.consistency) ** (1.0 / n) * shell
 
 
 @attrs.frozen(kw_only=True)

@@ -42,6 +42,13 @@ _DIFF_TOL = types.MappingProxyType({"rtol": 1e-12, "atol": 0.0})
 __all__ = ["WallModel"]
 
 
+
+def _quiet():
+    """The public methods evaluate the law quietly: a result beyond the doubles is a typed error
+    (:func:`_finite`), and an intermediate overflow of a form that stays finite is no news."""
+    return np.errstate(over="ignore", invalid="ignore", divide="ignore")
+
+
 def _overrides(obj, name) -> bool:
     return getattr(type(obj), name) is not getattr(WallModel, name)
 
@@ -137,7 +144,8 @@ class WallModel(abc.ABC):
         def fn(wall, lam, tb):
             return wall._pressure_at_strain(wall._check_stretch(lam, tb) - 1.0, tb)
 
-        return _finite("stretch", stretch, "pressure", evaluate(self, fn, _as_floats("stretch", stretch), tb))
+        with _quiet():            # (a value beyond the doubles is the typed error below, not a warning)
+            return _finite("stretch", stretch, "pressure", evaluate(self, fn, _as_floats("stretch", stretch), tb))
 
     def stretch(self, pressure, reduced_thickness):
         r"""Hoop stretch :math:`\lambda = R/a` under transmural pressure ``pressure`` (Pa)."""
@@ -157,7 +165,8 @@ class WallModel(abc.ABC):
         def fn(wall, p, tb):
             return wall._strain(wall._check_pressure(p, tb), tb)
 
-        return _finite("pressure", pressure, "strain", evaluate(self, fn, _as_floats("pressure", pressure), tb))
+        with _quiet():
+            return _finite("pressure", pressure, "strain", evaluate(self, fn, _as_floats("pressure", pressure), tb))
 
     def stiffness(self, stretch, reduced_thickness):
         r"""Tube-law slope :math:`dP/d\lambda` (Pa)."""
@@ -166,17 +175,23 @@ class WallModel(abc.ABC):
         def fn(wall, lam, tb):
             return wall._stiffness(wall._check_stretch(lam, tb), tb)
 
-        return evaluate(self, fn, _as_floats("stretch", stretch), tb)
+        with _quiet():
+            return _finite("stretch", stretch, "stiffness", evaluate(self, fn, _as_floats("stretch", stretch), tb))
 
     def limit_pressure(self, reduced_thickness):
-        r"""The pressure the wall can never reach (Pa); ``inf`` for most laws."""
-        return evaluate(self, lambda wall, tb: wall._limit_pressure(tb) + 0.0 * tb,
-                        _check_thickness(reduced_thickness))
+        r"""The pressure the wall can never reach (Pa); ``inf`` for most laws (and where it is
+        beyond double precision)."""
+        tb = _check_thickness(reduced_thickness)
+        with _quiet():
+            return _not_nan("reduced_thickness", tb, "limit pressure",
+                            evaluate(self, lambda wall, tb: wall._limit_pressure(tb) + 0.0 * tb, tb))
 
     def max_stretch(self, reduced_thickness):
         """The largest admissible stretch (``inf`` unless the material locks)."""
-        return evaluate(self, lambda wall, tb: wall._max_stretch(tb) + 0.0 * tb,
-                        _check_thickness(reduced_thickness))
+        tb = _check_thickness(reduced_thickness)
+        with _quiet():
+            return _not_nan("reduced_thickness", tb, "maximum stretch",
+                            evaluate(self, lambda wall, tb: wall._max_stretch(tb) + 0.0 * tb, tb))
 
     def min_pressure(self, reduced_thickness):
         r"""The most negative transmural pressure the wall holds (Pa): 0 for a wall that only
@@ -192,8 +207,10 @@ class WallModel(abc.ABC):
 
     def small_strain_modulus(self, reduced_thickness):
         r""":math:`dP/d\lambda` at :math:`\lambda = 1` (Pa): the slope of the linear limit."""
-        return evaluate(self, lambda wall, tb: wall._stiffness(np.ones(np.shape(tb)), tb),
-                        _check_thickness(reduced_thickness))
+        tb = _check_thickness(reduced_thickness)
+        with _quiet():
+            return _finite("reduced_thickness", tb, "small-strain modulus",
+                           evaluate(self, lambda wall, tb: wall._stiffness(np.ones(np.shape(tb)), tb), tb))
 
     def plot(self, reduced_thickness, *, ax=None, max_stretch=3.0, **kwargs):
         """Plot this wall's tube law; see :func:`tubefsi.plotting.plot_tube_law`."""
@@ -396,7 +413,10 @@ class WallModel(abc.ABC):
                 top = float(model_at(wall, index[bad:bad + 1])._trial_pressure(
                     xmax[bad:bad + 1] * 0.999999, take(tb, index[bad:bad + 1]))[0])
             limit = float(np.broadcast_to(wall._limit_pressure(tb), p.shape)[bad])
-            if top < limit:     # not a physical limit: the stretch cannot be told from its lock
+            if not math.isfinite(top):      # the law leaves the doubles before it reaches the pressure
+                raise InvalidParameterError("pressure", "pressures the tube law reaches within double precision",
+                                            float(p[bad]), "the pressure overflows at a smaller stretch")
+            if top < limit or not math.isfinite(limit):   # not a physical limit: the stretch cannot be told
                 raise InvalidParameterError(
                     "pressure", f"[0, {top:.10g}] Pa", float(p[bad]),
                     f"beyond it the stretch is the largest the wall admits, {float(np.ravel(lam_max)[bad]):.10g}, to "
@@ -515,6 +535,18 @@ def _finite(name, value, result_name, result):
     v = np.broadcast_to(np.asarray(value, dtype=float), r.shape).ravel()[bad]
     raise InvalidParameterError(name, f"values whose {result_name} is a finite double", float(v),
                                 f"the {result_name} would be {r.ravel()[bad]!r}")
+
+
+def _not_nan(name, value, result_name, result):
+    """``result`` (which may be infinite: no limit), or an :class:`InvalidParameterError` naming the
+    argument where it has no value."""
+    r = np.asarray(result)
+    if not np.any(np.isnan(r)):
+        return result
+    bad = int(np.argmax(np.isnan(r).ravel()))
+    v = np.broadcast_to(np.asarray(value, dtype=float), r.shape).ravel()[bad]
+    raise InvalidParameterError(name, f"values whose {result_name} is a double", float(v),
+                                f"the {result_name} has no value there in double precision")
 
 
 def _check_thickness(reduced_thickness):

@@ -55,7 +55,7 @@ from ..numerics.quadrature import (GAUSS_WEIGHTS, KRONROD_NODES, KRONROD_WEIGHTS
                                    warn_unconverged)
 from ..errors import InvalidParameterError
 from ..geometry import Tube
-from ..fields import choice, evaluate, flat_points, model_at, parameter_shape, positive
+from ..fields import choice, evaluate, flat_points, model_at, parameter_shape, positive, real
 from .base import WallModel
 
 # SciPy on first use (tubefsi._lazy): listing the models must not import it
@@ -64,14 +64,23 @@ differentiate = lazy_module("scipy.differentiate", globals(), "differentiate")
 #: scipy.differentiate tolerances: as tight as the error estimate allows
 _DIFF_TOL = types.MappingProxyType({"rtol": 1e-12, "atol": 0.0})
 
-__all__ = ["HyperelasticWall", "ThinWall", "ThickWall", "THICKNESS_CONVENTIONS", "axial_stretch", "InstalledTube"]
+__all__ = ["HyperelasticWall", "ThinWall", "ThickWall", "THICKNESS_CONVENTIONS", "axial_stretch", "AXIAL_STRETCH_RANGE",
+           "InstalledTube"]
 
 THICKNESS_CONVENTIONS = ("reference", "current")
 
 
 def _quartic(s):
-    r""":math:`s - s^{-3} = (s-1)(s+1)(s^2+1)/s^3`, free of cancellation near 1."""
-    return (s - 1.0) * (s + 1.0) * (s * s + 1.0) / s**3
+    r""":math:`s - s^{-3} = (s-1)(1 + 1/s)(1 + 1/s^2)`, free of cancellation near 1 and of overflow
+    (a double wherever the value is: the product form's :math:`s^3` is inf/inf at :math:`s = 10^{300}`)."""
+    return (s - 1.0) * (1.0 + 1.0 / s) * (1.0 + 1.0 / (s * s))
+
+
+def _times(c, x):
+    """``c * x`` where a zero coefficient contributes nothing, even at an ``x`` beyond the doubles
+    (a law's term that is absent, not 0 * inf = NaN)."""
+    with np.errstate(invalid="ignore", over="ignore"):
+        return np.where(c == 0, 0.0, c * x)
 
 
 #: Within this distance of stretch 1 the thick integrand :math:`D(s)/(s^2-1)` of a material that
@@ -189,10 +198,19 @@ def _secant_slope(wall, h, reach):
     return np.array(np.broadcast_to(m, shape)), np.array(np.broadcast_to(ok, shape))
 
 
+#: The admissible axial pre-stretch: there the invariants of the installed rest state,
+#: :math:`I_1 - 3 \sim \lambda_z^2` and :math:`I_2 - 3 \sim 2/\lambda_z^2`, and the installed
+#: cross-section (:math:`1/\sqrt{\lambda_z}`) are doubles with room to spare (each material checks
+#: what its own law makes of them: Fung's and Gent's rest state, a finite installed modulus).
+AXIAL_STRETCH_RANGE = (1e-100, 1e100)
+
+
 def axial_stretch():
     """The ``axial_stretch`` parameter of a material that supports an axial pre-stretch
-    (``docs/walls_beyond.md``, section "Axial pre-stretch"): positive, default 1."""
-    return positive(default=1.0, doc="axial pre-stretch lambda_z: installed / stress-free length", along=False)
+    (``docs/walls_beyond.md``, section "Axial pre-stretch"): in :data:`AXIAL_STRETCH_RANGE`, default 1."""
+    low, high = AXIAL_STRETCH_RANGE
+    return real(low=low, high=high, low_open=False, high_open=False, default=1.0,
+                doc="axial pre-stretch lambda_z: installed / stress-free length", along=False)
 
 
 class HyperelasticWall(WallModel):
@@ -325,7 +343,7 @@ class HyperelasticWall(WallModel):
             return None
         q = _quartic(s)
         with np.errstate(over="ignore", invalid="ignore"):
-            return factor * (1.0 + 3.0 * s**-4) + (4.0 / self._axial()) * k * q * q
+            return factor * (1.0 + 3.0 * s**-4) + _times(4.0 / self._axial() * k, q * q)
 
     def _invariant_curvature(self, i1, i2):
         second = self._W_second(i1, i2)
@@ -346,7 +364,8 @@ class HyperelasticWall(WallModel):
             if k is not None:
                 q = _quartic(s)
                 with np.errstate(over="ignore", invalid="ignore"):
-                    return (4.0 * factor * s**-4 + (4.0 / self._axial()) * k * q * q) / s
+                    # (q q / s as (q / s) q: no overflow of q^2 where the slope is a double)
+                    return 4.0 * factor * s**-5 + _times(4.0 / self._axial() * k, (q / s) * q)
         return (self._d2W(s) - self._dW(s) / s) / s
 
     def _locking_stretch(self) -> float:
@@ -407,8 +426,8 @@ class HyperelasticWall(WallModel):
         ``_SECANT_REACH`` of 1, where it meets the ratio to 2e-16 (``_SECANT_REACH_NUMERICAL`` with a
         numerical ``_d2W``, to about 1e-14: the numerical slope's own accuracy)."""
         s = np.asarray(s, dtype=float)
-        if self._uses_invariants():               # D(s)/(s^2 - 1) = F(s) (s^2 + 1)/s^3: no singularity
-            return self._invariant_factor(s)[0] * (s * s + 1.0) / s**3
+        if self._uses_invariants():               # D(s)/(s^2 - 1) = F(s) (1 + s^-2)/s: no singularity
+            return self._invariant_factor(s)[0] * ((1.0 + 1.0 / (s * s)) / s)
         with np.errstate(invalid="ignore", divide="ignore"):
             g = self._dW(s) / ((s - 1.0) * (s + 1.0))
         if not self._homogeneous_rest():          # D(1) != 0 in general: no secant through (1, 0)
@@ -557,9 +576,10 @@ class ThickWall(HyperelasticWall):
         shape, wall, (e, tb) = flat_points(self, strain, tb)
         e = np.broadcast_to(e, (max(1, math.prod(shape)),))   # the quadrature indexes its points
         b = (1.0 + tb) ** 2
+        d = tb * (2.0 + tb)                                 # b - 1, exactly at any t/a (b rounds to 1 at 1e-100)
         x = e * (2.0 + e)                                   # lam^2 - 1
         log_lam_o = 0.5 * np.log1p(x / b)
-        width = 0.5 * np.log1p(x * (b - 1.0) / (b + x))     # ln(lam / lam_o), no cancellation
+        width = 0.5 * np.log1p(x * d / (b + x))             # ln(lam / lam_o), no cancellation
         # a collapsing tube (lam < 1) has width < 0: integrate -f(-u) over [0, -width]
         sign = np.where(e < 0, -1.0, 1.0)
         width = np.abs(width)
@@ -587,10 +607,19 @@ class ThickWall(HyperelasticWall):
         return -self._ring_modulus(tb) * (tb / (1.0 + tb)) ** 3
 
     def _stiffness(self, stretch, tb):
+        # g(lam) - g(lam_o) lam / (b lam_o) = [g(lam) - g(lam_o)] + g(lam_o) (b lam_o - lam)/(b lam_o),
+        # b lam_o - lam = d (b + lam^2)/(b lam_o + lam), d = b - 1 = t/a (2 + t/a): the share of g(lam_o)
+        # without the cancellation of lam/(b lam_o) against 1 (all of it at t/a = 1e-100, where the
+        # small-strain modulus g(1) d/b would come out 0)
+        # (lam_o = sqrt(lam^2 + d)/(1 + t/a) and the share in ratios of lam: doubles at lam = 1e300)
         lam = np.asarray(stretch, dtype=float)
         b = (1.0 + tb) ** 2
-        lam_o = np.sqrt(1.0 + (lam * lam - 1.0) / b)
-        return self._thick_integrand(lam) - self._thick_integrand(lam_o) * lam / (b * lam_o)
+        d = tb * (2.0 + tb)
+        lam_o = np.hypot(lam, np.sqrt(d)) / (1.0 + tb)
+        g_o = self._thick_integrand(lam_o)
+        with np.errstate(over="ignore", invalid="ignore"):
+            share = d * ((b / lam + lam) / (b * lam_o)) / (b * lam_o / lam + 1.0)
+        return (self._thick_integrand(lam) - g_o) + g_o * share
 
 
 @attrs.frozen(kw_only=True)

@@ -40,12 +40,14 @@ class MooneyRivlin(HyperelasticWall):
             raise InvalidParameterError("c1 + c2", "(0, inf)", float(total[tuple(bad)]),
                                         "the small-strain shear modulus 2 (c1 + c2) must be positive"
                                         + (f" (entry {tuple(int(i) for i in bad)})" if total.ndim else ""))
-        installed = np.asarray(self.c1 / self.axial_stretch + self.c2 * self.axial_stretch)
-        if not np.all(installed > 0):
-            bad = np.argwhere(~(installed > 0))[0] if installed.ndim else ()
-            raise InvalidParameterError("c1/axial_stretch + c2*axial_stretch", "(0, inf)",
-                                        float(installed[tuple(bad)]),
-                                        "the installed tube's shear modulus must be positive")
+        with np.errstate(over="ignore", invalid="ignore"):
+            installed = np.asarray(2.0 * (self.c1 / self.axial_stretch + self.c2 * self.axial_stretch))
+        if not np.all((installed > 0) & np.isfinite(installed)):
+            bad = np.argwhere(~((installed > 0) & np.isfinite(installed)))[0] if installed.ndim else ()
+            raise InvalidParameterError("c1/axial_stretch + c2*axial_stretch", "(0, inf), twice it a finite double",
+                                        float(installed[tuple(bad)]) / 2.0,
+                                        "the installed tube's shear modulus 2 (c1/lz + c2 lz) must be positive "
+                                        "and finite")
 
     @property
     def shear_modulus(self) -> float:

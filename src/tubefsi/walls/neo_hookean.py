@@ -28,7 +28,8 @@ import numpy as np
 
 from ..numerics.kernels import expm1_ratio, log1p_ratio
 from ..numerics.roots import solve_signed
-from ..fields import positive
+from ..errors import InvalidParameterError
+from ..fields import positive, varies
 from .hyperelastic import HyperelasticWall, ThickWall, ThinWall, axial_stretch
 
 __all__ = ["NeoHookean", "ThinNeoHookean", "ThickNeoHookean"]
@@ -180,6 +181,24 @@ class _ThinForms(_NeoHookeanLaw):
         return log1p_ratio(k - 4, integral / (4.0 * self._installed_modulus() * tb * outlet_stretch ** (k - 4)))
 
 
+def _far_slope(out, stretch, d, modulus, power):
+    r"""``out`` (the thick slope times :math:`\lambda^{1 - power}`, from the polynomial form), with the
+    points where that form overflows (:math:`\lambda^4 (\lambda^2 + d)^2` at :math:`\lambda = 10^{77}`, or
+    :math:`d^2` at :math:`\bar t = 10^{77}`, as inf/inf) taken from the same quantity written in bounded
+    factors, :math:`\mu\,\frac{d}{\lambda^2 + d}\,\frac{d + 2 + d/\lambda^2}{\lambda^2 + d}\,\lambda^{-power}`
+    (a double, or an underflow to 0, wherever the slope is); the rare case costs its own points."""
+    if np.ndim(out) == 0:
+        if math.isfinite(out):
+            return out
+    elif np.all(np.isfinite(out)):
+        return out
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        lam = np.asarray(stretch, dtype=float)
+        lam2 = lam * lam
+        bounded = modulus * (d / (lam2 + d)) * ((d + 2.0 + d / lam2) / (lam2 + d)) / lam**power
+    return np.where(np.isfinite(out), out, bounded)
+
+
 class _ThickForms(_NeoHookeanLaw):
     __slots__ = ()
 
@@ -201,18 +220,19 @@ class _ThickForms(_NeoHookeanLaw):
     def _stiffness(self, stretch, tb):
         # mu d lam (lam^2 (d + 2) + d) / (lam^4 (lam^2 + d)^2), d = tb (2 + tb); the per-point factors
         # (mu d, d + 2) first, then in place: the integrand's hot spot, on (nodes x points) arrays
-        lam2 = np.multiply(stretch, stretch)
-        d = tb * (2.0 + tb)
-        den = lam2 + d
-        den *= den
-        den *= lam2
-        den *= lam2
-        num = lam2 * (d + 2.0)
-        num += d
-        num *= stretch
-        num *= self._installed_modulus() * d
-        num /= den
-        return num
+        with np.errstate(over="ignore", invalid="ignore"):     # (the far points: _far_slope)
+            lam2 = np.multiply(stretch, stretch)
+            d = tb * (2.0 + tb)
+            den = lam2 + d
+            den *= den
+            den *= lam2
+            den *= lam2
+            num = lam2 * (d + 2.0)
+            num += d
+            num *= stretch
+            num *= self._installed_modulus() * d
+            num /= den
+        return _far_slope(num, stretch, d, self._installed_modulus(), 1.0)
 
     def _log_slope(self, stretch, tb):
         # lam P' = mu d (lam^2 (d + 2) + d) / (lam^2 (lam^2 + d)^2): the stiffness's form with the
@@ -220,18 +240,19 @@ class _ThickForms(_NeoHookeanLaw):
         # the stiffness gets its own
         if type(self)._stiffness is not _ThickForms._stiffness:
             return stretch * self._stiffness(stretch, tb)
-        lam2 = np.multiply(stretch, stretch)
-        d = tb * (2.0 + tb)
-        den = lam2 + d
-        den *= den
-        den *= lam2
-        # (in place where the shapes allow: one array of nodes x points fewer)
-        inplace = type(lam2) is np.ndarray and np.broadcast_shapes(lam2.shape, np.shape(d)) == lam2.shape
-        num = np.multiply(lam2, d + 2.0, out=lam2) if inplace else lam2 * (d + 2.0)
-        num += d
-        num *= self._installed_modulus() * d
-        num /= den
-        return num
+        with np.errstate(over="ignore", invalid="ignore"):     # (the far points: _far_slope)
+            lam2 = np.multiply(stretch, stretch)
+            d = tb * (2.0 + tb)
+            den = lam2 + d
+            den *= den
+            den *= lam2
+            # (in place where the shapes allow: one array of nodes x points fewer)
+            inplace = type(lam2) is np.ndarray and np.broadcast_shapes(lam2.shape, np.shape(d)) == lam2.shape
+            num = np.multiply(lam2, d + 2.0, out=lam2) if inplace else lam2 * (d + 2.0)
+            num += d
+            num *= self._installed_modulus() * d
+            num /= den
+        return _far_slope(num, stretch, d, self._installed_modulus(), 0.0)
 
     def _strain(self, pressure, tb):
         # the law per unit modulus: no parameter but t/a, which is gathered for the active points
@@ -257,6 +278,17 @@ class NeoHookean(HyperelasticWall):
 
     shear_modulus: float = positive(unit="Pa", doc="small-strain shear modulus mu")
     axial_stretch: float = axial_stretch()
+
+    def __attrs_post_init__(self):
+        if varies(self):           # a graded wall: its modulus is evaluated along z
+            return
+        with np.errstate(over="ignore"):
+            installed = np.asarray(self.shear_modulus / self.axial_stretch)
+        if not np.all(np.isfinite(installed)):
+            bad = tuple(int(i) for i in np.argwhere(~np.isfinite(installed))[0]) if installed.ndim else ()
+            raise InvalidParameterError("axial_stretch", "values where shear_modulus / axial_stretch is a finite "
+                                        "double", float(np.broadcast_to(self.axial_stretch, installed.shape)[bad]),
+                                        "the installed tube's shear modulus would overflow")
 
     def _installed_modulus(self):
         return self.shear_modulus / self.axial_stretch

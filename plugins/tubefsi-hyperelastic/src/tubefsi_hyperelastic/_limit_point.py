@@ -36,7 +36,10 @@ def _first_peak(wall, tb: float) -> tuple[float, float]:
     lam = 1.0 + _SCAN
     with np.errstate(over="ignore", invalid="ignore"):
         slope = wall._stiffness(lam, tb)
-    bad = np.flatnonzero(~(slope > 0))
+    # the scan ends where the law leaves the doubles (a slope of inf or NaN: a huge exponent): a
+    # peak beyond it is beyond double precision too, and the root finder needs finite ends
+    end = np.flatnonzero(~np.isfinite(slope))
+    bad = np.flatnonzero(slope[:end[0] if end.size else lam.size] <= 0)
     if bad.size == 0:
         return math.inf, math.nan
     from scipy import optimize   # here, not at import: listing the models must not load SciPy

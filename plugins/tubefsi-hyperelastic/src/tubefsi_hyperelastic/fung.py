@@ -54,10 +54,11 @@ class Fung(HyperelasticWall):
         return attrs.evolve(self, shear_modulus=1.0)
 
     def _max_stretch(self, tb):
-        # b (I1 - 3) = 600: (lam - 1/lam)^2 = lz (600/b - c)
-        lz = self.axial_stretch
-        x = (lz * (600.0 / self.stiffening - self._installed_invariants(1.0)[0])) ** 0.5
-        return 0.5 * (x + (x * x + 4.0) ** 0.5)
+        # b (I1 - 3) = 600: (lam - 1/lam)^2 = x^2 = lz (600 - b c)/b, lam = (x + sqrt(x^2 + 4))/2; as
+        # sqrt(lz (600 - b c)) / sqrt(b) and by hypot, a double for every b (600/b overflows at 5e-324)
+        lz, b = self.axial_stretch, self.stiffening
+        x = np.sqrt(lz * (600.0 - b * self._installed_invariants(1.0)[0])) / np.sqrt(b)
+        return 0.5 * (x + np.hypot(x, 2.0))
 
     def _limit_pressure(self, tb):
         return self._pressure_at_strain(np.asarray(self._max_stretch(tb) - 1.0 + 0.0 * np.asarray(tb)), tb)

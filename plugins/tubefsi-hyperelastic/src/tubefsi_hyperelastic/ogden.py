@@ -51,16 +51,38 @@ def _check_terms(instance, attribute, value):
         raise InvalidParameterError("exponents", "nonzero numbers", value)
 
 
-def _slope_terms(a, k, s):
-    r""":math:`(a - k)s^a + (a + k)s^{-a}`, the bracket of a term's slope (:math:`k = 1`: :math:`\hat W''`,
-    :math:`k = 2`: the thin current-thickness law). For :math:`|a| < k/2` as
-    :math:`2a[\cosh(au) - k\sinh(au)/a]`, :math:`u = \ln s`, whose two terms do not cancel there
-    (the direct form loses everything as :math:`a \to 0`); elsewhere directly (where the hyperbolic
-    form would cancel, :math:`a = k` at large stretch)."""
+def _slope_terms(a, k, s, shift=0.0):
+    r""":math:`[(a - k)s^a + (a + k)s^{-a}]\,s^{-shift}`, the bracket of a term's slope (:math:`k = 1`:
+    :math:`\hat W''`, :math:`k = 2`: the thin current-thickness law) times the power of the stretch it
+    comes with, folded into the exponents (so a double wherever the product is: :math:`s^a` alone
+    overflows at :math:`s = 10^{300}`). For :math:`|a| < k/2` as :math:`2a[\cosh(au) - k\sinh(au)/a]`,
+    :math:`u = \ln s`, whose two terms do not cancel there (the direct form loses everything as
+    :math:`a \to 0`); elsewhere directly (where the hyperbolic form would cancel, :math:`a = k` at
+    large stretch)."""
     if abs(a) < 0.5 * k:
         u = np.log(s)
-        return 2.0 * a * (np.cosh(a * u) - k * np.sinh(a * u) / a)
-    return (a - k) * s**a + (a + k) * s ** (-a)
+        return 2.0 * a * (np.cosh(a * u) - k * np.sinh(a * u) / a) * s ** (-shift)
+    return (a - k) * s ** (a - shift) + (a + k) * s ** (-a - shift)
+
+
+def _difference(a, s, u):
+    r""":math:`s^{a-1} - s^{-a-1}` at :math:`u = \ln s`, without cancellation near 1 and without an
+    overflowing factor: :math:`s^{-a-1}\,\mathrm{expm1}(2au)` where :math:`au \le 0`, else
+    :math:`-s^{a-1}\,\mathrm{expm1}(-2au)` (the product form is :math:`0\cdot\infty` at :math:`s = 10^{300}`)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        grows = a * u > 0
+        return np.where(grows, -(s ** (a - 1.0)) * np.expm1(-2.0 * a * u), s ** (-a - 1.0) * np.expm1(2.0 * a * u))
+
+
+def _difference_ratio(a, s, u):
+    r""":math:`(s^{a-1} - s^{-a-1})/(s^2 - 1)` (:math:`a` at :math:`s = 1`): odd in :math:`a`; above 1 as
+    :math:`\mathrm{sign}(a)\,s^{|a|-3}\,\mathrm{expm1}(-2|a|u)/\mathrm{expm1}(-2u)` (bounded factors), below
+    as :math:`s^{-a-1}\,\mathrm{expm1}(2au)/\mathrm{expm1}(2u)`."""
+    big = abs(a)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        above = np.sign(a) * s ** (big - 3.0) * (np.expm1(-2.0 * big * u) / np.expm1(-2.0 * u))
+        below = s ** (-a - 1.0) * (np.expm1(2.0 * a * u) / np.expm1(2.0 * u))
+        return np.where(u == 0, a, np.where(u > 0, above, below))
 
 
 @attrs.frozen(kw_only=True)
@@ -80,9 +102,19 @@ class Ogden(LimitPoint, HyperelasticWall):
         if not sum(self.moduli) > 0:
             raise InvalidParameterError("moduli", "sum(moduli) > 0", self.moduli,
                                         "the small-strain shear modulus must be positive")
-        if not sum(self._installed_moduli()) > 0:
-            raise InvalidParameterError("axial_stretch", "values where sum(moduli_p lz^(-exponents_p/2)) > 0",
-                                        self.axial_stretch, "the installed tube's small-strain modulus must be positive")
+        # the installed small-strain modulus at each axial stretch (an array broadcasts: the wall is
+        # then solved per value, LimitPoint); a power that leaves the doubles is rejected too
+        lz = np.asarray(self.axial_stretch, dtype=float)
+        with np.errstate(over="ignore", invalid="ignore"):
+            terms = [m * lz ** (-0.5 * a) for m, a in zip(self.moduli, self.exponents)]
+            total = sum(terms)
+            ok = np.isfinite(total) & (total > 0) & np.all([np.isfinite(t) for t in terms], axis=0)
+        if not np.all(ok):
+            i = tuple(int(k) for k in np.argwhere(~ok)[0]) if ok.ndim else ()
+            raise InvalidParameterError("axial_stretch", "values where sum(moduli_p lz^(-exponents_p/2)) is positive "
+                                        "and each term a finite double", float(lz[i]),
+                                        "the installed tube's small-strain modulus must be positive and finite"
+                                        + (f" (entry {i})" if i else ""))
 
     def _installed_moduli(self):
         r""":math:`\mu_p\lambda_z^{-\alpha_p/2}` (the moduli themselves at :math:`\lambda_z = 1`)."""
@@ -104,19 +136,17 @@ class Ogden(LimitPoint, HyperelasticWall):
         return zip((2.0 * m / a for m, a in zip(self._installed_moduli(), self.exponents)), self.exponents)
 
     def _dW(self, s):
-        # s^(a-1) - s^(-a-1) = s^(-a-1) expm1(2 a ln s): no cancellation near s = 1
+        # s^(a-1) - s^(-a-1) = s^(-a-1) expm1(2 a ln s): no cancellation near s = 1 (_difference)
         u = np.log(s)
-        return sum(c * s ** (-a - 1.0) * np.expm1(2.0 * a * u) for c, a in self._terms())
+        return sum(c * _difference(a, s, u) for c, a in self._terms())
 
     def _d2W(self, s):
-        return sum(c * _slope_terms(a, 1.0, s) for c, a in self._terms()) / (s * s)
+        return sum(c * _slope_terms(a, 1.0, s, shift=2.0) for c, a in self._terms())
 
     def _thick_integrand(self, s):
+        # (s^(a-1) - s^(-a-1)) / (s^2 - 1)  ->  a at s = 1 (_difference_ratio)
         u = np.log(s)
-        # (s^(a-1) - s^(-a-1)) / (s^2 - 1) = s^(-a-1) expm1(2 a u) / expm1(2 u)  ->  a at s = 1
-        with np.errstate(invalid="ignore", divide="ignore"):
-            ratios = [np.where(u == 0, a, np.expm1(2.0 * a * u) / np.expm1(2.0 * u)) for _, a in self._terms()]
-        return sum(c * s ** (-a - 1.0) * r for (c, a), r in zip(self._terms(), ratios))
+        return sum(c * _difference_ratio(a, s, u) for c, a in self._terms())
 
     # -- asymptotics (for the limit pressure when the law has no peak)
     def _critical(self, theory):
@@ -150,7 +180,7 @@ class ThinOgden(ThinWall, Ogden):
             return tb * self._d2W(stretch)
         # d/dlam (dW/lam) = sum c [(a-2) s^(a-3) + (a+2) s^(-a-3)]: no cancellation at large stretch
         s = stretch
-        return tb * sum(c * _slope_terms(a, 2.0, s) for c, a in self._terms()) / s**3
+        return tb * sum(c * _slope_terms(a, 2.0, s, shift=3.0) for c, a in self._terms())
 
 
 @attrs.frozen(kw_only=True)

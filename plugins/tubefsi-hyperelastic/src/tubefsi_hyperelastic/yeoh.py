@@ -24,7 +24,7 @@ import numpy as np
 from tubefsi import InvalidParameterError
 from tubefsi.fields import nonnegative, positive, real
 from tubefsi.walls import HyperelasticWall, ThickWall, ThinWall
-from tubefsi.walls.hyperelastic import axial_stretch
+from tubefsi.walls.hyperelastic import _times, axial_stretch
 
 from ._limit_point import LimitPoint
 
@@ -41,11 +41,12 @@ class Yeoh(LimitPoint, HyperelasticWall):
     axial_stretch: float = axial_stretch()
 
     def __attrs_post_init__(self):
-        rest = self._W1(self._installed_invariants(1.0)[0], None)
-        if not np.all(rest > 0):
-            raise InvalidParameterError("axial_stretch", "values where c1 + 2 c2 y + 3 c3 y^2 > 0 at rest, "
-                                        "y = (lz - 1)^2 (lz + 2)/lz", self.axial_stretch,
-                                        "the installed tube's small-strain modulus must be positive")
+        with np.errstate(over="ignore", invalid="ignore"):
+            rest = self._W1(self._installed_invariants(1.0)[0], None)
+        if not np.all((rest > 0) & np.isfinite(rest)):
+            raise InvalidParameterError("axial_stretch", "values where c1 + 2 c2 y + 3 c3 y^2 is positive and finite "
+                                        "at rest, y = (lz - 1)^2 (lz + 2)/lz", self.axial_stretch,
+                                        "the installed tube's small-strain modulus must be positive and finite")
 
     def _pressure_scale(self):                  # P is linear in (c1, c2, c3): c1 * P_hat(c2/c1, c3/c1, lz)
         return self.c1
@@ -57,11 +58,13 @@ class Yeoh(LimitPoint, HyperelasticWall):
         c2, c3, _, _ = self._shape_key()
         return attrs.evolve(self, c1=1.0, c2=c2, c3=c3)
 
+    # a term whose coefficient is 0 contributes nothing at any y (_times: not 0 * inf = NaN where y
+    # leaves the doubles, at a stretch of 1e300)
     def _W1(self, i1, i2):       # dW/dI1 at y = I1 - 3
-        return self.c1 + i1 * (2.0 * self.c2 + 3.0 * self.c3 * i1)
+        return self.c1 + _times(2.0 * self.c2, i1) + _times(3.0 * self.c3, i1 * i1)
 
     def _W_second(self, i1, i2):
-        return 2.0 * self.c2 + 6.0 * self.c3 * i1, 0.0, 0.0
+        return 2.0 * self.c2 + _times(6.0 * self.c3, i1), 0.0, 0.0
 
     def _max_stretch(self, tb):
         return math.inf if self.c2 >= 0 else super()._max_stretch(tb)   # c2, c3 >= 0: increasing

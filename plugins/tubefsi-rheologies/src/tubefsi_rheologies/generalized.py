@@ -29,6 +29,14 @@ def _log1p_power(x, a):
     return np.log1p(np.exp(-np.abs(la))) + np.maximum(la, 0.0)
 
 
+def _log1p_power_per_exponent(x, a):
+    r""":math:`\ln(1 + x^a)/a` for :math:`x > 0`: :math:`\max(\ln x, 0) + \ln(1 + e^{-a|\ln x|})/a`,
+    finite for any exponent (the product :math:`a\ln x` alone overflows at :math:`a = 10^{308}`)."""
+    with np.errstate(divide="ignore", over="ignore"):
+        la = np.log(x)
+        return np.log1p(np.exp(-np.abs(a * la))) / a + np.maximum(la, 0.0)
+
+
 def _require(ok, name, admissible, value, detail=None):
     """An ``InvalidParameterError`` naming the first entry where ``ok`` fails (arrays broadcast)."""
     ok = np.asarray(ok)
@@ -76,7 +84,7 @@ class CarreauYasuda(_ViscosityRange):
     def _stress(self, shear_rate):
         a = self.transition
         x = self.relaxation_time * shear_rate
-        shape = np.exp((self.index - 1.0) / a * _log1p_power(x, a))
+        shape = np.exp((self.index - 1.0) * _log1p_power_per_exponent(x, a))
         return shear_rate * (self.infinite_shear_viscosity
                              + (self.zero_shear_viscosity - self.infinite_shear_viscosity) * shape)
 
@@ -125,7 +133,8 @@ class Cross(_ViscosityRange):
     def __attrs_post_init__(self):
         super().__attrs_post_init__()
         m, e0, einf = self.exponent, self.zero_shear_viscosity, self.infinite_shear_viscosity
-        _require((m < 1.0) | (einf > (e0 - einf) * (m - 1.0) ** 2 / (4.0 * m)), "exponent",
+        # (m - 1)^2 / (4m) as (m - 1) ((m - 1)/(4m)): no square that overflows at m = 1e300
+        _require((m < 1.0) | (einf > (e0 - einf) * (m - 1.0) * (0.25 * ((m - 1.0) / m))), "exponent",
                  "(0, 1), or [1, inf) with infinite_shear_viscosity > "
                  "(zero_shear_viscosity - infinite_shear_viscosity) (m - 1)^2 / (4 m)", m,
                  "the shear stress would not increase with the shear rate")
@@ -164,11 +173,13 @@ class Ellis(Rheology):
         return t / self.zero_shear_viscosity * (1.0 + 4.0 / (a + 3.0) * (t / self.half_stress) ** (a - 1.0))
 
     def _velocity(self, r, radius, pressure_gradient):
-        a, g = self.exponent, pressure_gradient
-        newtonian = 0.25 * g / self.zero_shear_viscosity * (radius - r) * (radius + r)
-        # R^(a+1) - r^(a+1) = R^(a+1) (1 - (r/R)^(a+1)), without cancellation near the wall
+        # in the wall stress tau_w = G R/2 and r/R <= 1 only: v = (tau_w/eta_0)(R - r)(1 + r/R)/2
+        # + R tau_1/2/((a+1) eta_0) (tau_w/tau_1/2)^a (1 - (r/R)^(a+1)), the latter without
+        # cancellation near the wall; no power of R, G or tau_1/2 alone (each leaves the doubles
+        # long before v does)
+        a, eta0, half = self.exponent, self.zero_shear_viscosity, self.half_stress
+        tau_w = 0.5 * pressure_gradient * radius
+        newtonian = 0.5 * (tau_w / eta0) * (radius - r) * (1.0 + r / radius)
         with np.errstate(divide="ignore"):
-            log_ratio = np.log(r / radius)
-        shell = -radius ** (a + 1.0) * np.expm1((a + 1.0) * log_ratio)
-        return newtonian + (0.5 * g) ** a / ((a + 1.0) * self.zero_shear_viscosity
-                                             * self.half_stress ** (a - 1.0)) * shell
+            shell = -np.expm1((a + 1.0) * np.log(r / radius))
+        return newtonian + radius * (half / ((a + 1.0) * eta0)) * (tau_w / half) ** a * shell

@@ -36,6 +36,12 @@ def _plug(r, radius, g, tau_y):
     return np.maximum(r, np.minimum(radius, 2.0 * tau_y / g))
 
 
+def _root_difference(a, b):
+    r""":math:`\sqrt a - \sqrt b` for :math:`a \ge b \ge 0` without cancellation (0 at a = b)."""
+    den = np.sqrt(a) + np.sqrt(b)
+    return np.divide(np.maximum(a - b, 0.0), den, out=np.zeros(np.broadcast_shapes(np.shape(den), np.shape(a))), where=den > 0)
+
+
 @attrs.frozen(kw_only=True)
 class Bingham(Rheology):
     r"""Bingham plastic: :math:`\tau = \tau_y + \mu_p\dot\gamma` once yielded.
@@ -61,7 +67,8 @@ class Bingham(Rheology):
         t = np.asarray(wall_stress, dtype=float)
         excess = np.maximum(t - self.yield_stress, 0.0) if excess is None else excess
         x = self.yield_stress / t
-        return excess * excess * (x * x + 2.0 * x + 3.0) / (3.0 * self.plastic_viscosity * t)
+        # excess^2/tau_w as excess (excess/tau_w): no square beyond the doubles
+        return excess * (excess / t) * (x * x + 2.0 * x + 3.0) / (3.0 * self.plastic_viscosity)
 
     def _velocity(self, r, radius, pressure_gradient):
         g = pressure_gradient
@@ -90,29 +97,40 @@ class Casson(Rheology):
         return (np.sqrt(self.yield_stress) + np.sqrt(self.plastic_viscosity * shear_rate)) ** 2
 
     def _root_excess(self, stress, excess=None):
-        """:math:`\\sqrt\\tau - \\sqrt{\\tau_y}` (>= 0), without cancellation."""
+        """:math:`\\sqrt\\tau - \\sqrt{\\tau_y}` (>= 0), without cancellation (0 at
+        :math:`\\tau = \\tau_y = 0`, the Newtonian limit's centreline, where the ratio is 0/0)."""
         excess = np.maximum(stress - self.yield_stress, 0.0) if excess is None else excess
-        return excess / (np.sqrt(stress) + np.sqrt(self.yield_stress))
+        root_sum = np.sqrt(stress) + np.sqrt(self.yield_stress)
+        return np.divide(excess, root_sum, out=np.zeros(np.broadcast_shapes(np.shape(root_sum), np.shape(excess))), where=root_sum > 0)
 
     def _shear_rate(self, stress):
         return self._root_excess(stress) ** 2 / self.plastic_viscosity
 
     def _apparent_shear_rate(self, wall_stress, excess=None):
         t = np.asarray(wall_stress, dtype=float)
-        c, e = np.sqrt(self.yield_stress), self._root_excess(t, excess)
+        # in units of w = sqrt(tau_w) (the sum is homogeneous of degree 8 in c and e): no power of
+        # the stress beyond the first, so a double wherever Gamma is one
+        w = np.sqrt(t)
+        c, e = np.sqrt(self.yield_stress) / w, self._root_excess(t, excess) / w
         total = sum(comb(5, k) * c ** (5 - k) * e ** (k + 3) / (k + 3) for k in range(6))
-        return 8.0 * total / (self.plastic_viscosity * t**3)
+        return 8.0 * total * t / self.plastic_viscosity
 
     def _velocity(self, r, radius, pressure_gradient):
-        # v = (2/(k mu_p)) [z^4/4 + c z^3/3] between z(r) and z(R), z = sqrt(k rho) - c, k = G/2
+        # v = (2/(k mu_p)) [z^4/4 + c z^3/3] between z(r) and z(R), z = sqrt(k rho) - c, k = G/2;
+        # in units of sqrt(k) (z = sqrt(k) y, y = sqrt(rho) - c/sqrt(k)), so that no power of the
+        # stress is formed: v = (2 gap/mu_p) [k (e + y)(e^2 + y^2)/4 + c sqrt(k) (e^2 + e y + y^2)/3]
+        # is a double wherever the velocity is (a wall stress of 1e295 Pa has e^4 beyond the doubles)
         k, c = 0.5 * pressure_gradient, np.sqrt(self.yield_stress)
         rr = _plug(r, radius, pressure_gradient, self.yield_stress)
-        e = self._root_excess(k * radius)
-        z = self._root_excess(k * rr)
-        gap = np.sqrt(k) * (radius - rr) / (np.sqrt(radius) + np.sqrt(rr))          # e - z
-        quartic = gap * (e + z) * (e * e + z * z) / 4.0
-        cubic = c * gap * (e * e + e * z + z * z) / 3.0
-        return 2.0 * (quartic + cubic) / (k * self.plastic_viscosity)
+        with np.errstate(divide="ignore"):
+            plug = self.yield_stress / k                                    # the plug radius
+        e = _root_difference(radius, plug)                                   # sqrt(R) - c/sqrt(k)
+        y = _root_difference(rr, plug)
+        gap = (radius - rr) / (np.sqrt(radius) + np.sqrt(rr))               # e - y
+        gap = np.where(radius > rr, gap, 0.0)
+        quartic = k * ((e + y) * (e * e + y * y)) / 4.0
+        cubic = c * np.sqrt(k) * (e * e + e * y + y * y) / 3.0
+        return 2.0 * gap * (quartic + cubic) / self.plastic_viscosity
 
 
 @attrs.frozen(kw_only=True)
@@ -144,8 +162,11 @@ class HerschelBulkley(Rheology):
         t = np.asarray(wall_stress, dtype=float)
         m, ty = 1.0 / self.index, self.yield_stress
         d = np.maximum(t - ty, 0.0) if excess is None else excess
-        bracket = d * d / (m + 3.0) + 2.0 * ty * d / (m + 2.0) + ty * ty / (m + 1.0)
-        return 4.0 * (d / self.consistency) ** m * d * bracket / t**3
+        # the bracket over tau_w^2, in the shares d/tau_w and tau_y/tau_w: no power of a stress
+        # beyond (d/K)^m, so a double wherever Gamma is one
+        dt, yt = d / t, ty / t
+        bracket = dt * dt / (m + 3.0) + 2.0 * yt * dt / (m + 2.0) + yt * yt / (m + 1.0)
+        return 4.0 * (d / self.consistency) ** m * dt * bracket
 
     def _velocity(self, r, radius, pressure_gradient):
         m, g, ty = 1.0 / self.index, pressure_gradient, self.yield_stress
@@ -157,5 +178,7 @@ class HerschelBulkley(Rheology):
         with np.errstate(divide="ignore"):
             log_ratio = np.log1p(np.maximum(frac, -1.0))
         shell = -np.expm1((m + 1.0) * log_ratio)
-        scale = np.where(yielded, (np.maximum(d_wall, 0.0) / self.consistency) ** m * np.maximum(d_wall, 0.0), 0.0)
-        return 2.0 * scale * shell / ((m + 1.0) * g)
+        # (d_wall/K)^m d_wall / G with d_wall/G <= R/2 divided first: no product beyond the doubles
+        d_pos = np.maximum(d_wall, 0.0)
+        scale = np.where(yielded, (d_pos / self.consistency) ** m * (d_pos / g), 0.0)
+        return 2.0 * scale * shell / (m + 1.0)

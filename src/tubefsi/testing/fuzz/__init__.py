@@ -63,6 +63,7 @@ from typing import NamedTuple
 
 from ... import registry
 from ...geometry import Tube
+from ._extremes import extremes_family
 from ._core import BREACHES, TIME_LIMIT, _TUBE, Outcome, Probe, Report, run_probe
 from ._known import _known_probes
 from ._models import (_advise_probes, _entry_keyword_probes, _model_probes, _rheology_probes, _solution_probes,
@@ -134,6 +135,7 @@ FAMILIES = {
     "keywords": _keywords_family,
     "entry points": _entry_points_family,
     "known": _known_family,
+    "extremes": extremes_family,
 }
 
 
