@@ -120,7 +120,7 @@ def rate_natural_rate(rheology, wall_stress, excess=None, *, rtol: float = RTOL)
         return 4.0 * _EPS * tau_y / np.maximum(el[idx, None] * u, _TINY)
 
     res = unit_integral(f, live.size, rtol=rtol, relative_rounding=rounding)
-    out[live] = 4.0 * el * res.value / tl
+    out[live] = 4.0 * res.value * (el / tl)
     return out.reshape(shape), (res, live)
 
 

@@ -186,17 +186,19 @@ def _far_slope(out, stretch, d, modulus, power):
     points where that form overflows (:math:`\lambda^4 (\lambda^2 + d)^2` at :math:`\lambda = 10^{77}`, or
     :math:`d^2` at :math:`\bar t = 10^{77}`, as inf/inf) taken from the same quantity written in bounded
     factors, :math:`\mu\,\frac{d}{\lambda^2 + d}\,\frac{d + 2 + d/\lambda^2}{\lambda^2 + d}\,\lambda^{-power}`
-    (a double, or an underflow to 0, wherever the slope is); the rare case costs its own points."""
+    (a double, or an underflow to 0, wherever the slope is). The slope is positive: a 0 (the
+    denominator overflowed first, past 1e60) or a NaN marks such a point; the rare case costs its
+    own points."""
     if np.ndim(out) == 0:
-        if math.isfinite(out):
+        if 0.0 < out < math.inf:
             return out
-    elif np.all(np.isfinite(out)):
+    elif np.all((out > 0) & (out < math.inf)):
         return out
     with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
         lam = np.asarray(stretch, dtype=float)
         lam2 = lam * lam
         bounded = modulus * (d / (lam2 + d)) * ((d + 2.0 + d / lam2) / (lam2 + d)) / lam**power
-    return np.where(np.isfinite(out), out, bounded)
+        return np.where((out > 0) & (out < math.inf), out, bounded)
 
 
 class _ThickForms(_NeoHookeanLaw):

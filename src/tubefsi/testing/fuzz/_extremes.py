@@ -153,6 +153,9 @@ def _wall_at_check(result):
         return f"pressures {p!r} at stretches {lam!r}: negative or decreasing"
     if np.any(k < 0):
         return f"negative stiffness {k!r}"
+    if np.max(k) < 1e-300:                 # a subnormal modulus: its limits may underflow to 0
+        p_lim, lam_max, modulus = limits
+        return None if p_lim >= 0 and lam_max > 1 and 0 <= modulus < math.inf else f"limits {limits!r}"
     return _limits_check(limits)
 
 
