@@ -6,8 +6,6 @@ The plugins' models have their own files (``plugins/*/tests/test_extremes_*.py``
 "extremes" (:mod:`tubefsi.testing.fuzz._extremes`) runs the same contract over every registered model.
 """
 
-import math
-
 import numpy as np
 import pytest
 from mpmath import mp, mpf
@@ -53,8 +51,9 @@ def test_thick_stiffness_far_out_is_its_closed_form(name, kwargs):
 
 
 def test_thick_small_strain_modulus_at_the_thinnest_wall():
-    r"""At t/a = 1e-100 the thick wall's small-strain modulus is :math:`g(1)\,d/b`, d = t/a (2 + t/a):
-    8e-97 for mu = 2e3 (the closed form), where ``b - 1`` rounded to 0 (it was 0)."""
+    r"""At t/a = 1e-100 the thick neo-Hookean small-strain modulus is :math:`4\mu\,t/a` to first
+    order, 8e-97 for mu = 2e3: the closed form the plugins' thick walls are checked against at the
+    same thickness (``test_extremes_hyperelastic.py``, where the generic thick slope gave 0)."""
     wall = W["thick-neo-hookean"](shear_modulus=2e3)
     assert rel(wall.small_strain_modulus(1e-100), 4 * mpf(2e3) * mpf(1e-100)) < 1e-14
 
