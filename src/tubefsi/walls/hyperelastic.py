@@ -611,11 +611,15 @@ class ThickWall(HyperelasticWall):
         # b lam_o - lam = d (b + lam^2)/(b lam_o + lam), d = b - 1 = t/a (2 + t/a): the share of g(lam_o)
         # without the cancellation of lam/(b lam_o) against 1 (all of it at t/a = 1e-100, where the
         # small-strain modulus g(1) d/b would come out 0)
-        # (lam_o = sqrt(lam^2 + d)/(1 + t/a) and the share in ratios of lam: doubles at lam = 1e300)
+        # (the share in ratios of lam, and past lam^2's overflow lam_o = sqrt(lam^2 + d)/(1 + t/a):
+        # doubles at lam = 1e300; the first form is exactly 1 at lam = 1, where fibres engage)
         lam = np.asarray(stretch, dtype=float)
         b = (1.0 + tb) ** 2
         d = tb * (2.0 + tb)
-        lam_o = np.hypot(lam, np.sqrt(d)) / (1.0 + tb)
+        with np.errstate(over="ignore"):
+            lam_o = np.sqrt(1.0 + (lam * lam - 1.0) / b)
+        if not np.all(np.isfinite(lam_o)):
+            lam_o = np.where(np.isfinite(lam_o), lam_o, np.hypot(lam, np.sqrt(d)) / (1.0 + tb))
         g_o = self._thick_integrand(lam_o)
         with np.errstate(over="ignore", invalid="ignore"):
             share = d * ((b / lam + lam) / (b * lam_o)) / (b * lam_o / lam + 1.0)
