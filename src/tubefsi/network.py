@@ -44,7 +44,6 @@ import copy
 import csv
 import json
 import math
-import warnings
 
 import attrs
 import numpy as np
@@ -56,14 +55,13 @@ from ._keywords import checked_keywords
 from ._progress import bar
 from ._validation import as_array
 from . import validity
-from .errors import (AccuracyWarning, ConvergenceError, InvalidParameterError, ModelValidityWarning,
-                     NoSteadyStateError, warn_user)
+from .errors import (AccuracyWarning, ConvergenceError, InvalidParameterError, NoSteadyStateError, warn_user)
 from .fields import varies, _array_fields, parameter_shape
 from .geometry import Tube
 from .scene import make_scene, resolve
 from .solution import Solution
 from .solve import max_flow_rate as tubefsi_max_flow
-from .solve import solve
+from .solve import solve, solve_unchecked
 
 __all__ = ["Network", "NetworkSolution"]
 
@@ -317,10 +315,10 @@ class _Groups:
         controlled; zeros for the tubes of no group)."""
         q, d_in, d_out, radius_in, radius_out = (np.zeros(drop.size) for _ in range(5))
         for (index, fluid, wall, tube), p_e in zip(self.parts, self.external):
-            with warnings.catch_warnings():    # Newton's trial pressures: the result is checked once
-                warnings.simplefilter("ignore", ModelValidityWarning)
-                sol = solve(fluid, wall, tube, pressure_drop=drop[index], outlet_pressure=outlet[index],
-                            external_pressure=p_e)
+            # Newton's trial pressures: unchecked (the result is checked once; no process-wide
+            # warning filter, which would silence other threads too)
+            sol = solve_unchecked(fluid, wall, tube, pressure_drop=drop[index], outlet_pressure=outlet[index],
+                                  external_pressure=p_e)
             q[index] = sol.flow_rate
             _, d_in[index], d_out[index] = sol._sensitivities()
             radius_in[index] = sol.inlet_radius
@@ -346,11 +344,10 @@ class _Groups:
         ``q > 0`` with ``outlet`` pressure; a flow rate beyond a tube's maximum raises, naming it."""
         p_in, radius_in, radius_out = (np.zeros(q.size) for _ in range(3))
         for (index, fluid, wall, tube), p_e in zip(self.parts, self.external):
-            with warnings.catch_warnings():    # checked with the rest of the result
-                warnings.simplefilter("ignore", ModelValidityWarning)
-                sol = solve(fluid, wall, tube, flow_rate=q[index], outlet_pressure=outlet[index],
-                            external_pressure=p_e, on_infeasible="nan")
-            if sol.feasible is not None:
+            # checked with the rest of the result
+            sol = solve_unchecked(fluid, wall, tube, flow_rate=q[index], outlet_pressure=outlet[index],
+                                  external_pressure=p_e, on_infeasible="nan")
+            if not np.all(sol.feasible):
                 j = int(np.flatnonzero(~sol.feasible)[0])
                 limit = np.broadcast_to(tubefsi_max_flow(fluid, wall, tube, outlet_pressure=outlet[index],
                                                          external_pressure=p_e), index.shape)[j]

@@ -27,8 +27,8 @@ from .couplers.rescaled import Rescaled, in_units
 from .errors import InvalidParameterError, NoSteadyStateError
 from .geometry import Tube
 from .rheology.power_law import FactorRangeError
-from .scene import Scene, State, _resolve, make_scene
-from .solution import Solution
+from .scene import Scene, State, _resolve, make_scene, resolve
+from .solution import Solution, max_flow_rate_of
 from .validity import check_and_warn
 
 __all__ = ["solve", "max_flow_rate", "select_coupler", "Problem", "CHUNK"]
@@ -46,8 +46,10 @@ def _ranked(couplers):
 
 @checked_keywords
 def select_coupler(rheology, wall, coupler="auto") -> Coupler:
-    """The coupler ``solve`` would use: a name, an instance, or ``"auto"`` (cheapest accurate)."""
-    return _select(rheology, wall, coupler)[0]
+    """The coupler ``solve`` would use for ``rheology`` and ``wall`` (instances, classes or
+    registered names, as ``solve`` takes them): a name, an instance, or ``"auto"`` (cheapest
+    accurate)."""
+    return _select(resolve("rheology", rheology), resolve("wall", wall), coupler)[0]
 
 
 def _select(rheology, wall, coupler):
@@ -357,17 +359,7 @@ def max_flow_rate(rheology, wall, tube, *, outlet_pressure=0.0, external_pressur
         unit = tube.radius       # in units of the radius (the limit is a flow rate: times unit^3)
         return max_flow_rate(rheology, wall, in_units(tube, unit), outlet_pressure=outlet_pressure,
                              external_pressure=external_pressure, coupler=coupler) * unit**3
-    return _max_flow_rate(scene, _choose(scene, coupler)[0])
-
-
-def _max_flow_rate(scene, chosen):
-    if scene.shape == ():
-        return float(chosen.max_flow_rate(scene))
-    flat = scene.flat(scene.shape)
-    out = np.empty(flat.size)
-    for index, part in flat.split(np.arange(flat.size)):
-        out[index] = chosen.max_flow_rate(part)
-    return out.reshape(scene.shape)
+    return max_flow_rate_of(scene, _choose(scene, coupler)[0])
 
 
 @attrs.frozen(init=False)
@@ -410,7 +402,7 @@ class Problem:
 
     def max_flow_rate(self):
         """:func:`tubefsi.max_flow_rate` of this problem (m^3/s; ``inf`` where there is none)."""
-        return _max_flow_rate(self.scene, self.coupler)
+        return max_flow_rate_of(self.scene, self.coupler)
 
 
 def _radius_units(function, args, kwargs):
@@ -445,7 +437,7 @@ def _radius_units(function, args, kwargs):
     state = State(q if q.ndim else float(q), inner.state.pressure_drop, inner.state.inlet_strain,
                   inner.state.log_stretch)
     return Solution(scene=scene, coupler=Rescaled(inner=inner.coupler, unit=unit), state=state, scalar=inner.scalar,
-                    coupler_name=inner.coupler_name, feasible=inner.feasible, controlled=inner.controlled)
+                    coupler_name=inner.coupler_name, feasible=inner._feasible, controlled=inner.controlled)
 
 
 def _radius_power_in_range(scene):

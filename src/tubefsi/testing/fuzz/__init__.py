@@ -68,6 +68,7 @@ from ._known import _known_probes
 from ._models import (_advise_probes, _entry_keyword_probes, _model_probes, _rheology_probes, _solution_probes,
                       _solve_probes, _tube_probes, _wall_probes)
 from ._scenes import scene_outcomes
+from ._solutions import solution_probes
 
 __all__ = ["Probe", "Outcome", "Report", "BREACHES", "TIME_LIMIT", "FAMILIES", "Selection", "bad_input_probes", "run_probe", "scene_outcomes",
            "campaign", "FuzzContract", "main"]
@@ -112,6 +113,14 @@ def _keywords_family(chosen):
         yield from _entry_keyword_probes()
 
 
+def _solutions_family(chosen):
+    """A solution's accessors at every shape of argument, for the first pair of each model."""
+    tube = Tube(**_TUBE)
+    for fluid, wall, tag in chosen.pairs():
+        if tag.split()[0].endswith("#0"):
+            yield from solution_probes(fluid, wall, tube, tag)
+
+
 def _known_family(chosen):
     if chosen.core:
         yield from _known_probes()
@@ -133,6 +142,7 @@ FAMILIES = {
     "fields": _fields_family,
     "keywords": _keywords_family,
     "entry points": _entry_points_family,
+    "solutions": _solutions_family,
     "known": _known_family,
 }
 
