@@ -195,7 +195,7 @@ class WallModel(abc.ABC):
         return evaluate(self, lambda wall, tb: wall._stiffness(np.ones(np.shape(tb)), tb),
                         _check_thickness(reduced_thickness))
 
-    def plot(self, reduced_thickness, *, ax=None, max_stretch=3.0, **kwargs):
+    def plot(self, reduced_thickness, *, ax=None, max_stretch=None, **kwargs):
         """Plot this wall's tube law; see :func:`tubefsi.plotting.plot_tube_law`."""
         from ..plotting import plot_tube_law
 
