@@ -799,6 +799,20 @@ class NetworkSolution:
 
         return plot_network(self, **kwargs)
 
+    def _repr_html_(self) -> str:
+        """The notebook summary: the size and convergence, then the first rows of the node and tube
+        tables with units."""
+        from . import _html
+
+        units = {"pressure": "Pa", "inflow": "m^3/s", "flow_rate": "m^3/s", "pressure_u": "Pa",
+                 "pressure_v": "Pa", "radius_u": "m", "radius_v": "m", "length": "m"}
+        return "\n".join([
+            _html.table("NetworkSolution", [("nodes", len(self.nodes)), ("tubes", len(self.tubes)),
+                                            ("Newton iterations", self.iterations),
+                                            ("residual", f"{self.residual:.2e}")]),
+            _html.columns_html("nodes", self.node_table(), units),
+            _html.columns_html("tubes", self.tube_table(), units)])
+
     def __repr__(self) -> str:
         return (f"NetworkSolution({len(self.nodes)} nodes, {len(self.tubes)} tubes, "
                 f"{self.iterations} iterations, residual {self.residual:.2e})")

@@ -377,6 +377,28 @@ class Solution:
 
         return plot_profiles(self, **kwargs)
 
+    def _repr_html_(self) -> str:
+        """The notebook summary: the load and the key results with units, the models and the tube."""
+        from . import _html
+
+        control = "flow-controlled" if self.controlled == "flow_rate" else "pressure-controlled"
+        results = [("flow rate", _html.number(self.flow_rate, "m^3/s")),
+                   ("pressure drop", _html.number(self.pressure_drop, "Pa")),
+                   ("inlet pressure", _html.number(self.inlet_pressure, "Pa")),
+                   ("outlet pressure", _html.number(self.outlet_pressure, "Pa")),
+                   ("inlet displacement", _html.number(self.inlet_displacement, "m")),
+                   ("inlet radius", _html.number(self.inlet_radius, "m"))]
+        feasible = self.feasible
+        if not feasible.all():
+            results.append(("feasible", f"{int(feasible.sum())} of {feasible.size} points"))
+        tube = self.tube
+        geometry = [(name, _html.number(getattr(tube, name), "m")) for name in ("radius", "thickness", "length")]
+        return "\n".join([
+            _html.table(f"Solution ({control}, coupler '{self.coupler_name}', shape {np.shape(self.state.flow_rate)})",
+                        results),
+            _html.model_html(self.rheology, "rheology"), _html.model_html(self.wall, "wall"),
+            _html.table("tube", geometry)])
+
     def __repr__(self) -> str:
         return (f"Solution(flow_rate={self.flow_rate!r}, pressure_drop={self.pressure_drop!r}, "
                 f"inlet_displacement={self.inlet_displacement!r}, coupler={self.coupler_name!r})")

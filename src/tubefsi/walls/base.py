@@ -195,6 +195,12 @@ class WallModel(abc.ABC):
         return evaluate(self, lambda wall, tb: wall._stiffness(np.ones(np.shape(tb)), tb),
                         _check_thickness(reduced_thickness))
 
+    def _repr_html_(self) -> str:
+        """The notebook summary: the class, its registered name and the parameters with units."""
+        from .._html import model_html
+
+        return model_html(self, "wall")
+
     def plot(self, reduced_thickness, *, ax=None, max_stretch=None, **kwargs):
         """Plot this wall's tube law; see :func:`tubefsi.plotting.plot_tube_law`."""
         from ..plotting import plot_tube_law
