@@ -195,7 +195,9 @@ class Network:
     def from_networkx(cls, graph, *, rheology=None, wall="wall", tube="tube", fluid="rheology",
                       pressure="pressure", inflow="inflow", pos="pos"):
         """A network from a networkx graph whose edges hold a ``wall`` and a ``tube`` attribute
-        (and optionally ``fluid``); nodes may hold ``pressure``, ``inflow`` and ``pos``.
+        (and optionally a ``rheology`` attribute, the fluid of that tube); nodes may hold
+        ``pressure``, ``inflow`` and ``pos``. Each keyword names the attribute to read (``fluid``:
+        the edge attribute holding a tube's rheology, ``"rheology"`` by default).
 
         Edges run from the first node to the second as networkx lists them; a multigraph's
         tubes are named ``(u, v, key)``.

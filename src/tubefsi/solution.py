@@ -220,9 +220,11 @@ class Solution:
 
         From the separated identity (``docs/theory.md``, section "Sensitivities"): for a rheology
         parameter, :math:`G_{in}\int_0^L \partial_\theta\ln G\,dz` (closed forms for the power
-        law and the Newtonian fluid, a central difference of :math:`G` otherwise); for the
-        modulus that the tube law is proportional to (``P = \mu\hat P``: the shear modulus of a
-        neo-Hookean wall, Young's modulus of a linear one) with an unloaded outlet,
+        law and the Newtonian fluid; otherwise central differences of :math:`\ln G` at relative
+        steps 1e-3 and 5e-4, Richardson-extrapolated). For the wall, only the modulus that scales
+        its tube law, :math:`P = \mu\hat P` with :math:`\hat P` free of it (the shear modulus of a
+        neo-Hookean wall, Young's modulus of a linear one: the field whose doubling doubles the
+        tube law and leaves the wall's shape parameters unchanged), with an unloaded outlet:
         :math:`(\Delta p - L G_{in})/\mu`. Other wall parameters raise
         ``InvalidParameterError`` (difference two solves). 0 where ``q = 0``.
         """

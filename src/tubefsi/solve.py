@@ -292,6 +292,7 @@ def _solve_points(runner, scene, controlled, load, shape, on_infeasible, progres
     out = {f: np.full(n, np.nan) for f in _STATE_FIELDS}
     feasible = np.ones(n, dtype=bool)
     shown = bar(n, progress, "tubefsi.solve")
+    done = 0
     for index, part in flat.split(np.arange(n)):
         for start in range(0, index.size, CHUNK):
             idx = index[start:start + CHUNK]
@@ -302,6 +303,8 @@ def _solve_points(runner, scene, controlled, load, shape, on_infeasible, progres
             if ok is not None:
                 feasible[idx] = ok
             shown.update(idx.size)
+            done += idx.size
+    shown.update(n - done)          # (points no part holds: the bar still ends at its total)
     shown.close()
     state = State(*(out[f].reshape(shape) for f in _STATE_FIELDS))
     return state, (None if np.all(feasible) else feasible)

@@ -61,6 +61,12 @@ import dataclasses
 import time
 from typing import NamedTuple
 
+try:
+    import hypothesis  # noqa: F401 - the random scenes need it; say so before anything fails inside
+except ModuleNotFoundError as exc:
+    raise ModuleNotFoundError("tubefsi.testing.fuzz needs hypothesis, from the test extra: pip install '.[test]' "
+                              "in a clone of tubefsi (docs/installation.md)", name=exc.name) from exc
+
 from ... import registry
 from ...geometry import Tube
 from ._core import BREACHES, TIME_LIMIT, _TUBE, Outcome, Probe, Report, run_probe
