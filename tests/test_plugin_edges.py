@@ -20,6 +20,7 @@ import pytest
 import tubefsi
 from tubefsi import cli, registry
 from tubefsi.registry import PluginWarning
+from tubefsi.testing.fuzz import bad_input_probes, run_probe
 
 SCENE = ["--rheology", "power-law:consistency=0.017,index=0.7", "--wall", "thick-neo-hookean:shear_modulus=2000",
          "--tube", "radius=1e-4,thickness=3e-5,length=1e-2"]
@@ -181,3 +182,11 @@ def test_warnings_as_errors_on_the_command_line(install, capsys):
         assert cli.main(["list"]) == 0
     assert "thick-neo-hookean" in capsys.readouterr().out
 
+
+def test_the_hostile_plugins_family_finds_no_breach_and_leaves_no_trace():
+    before = {kind: dict(getattr(registry, kind)) for kind in ("rheologies", "walls", "couplers")}
+    probes = bad_input_probes(families=["hostile plugins"])
+    assert len(probes) >= 30
+    breaches = [o for o in map(run_probe, probes) if o.breach]
+    assert not breaches, "\n".join(f"{o.category}: {o.entry} [{o.label}] {o.detail}" for o in breaches)
+    assert {kind: dict(getattr(registry, kind)) for kind in before} == before

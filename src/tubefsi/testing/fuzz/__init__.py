@@ -64,9 +64,11 @@ from typing import NamedTuple
 from ... import registry
 from ...geometry import Tube
 from ._core import BREACHES, TIME_LIMIT, _TUBE, Outcome, Probe, Report, run_probe
+from ._cli import _cli_family
 from ._known import _known_probes
 from ._models import (_advise_probes, _entry_keyword_probes, _model_probes, _rheology_probes, _solution_probes,
                       _solve_probes, _tube_probes, _wall_probes)
+from ._plugins import _plugins_family
 from ._scenes import scene_outcomes
 
 __all__ = ["Probe", "Outcome", "Report", "BREACHES", "TIME_LIMIT", "FAMILIES", "Selection", "bad_input_probes", "run_probe", "scene_outcomes",
@@ -134,6 +136,8 @@ FAMILIES = {
     "keywords": _keywords_family,
     "entry points": _entry_points_family,
     "known": _known_family,
+    "cli files": _cli_family,
+    "hostile plugins": _plugins_family,
 }
 
 
