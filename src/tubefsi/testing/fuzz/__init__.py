@@ -70,9 +70,11 @@ except ModuleNotFoundError as exc:
 from ... import registry
 from ...geometry import Tube
 from ._core import BREACHES, TIME_LIMIT, _TUBE, Outcome, Probe, Report, run_probe
+from ._cli import _cli_family
 from ._known import _known_probes
 from ._models import (_advise_probes, _entry_keyword_probes, _model_probes, _rheology_probes, _solution_probes,
                       _solve_probes, _tube_probes, _wall_probes)
+from ._plugins import _plugins_family
 from ._scenes import scene_outcomes
 from ._solutions import solution_probes
 
@@ -150,6 +152,8 @@ FAMILIES = {
     "entry points": _entry_points_family,
     "solutions": _solutions_family,
     "known": _known_family,
+    "cli files": _cli_family,
+    "hostile plugins": _plugins_family,
 }
 
 
