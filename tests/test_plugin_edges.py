@@ -190,3 +190,43 @@ def test_the_hostile_plugins_family_finds_no_breach_and_leaves_no_trace():
     breaches = [o for o in map(run_probe, probes) if o.breach]
     assert not breaches, "\n".join(f"{o.category}: {o.entry} [{o.label}] {o.detail}" for o in breaches)
     assert {kind: dict(getattr(registry, kind)) for kind in before} == before
+
+
+BROKEN_COUPLERS = '''
+from tubefsi.couplers.quadrature import Quadrature
+
+
+class NoBuild(Quadrature):
+    """A coupler that cannot be built."""
+
+    cost_rank = -10
+
+    def __init__(self):
+        raise RuntimeError("no licence server")
+
+
+class NoSupports(Quadrature):
+    """A coupler whose supports() raises."""
+
+    cost_rank = -9
+
+    def supports(self, rheology, wall):
+        raise KeyError("lookup table missing")
+'''
+
+
+def test_a_plugin_coupler_that_raises_is_passed_over_by_auto(install):
+    """A coupler of the right base that raises when built or asked what it supports is left out of
+    ``auto`` with a warning naming it; the built-ins answer, to the bit."""
+    reference = _solve_builtin()
+    install("broken-couplers", """
+        [tubefsi.couplers]
+        no-build = broken_couplers:NoBuild
+        no-supports = broken_couplers:NoSupports
+        """, {"broken_couplers": BROKEN_COUPLERS})
+    with pytest.warns(PluginWarning) as record:
+        sol = _solve_builtin()
+    message = _plugin_messages(record)
+    assert "'no-build'" in message and "no licence server" in message
+    assert "'no-supports'" in message and "lookup table missing" in message
+    assert sol.pressure_drop == reference.pressure_drop and sol.coupler_name == reference.coupler_name

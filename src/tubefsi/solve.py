@@ -17,6 +17,7 @@ import attrs
 import numpy as np
 
 from . import registry
+from .registry import PluginWarning
 from ._keywords import checked_keywords
 from ._progress import bar
 from ._validation import as_load
@@ -24,7 +25,7 @@ from .couplers.base import Coupler
 from .couplers.checked import checked
 from .couplers.graded import Graded
 from .couplers.rescaled import Rescaled, in_units
-from .errors import InvalidParameterError, NoSteadyStateError
+from .errors import InvalidParameterError, NoSteadyStateError, warn_user
 from .geometry import Tube
 from .rheology.power_law import FactorRangeError
 from .scene import Scene, State, _resolve, make_scene, resolve
@@ -39,9 +40,28 @@ _STATE_FIELDS = State._fields
 
 
 def _ranked(couplers):
-    """The registered couplers that meet the accuracy contract, one instance each, cheapest first."""
+    """The registered couplers that meet the accuracy contract, one instance each, cheapest first
+    (a plugin coupler that cannot be built with its defaults is left out, with a PluginWarning)."""
     ranked = sorted((couplers[name].cost_rank, name) for name in couplers if couplers[name].meets_accuracy_contract)
-    return tuple((couplers[name](), name) for _, name in ranked)
+    out = []
+    for _, name in ranked:
+        try:
+            out.append((couplers[name](), name))
+        except Exception as exc:          # noqa: BLE001 (a plugin's failure, whatever it is, is its own)
+            warn_user(f"coupler {name!r} is left out of 'auto': building it raised {type(exc).__name__}: {exc}",
+                      PluginWarning)
+    return tuple(out)
+
+
+def _supports(instance, name, rheology, wall) -> bool:
+    """Whether ``auto``'s candidate supports the pair; a plugin coupler whose ``supports`` raises
+    does not (with a PluginWarning)."""
+    try:
+        return bool(instance.supports(rheology, wall))
+    except Exception as exc:              # noqa: BLE001
+        warn_user(f"coupler {name!r} is passed over by 'auto': its supports() raised {type(exc).__name__}: {exc}",
+                  PluginWarning)
+        return False
 
 
 @checked_keywords
@@ -56,7 +76,7 @@ def _select(rheology, wall, coupler):
     """``(coupler, name)``: the coupler that answers for the pair and its registered name."""
     if type(coupler) is str and coupler == "auto":
         for instance, name in registry.couplers.derived("auto", _ranked):
-            if instance.supports(rheology, wall):
+            if _supports(instance, name, rheology, wall):
                 return instance, name
         raise InvalidParameterError("coupler", "a coupler that supports this pair", "auto",
                                     "no registered coupler supports it")
