@@ -623,20 +623,22 @@ class _Solver:
                 if t_balance is not None and np.linalg.norm(t_balance[free]) <= (1 - 1e-4 * alpha) * norm:
                     break
                 alpha *= 0.5
-                if alpha < 1e-10 and np.all(np.abs(F) <= 10 * self._noise(p, q, gu, gv)):
-                    warn_user(f"network: mass balance to {worst / through:.1e} of the throughput, not rtol = "
+                if alpha < 1e-10 and np.all(np.abs(F) <= 10 * self._noise(p, q, gu, gv)) \
+                        and _share(worst, through) <= _WORST_ROUNDED:
+                    warn_user(f"network: mass balance to {_share(worst, through):.1e} of the throughput, not rtol = "
                               f"{rtol:g}: pressures close to a limit pressure amplify the rounding of the "
                               f"pressures into the flows beyond that", AccuracyWarning)
-                    return self._result(p, q, r_u, r_v, iteration, worst / through)
+                    return self._result(p, q, r_u, r_v, iteration, _share(worst, through))
                 if alpha < 1e-10:
                     raise ConvergenceError(f"network: the line search stalled after {iteration} Newton iterations; "
-                                           f"largest mass imbalance {worst:.3e} m^3/s = {worst / through:.3e} of the "
-                                           f"throughput (rtol {rtol:g})")
+                                           f"largest mass imbalance {worst:.3e} m^3/s = {_share(worst, through):.3e} of "
+                                           f"the throughput (rtol {rtol:g}){_UNRESOLVED if through == 0 else ''}")
             p, q, gu, gv, r_u, r_v, balance = trial, t_q, t_gu, t_gv, t_ru, t_rv, t_balance
             if shown is not None:
                 shown.update()
         raise ConvergenceError(f"network: no convergence in {max_iterations} Newton iterations; largest mass "
-                               f"imbalance {worst:.3e} m^3/s = {worst / through:.3e} of the throughput (rtol {rtol:g})")
+                               f"imbalance {worst:.3e} m^3/s = {_share(worst, through):.3e} of the throughput "
+                               f"(rtol {rtol:g}){_UNRESOLVED if through == 0 else ''}")
 
     def _result(self, p, q, r_u, r_v, iterations, residual):
         if self.feed_groups.parts:
@@ -818,6 +820,23 @@ class NetworkSolution:
     def __repr__(self) -> str:
         return (f"NetworkSolution({len(self.nodes)} nodes, {len(self.tubes)} tubes, "
                 f"{self.iterations} iterations, residual {self.residual:.2e})")
+
+
+#: Why a network can have no resolvable throughput: tubes in series whose conductances differ by
+#: more than double precision resolves (the drop over the wide one is below one rounding unit of
+#: the pressures, so its flow is either 0 or far too large).
+_UNRESOLVED = ("; no flow is resolved at all: tubes in series whose conductances differ beyond double "
+               "precision (e.g. radii 5 m and 0.1 mm) cannot balance; model the wide one as a node")
+
+
+#: The largest mass imbalance (a share of the throughput) accepted, with an AccuracyWarning, where
+#: the rounding of the pressures allows no better; beyond it the line search's stall is an error.
+_WORST_ROUNDED = 1e-6
+
+
+def _share(worst, through) -> float:
+    """The imbalance as a share of the throughput (inf where nothing flows but something should)."""
+    return worst / through if through > 0 else (0.0 if worst == 0 else float("inf"))
 
 
 def _hashable(x) -> bool:
