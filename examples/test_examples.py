@@ -14,6 +14,7 @@ import csv
 import importlib.util
 import math
 import re
+import warnings
 from pathlib import Path
 
 import matplotlib
@@ -21,6 +22,8 @@ import matplotlib
 matplotlib.use("Agg")
 
 import pytest  # noqa: E402
+
+import tubefsi  # noqa: E402
 
 EXAMPLES = Path(__file__).resolve().parent
 FLOAT = r"[-+]?(?:\d+\.?\d*(?:e[-+]?\d+)?|inf|nan)"
@@ -51,8 +54,12 @@ def assert_pngs(directory, names, min_bytes=10_000):
 # ---------------------------------------------------------------------------- demo.py
 def test_demo_writes_its_table_and_four_figures(tmp_path, capsys):
     out = tmp_path / "demo"
-    assert load("demo").main([str(out)]) == 0
+    with warnings.catch_warnings():           # the demo's scenes are valid, or say why not
+        warnings.simplefilter("error", tubefsi.ModelValidityWarning)
+        assert load("demo").main([str(out)]) == 0
     text = capsys.readouterr().out
+    notes = text.split("shown on purpose to compare the walls")[1].split("maximum steady flow rate")[0]
+    assert "thin-linear: inlet hoop strain" in notes and "thick-linear: inlet hoop strain" in notes
     for name in ("rigid", "thin-linear", "thick-linear", "thin-neo-hookean", "thick-neo-hookean",
                  "maximum steady flow rate"):
         assert name in text
@@ -102,8 +109,11 @@ def _curves(path):
 
 def test_reproduce_chapter_writes_both_variants_of_both_figures(tmp_path, capsys):
     points = 11
-    assert load("reproduce_chapter").main([str(tmp_path), "--points", str(points)]) == 0
+    with warnings.catch_warnings():     # the chapter's curves leave the model's range: said, not warned
+        warnings.simplefilter("error", tubefsi.ModelValidityWarning)
+        assert load("reproduce_chapter").main([str(tmp_path), "--points", str(points)]) == 0
     text = capsys.readouterr().out
+    assert "linear walls reach inlet strains up to" in text
     assert f"({points} points)" in text
     stems = [f"{f}_{v}" for f in ("thin", "thick") for v in ("printed", "consistent")]
     assert_pngs(tmp_path, [f"{s}.png" for s in stems])
@@ -248,3 +258,25 @@ def test_network_study_maps_batches_over_dask(tmp_path, capsys):
     one = study.solve_batch((7, moduli[7:8], index[7:8]))[0]
     assert float(rows[7]["split_fraction"]) == pytest.approx(one[1], rel=1e-12)
     assert 0.5 < float(rows[7]["split_fraction"]) < 1.0
+
+
+# ---------------------------------------------------------------------------- gallery, README
+@pytest.mark.parametrize("script", sorted(p.name for p in (EXAMPLES / "gallery").glob("plot_*.py")))
+def test_gallery_scripts_do_not_warn(script, tmp_path, monkeypatch, capsys):
+    """A gallery figure is a valid scene, or catches and prints the warning it shows on purpose."""
+    import matplotlib.pyplot as plt
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(plt, "show", lambda *a, **k: None)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", tubefsi.ModelValidityWarning)
+        exec(compile((EXAMPLES / "gallery" / script).read_text(), script, "exec"), {"__name__": "__main__"})
+    plt.close("all")
+
+
+def test_readme_snippet_does_not_warn(tmp_path, monkeypatch):
+    block = re.findall(r"```python\n(.*?)```", (EXAMPLES.parent / "README.md").read_text(), flags=re.S)[0]
+    monkeypatch.chdir(tmp_path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", tubefsi.ModelValidityWarning)
+        exec(compile(block, "README.md", "exec"), {})

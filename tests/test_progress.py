@@ -75,3 +75,17 @@ def test_fem_reference_shows_its_coupling_iterations(capsys):
     assert seen and "coupling iteration" in err
     assert shown.pressure_drop == quiet.pressure_drop and quiet.iterations > 1
     assert math.isfinite(shown.pressure_drop)
+
+
+def test_a_long_sweeps_bar_ends_at_its_total_and_stays(capsys):
+    """A sweep over several chunks (and over fluids whose parameters vary, solved one parameter
+    set at a time) leaves a finished bar at n/n, not 0 % or a count short of n (issue 27)."""
+    n = 21_000                   # more than one chunk (tubefsi.solve.CHUNK, 16384 points)
+    tubefsi.solve(FLUID, walls["thick-neo-hookean"](shear_modulus=2e3), TUBE,
+                  flow_rate=np.linspace(1e-11, 1e-9, n), progress=True)
+    err = capsys.readouterr().err
+    assert f"{n}/{n}" in err.replace(",", "")
+    fluid = rheologies["power-law"](consistency=np.linspace(0.01, 0.02, 7)[:, None], index=0.7)
+    tubefsi.solve(fluid, walls["thick-neo-hookean"](shear_modulus=2e3), TUBE, flow_rate=np.full((7, 3), 1e-10),
+                  progress=True)
+    assert "21/21" in capsys.readouterr().err

@@ -153,7 +153,7 @@ def test_collision_between_plugins_does_not_depend_on_discovery_order(install, o
             [tubefsi.walls]
             fake-wall = {module}:{cls}
             only-{cls.lower()} = {module}:{cls}
-            """, {module: f"class {cls}:\n    pass\n"})
+            """, {module: f"from tubefsi.walls import WallModel\n\nclass {cls}(WallModel):\n    pass\n"})
     assert _providers("tubefsi.walls", "fake-wall") == list(reversed(order))  # each install goes first
     registry.walls["rigid"]
     assert "alpha_walls_mod" not in sys.modules and "zeta_walls_mod" not in sys.modules  # lazy per name
@@ -178,7 +178,7 @@ def test_broken_plugin_warns_and_does_not_block_a_lower_priority_provider(instal
         "bbb-good": ("""
             [tubefsi.walls]
             fake-wall = bbb_good_walls:GoodWall
-            """, {"bbb_good_walls": "class GoodWall:\n    pass\n"}),
+            """, {"bbb_good_walls": "from tubefsi.walls import WallModel\n\nclass GoodWall(WallModel):\n    pass\n"}),
     }
     for dist in order:
         install(dist, *plugins[dist])

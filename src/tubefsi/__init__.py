@@ -23,14 +23,14 @@ import importlib
 import sys
 import types
 
-from .errors import (AccuracyWarning, ConvergenceError, InvalidParameterError, KeywordError, ModelValidityWarning,
-                     NoSteadyStateError, StretchRangeError, TubefsiError, BucklingError)
+from .errors import (AccuracyWarning, BucklingError, ConvergenceError, FitWarning, InvalidParameterError, KeywordError,
+                     ModelValidityWarning, NoSteadyStateError, StretchRangeError, TubefsiError)
 
 __all__ = [
     "dimensionless", "fields", "Tube", "solve", "max_flow_rate", "select_coupler", "Solution", "registry",
     "advise", "Advice", "Diagnostics", "ModelValidityWarning", "fit", "FitResult", "Network", "NetworkSolution",
     "TubefsiError", "InvalidParameterError", "KeywordError", "NoSteadyStateError", "ConvergenceError", "AccuracyWarning",
-    "StretchRangeError", "BucklingError", "Profile", "sampled", "Problem", "cache_clear", "cache_info",
+    "StretchRangeError", "BucklingError", "FitWarning", "Profile", "sampled", "Problem", "cache_clear", "cache_info",
 ]
 
 __version__ = "0.1.0"

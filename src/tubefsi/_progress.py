@@ -38,4 +38,5 @@ def bar(total: int, progress, desc: str, unit: str = "point"):
         raise ImportError("progress=True needs tqdm: pip install 'tubefsi[progress]'") from None
     if progress == "auto" and not (hasattr(sys.stderr, "isatty") and sys.stderr.isatty()):
         return _Silent()
-    return tqdm(total=total, desc=desc, unit=unit, leave=False, file=sys.stderr)
+    # the finished bar stays (tqdm's default): a sweep that ends shows that it ended, at its total
+    return tqdm(total=total, desc=desc, unit=unit, leave=True, file=sys.stderr)

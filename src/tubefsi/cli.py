@@ -19,9 +19,12 @@ one value or a comma-separated list; negative numbers reach the library's
 validation (``--flow-rate -1e-9`` as well as ``--flow-rate=-1e-9``). Output paths and
 formats (``--output``, ``--plot``) are checked before anything is computed. Any bad
 argument — an unknown model or parameter, a value outside its admissible range, a load
-beyond the maximum flow rate — ends with a one-line ``tubefsi: error: ...`` on stderr and
-exit status 2; a result outside the model's assumptions prints ``tubefsi: warning: ...``
-lines on stderr (:mod:`tubefsi.validity`).
+beyond the maximum flow rate, a malformed network file — ends with a one-line
+``tubefsi: error: ...`` on stderr and exit status 2; a result outside the model's assumptions
+prints ``tubefsi: warning: ...`` lines on stderr (:mod:`tubefsi.validity`), and so does a
+plugin that cannot be registered. A closed standard output (``>&-``) or one whose reader stops
+(``| head``) ends the command quietly with status 0; characters the output's encoding lacks are
+printed as backslash escapes.
 
 The command starts fast: ``--help``, ``--version`` import only the standard library and
 the registry; ``list`` imports every registered model but not SciPy, which the models load on
@@ -31,10 +34,13 @@ first use (:mod:`tubefsi._lazy`); ``python -m tubefsi`` runs the same command.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import inspect
+import io
 import json
 import os
 import re
+import reprlib
 import sys
 import warnings
 
@@ -237,7 +243,11 @@ def _tube(text, option):
     ``outlet_thickness=..`` the radius and/or the thickness run linearly from the inlet's value
     (``radius``, ``thickness``) to the outlet's (a :func:`tubefsi.sampled` linear table over
     ``[0, length]``, ``docs/graded.md``)."""
-    tube_params = _parse_pairs(text, text)
+    return _tube_from(_parse_pairs(text, text), option)
+
+
+def _tube_from(tube_params, option):
+    """A Tube from a dict of the keys of :func:`_tube`."""
     expected = ("radius", "thickness", "length")
     unknown = [k for k in tube_params if k not in expected and k not in _TAPER_KEYS]
     if unknown:
@@ -318,7 +328,7 @@ def _parser() -> argparse.ArgumentParser:
     p.set_defaults(run=_cmd_solve)
 
     p = sub.add_parser("reproduce", help="the chapter's figures, as printed and consistent (PNG and CSV)")
-    p.add_argument("out", nargs="?", default="chapter-figures", metavar="OUTDIR",
+    p.add_argument("out", nargs="?", default="chapter-figures", metavar="OUTDIR", type=_path,
                    help="output directory (default: ./chapter-figures)")
     p.add_argument("--png-only", action="store_true", help="write the figures without their CSV data")
     p.set_defaults(run=_cmd_reproduce)
@@ -333,8 +343,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--format", choices=("csv", "json", "netcdf"), default=None,
                    help="table format (default: from the --output suffix .csv/.json/.nc, else csv; "
                         "netcdf needs xarray)")
-    p.add_argument("--output", metavar="FILE", help="write the table to FILE instead of standard output")
-    p.add_argument("--plot", metavar="FILE", help="also save a plot of the curve (PNG, SVG, PDF, ...)")
+    p.add_argument("--output", metavar="FILE", type=_path,
+                   help="write the table to FILE (.csv, .json, .nc) instead of standard output")
+    p.add_argument("--plot", metavar="FILE", type=_path, help="also save a plot of the curve (PNG, SVG, PDF, ...)")
     p.add_argument("--density", type=float, metavar="RHO",
                    help="fluid density (kg/m^3): warn where the reduced Reynolds number is not small")
     p.add_argument("--progress", action="store_true",
@@ -348,10 +359,11 @@ def _parser() -> argparse.ArgumentParser:
                                    '"length": 1e-2}}, ...], "pressures": {"a": 500, "c": 0}, "inflows": {}}. '
                                    + _SCENE_HELP)
     p.add_argument("file", metavar="FILE", help="the network description (JSON)")
-    p.add_argument("--format", choices=("json", "csv"), default="json",
+    p.add_argument("--format", choices=("json", "csv"), default=None,
                    help="json (default: nodes and tubes) or csv (two tables, PREFIX_nodes.csv, PREFIX_tubes.csv)")
-    p.add_argument("--output", metavar="FILE|PREFIX", help="write the result here instead of standard output")
-    p.add_argument("--plot", metavar="FILE", help="also save a plot of the network")
+    p.add_argument("--output", metavar="FILE|PREFIX", type=_path,
+                   help="write the result here (FILE.json, or PREFIX with --format csv) instead of standard output")
+    p.add_argument("--plot", metavar="FILE", type=_path, help="also save a plot of the network")
     p.set_defaults(run=_cmd_network)
 
     p = sub.add_parser("advise", help="compare the model with simpler ones on the same scene",
@@ -367,6 +379,13 @@ def _parser() -> argparse.ArgumentParser:
 
 
 _SCENE_HELP = "Models are NAME or NAME:key=value,...; see 'tubefsi list'. SI units throughout."
+
+
+def _path(text):
+    """An output path (argparse type): not empty, which would silently mean standard output."""
+    if not text:
+        raise argparse.ArgumentTypeError("needs a file name, got an empty string")
+    return text
 
 
 def _add_scene_args(p):
@@ -422,8 +441,13 @@ def _check_outputs(args):
     fmt = args.format
     if args.output:
         _writable("--output", args.output)
+        suffix = os.path.splitext(args.output)[1].lower()
+        if fmt is None and suffix and suffix not in _FORMATS:   # y.png, y.xlsx: not a table this writes
+            hint = "; a figure is --plot FILE" if suffix.lstrip(".") in _figure_formats() else ""
+            raise UsageError(f"--output {args.output!r}: {suffix!r} is not a table format; use .csv, .json or .nc "
+                             f"(or give --format){hint}")
         if fmt is None:
-            fmt = _FORMATS.get(os.path.splitext(args.output)[1].lower(), "csv")
+            fmt = _FORMATS.get(suffix, "csv")
     fmt = fmt or "csv"
     if fmt == "netcdf":
         if not args.output:
@@ -434,14 +458,19 @@ def _check_outputs(args):
             raise UsageError("--format netcdf needs xarray: pip install 'tubefsi[xarray]'") from None
     if args.plot:
         _writable("--plot", args.plot)
-        from matplotlib.figure import Figure
-
-        supported = Figure().canvas.get_supported_filetypes()
+        supported = _figure_formats()
         ext = os.path.splitext(args.plot)[1].lower().lstrip(".")
         if ext not in supported:
             raise UsageError(f"--plot {args.plot!r}: the format {ext or '(none)'!r} is not one matplotlib writes; "
                              f"use one of {', '.join(sorted(supported))}")
     return fmt
+
+
+def _figure_formats():
+    """The file formats matplotlib writes (png, pdf, svg, ...)."""
+    from matplotlib.figure import Figure
+
+    return Figure().canvas.get_supported_filetypes()
 
 
 def _cmd_curve(args, out) -> int:
@@ -490,43 +519,129 @@ def _cmd_curve(args, out) -> int:
     return 0
 
 
+#: The keys of a network file, and of each of its tubes: required, then optional (``docs/cli.md``).
+_NETWORK_KEYS = ("rheology", "tubes", "pressures", "inflows", "positions")
+_TUBE_KEYS = ("u", "v", "wall", "tube")
+_TUBE_OPTIONAL = ("name", "rheology", "external_pressure")
+
+
 def _network_from_file(path):
-    """A :class:`~tubefsi.Network` from a JSON description (``docs/cli.md``, "Networks")."""
+    """A :class:`~tubefsi.Network` from a JSON description (``docs/cli.md``, "Networks"). Whatever
+    is malformed is a :class:`UsageError` naming the file and the place in it (``tubes[2]: wall:
+    ...``), checked here field by field: JSON holds any type anywhere, and a list where a node name
+    or a number belongs would otherwise fail deep inside the library."""
     from .network import Network
 
-    try:
-        with open(path, encoding="utf-8") as fh:
-            spec = json.load(fh)
-    except OSError as exc:
-        raise UsageError(f"cannot read the network file {path!r}: {exc.strerror}") from None
-    except json.JSONDecodeError as exc:
-        raise UsageError(f"{path!r} is not JSON: {exc.msg} at line {exc.lineno}") from None
+    spec = _read_json(path)
     if not isinstance(spec, dict) or not isinstance(spec.get("tubes"), list) or not spec["tubes"]:
         raise UsageError(f"{path!r}: expected an object with a non-empty list 'tubes'")
-    unknown = sorted(set(spec) - {"rheology", "tubes", "pressures", "inflows", "positions"})
-    if unknown:
-        raise UsageError(f"{path!r}: unknown key {unknown[0]!r}; keys: rheology, tubes, pressures, inflows, "
-                         "positions")
-    fluid = _build("rheology", registry.rheologies, spec["rheology"]) if "rheology" in spec else None
+    _only_keys(path, "", spec, _NETWORK_KEYS)
+    with _located(path, "rheology"):
+        fluid = _model_at("rheology", registry.rheologies, spec["rheology"]) if "rheology" in spec else None
     net = Network(rheology=fluid)
     for i, item in enumerate(spec["tubes"]):
-        where = f"{path!r}, tube {i}"
-        if not isinstance(item, dict) or not {"u", "v", "wall", "tube"} <= set(item):
-            raise UsageError(f"{where}: expected u, v, wall, tube (and optionally name, rheology, external_pressure)")
-        geometry = item["tube"]
-        if isinstance(geometry, dict):
-            geometry = ",".join(f"{k}={v}" for k, v in geometry.items())
-        wall = _build("wall", registry.walls, item["wall"])
-        rheology = _build("rheology", registry.rheologies, item["rheology"]) if "rheology" in item else None
-        net.add_tube(item["u"], item["v"], wall, _tube(geometry, f"{where}: tube"), name=item.get("name"),
-                     rheology=rheology, external_pressure=item.get("external_pressure", 0.0))
-    for node, p in dict(spec.get("pressures", {})).items():
-        net.set_pressure(node, p)
-    for node, q in dict(spec.get("inflows", {})).items():
-        net.set_inflow(node, q)
-    for node, xy in dict(spec.get("positions", {})).items():
-        net.set_position(node, xy)
+        place = f"tubes[{i}]"
+        if not isinstance(item, dict) or not set(_TUBE_KEYS) <= set(item):
+            raise UsageError(f"{path!r}, {place}: expected an object with u, v, wall, tube (and optionally "
+                             f"name, rheology, external_pressure), got {reprlib.repr(item)}")
+        _only_keys(path, place, item, _TUBE_KEYS + _TUBE_OPTIONAL)
+        with _located(path, place):
+            name = item.get("name")
+            if name is not None and not (isinstance(name, str) or type(name) is int):
+                raise UsageError(f"name: a tube's name is a string or an integer, got {reprlib.repr(name)}")
+            wall = _model_at("wall", registry.walls, item["wall"])
+            rheology = _model_at("rheology", registry.rheologies, item["rheology"]) if "rheology" in item else None
+            net.add_tube(_node_at("u", item["u"]), _node_at("v", item["v"]), wall, _tube_at(item["tube"]), name=name,
+                         rheology=rheology,
+                         external_pressure=_number_at("external_pressure", item.get("external_pressure", 0.0), "Pa"))
+    for key, unit in (("pressures", "Pa"), ("inflows", "m^3/s"), ("positions", "[x, y]")):
+        entries = spec.get(key, {})
+        if not isinstance(entries, dict):
+            raise UsageError(f"{path!r}, {key}: expected an object {{node: {unit}}}, got {reprlib.repr(entries)}")
+        for node, value in entries.items():
+            with _located(path, f"{key}[{node!r}]"):
+                if key == "pressures":
+                    net.set_pressure(node, _number_at("pressure", value, unit))
+                elif key == "inflows":
+                    net.set_inflow(node, _number_at("inflow", value, unit))
+                elif isinstance(value, list) and len(value) == 2:
+                    net.set_position(node, [_number_at("x", value[0], "plot units"),
+                                            _number_at("y", value[1], "plot units")])
+                else:
+                    raise UsageError(f"expected a position [x, y] (two numbers), got {reprlib.repr(value)}")
     return net
+
+
+def _read_json(path):
+    """The JSON value in the file ``path``; a file that cannot be read or is not JSON is a UsageError."""
+    try:
+        with open(path, encoding="utf-8") as fh:
+            return json.load(fh)
+    except OSError as exc:
+        raise UsageError(f"cannot read the network file {path!r}: {exc.strerror or exc}") from None
+    except RecursionError:       # Python's json recurses once per level of nesting
+        raise UsageError(f"{path!r}: the JSON is nested too deeply to read (a network file is a few levels deep)") \
+            from None
+    except UnicodeDecodeError as exc:
+        raise UsageError(f"{path!r} is not JSON: not UTF-8 text (byte {exc.start})") from None
+    except json.JSONDecodeError as exc:
+        raise UsageError(f"{path!r} is not JSON: {exc.msg} at line {exc.lineno}") from None
+    except ValueError as exc:    # e.g. an integer of more digits than Python converts
+        raise UsageError(f"{path!r} is not JSON that can be read: {exc}") from None
+
+
+@contextlib.contextmanager
+def _located(path, place):
+    """A usage or parameter error of the block, as one UsageError naming the file and the place in it."""
+    try:
+        yield
+    except (UsageError, InvalidParameterError) as exc:
+        raise UsageError(f"{path!r}, {place}: {exc}") from None
+
+
+def _only_keys(path, place, obj, known):
+    unknown = sorted(set(obj) - set(known))
+    if unknown:
+        where = f"{path!r}, {place}" if place else f"{path!r}"
+        raise UsageError(f"{where}: unknown key {unknown[0]!r}; keys: {', '.join(known)}")
+
+
+def _model_at(kind, models, spec):
+    """The model of a spec from a file, which must be a string like the command line's."""
+    if not isinstance(spec, str):
+        raise UsageError(f"{kind}: expected a model spec, a string NAME or 'NAME:key=value,...', "
+                         f"got {reprlib.repr(spec)}")
+    return _build(kind, models, spec)
+
+
+def _node_at(key, node):
+    # a string: the keys of 'pressures', 'inflows' and 'positions', which name nodes, are strings in JSON
+    if not isinstance(node, str):
+        raise UsageError(f"{key}: a node name is a string, got {reprlib.repr(node)}")
+    return node
+
+
+def _number_at(key, value, unit):
+    """A JSON number as a float (its range is the library's to check)."""
+    if type(value) not in (int, float):
+        raise UsageError(f"{key}: expected a number ({unit}), got {reprlib.repr(value)}")
+    try:
+        return float(value)
+    except OverflowError:          # an integer written out with hundreds of digits
+        raise UsageError(f"{key}: {reprlib.repr(value)} is beyond the floating-point numbers ({unit})") from None
+
+
+def _tube_at(geometry):
+    """A Tube from a file: an object of numbers, or the command line's ``radius=..,...`` string."""
+    if isinstance(geometry, str):
+        return _tube(geometry, "tube")
+    if not isinstance(geometry, dict):
+        raise UsageError("tube: expected an object {\"radius\": .., \"thickness\": .., \"length\": ..} (m) or "
+                         f"'radius=..,thickness=..,length=..', got {reprlib.repr(geometry)}")
+    params = {}
+    for key, value in geometry.items():     # a number, or a number written as a string ("1e-4")
+        params[key] = _parse_value(value) if isinstance(value, str) else _number_at(f"tube: {key}", value, "m")
+    return _tube_from(params, "tube")
 
 
 def _cmd_network(args, out) -> int:
@@ -534,6 +649,10 @@ def _cmd_network(args, out) -> int:
         raise UsageError("--format csv writes two tables: give --output PREFIX")
     if args.output:
         _writable("--output", args.output + "_nodes.csv" if args.format == "csv" else args.output)
+        suffix = os.path.splitext(args.output)[1].lower()
+        if args.format is None and suffix not in ("", ".json"):
+            raise UsageError(f"--output {args.output!r}: the result is JSON, not {suffix!r}; give FILE.json "
+                             "(or --format csv --output PREFIX for two CSV tables)")
     if args.plot:
         _check_outputs(argparse.Namespace(format="csv", output=None, plot=args.plot))
     net = _network_from_file(args.file)
@@ -607,12 +726,40 @@ def _error(message) -> int:
     return 2
 
 
+class _Discard(io.TextIOBase):
+    """Standard output when it is closed (``tubefsi ... >&-``, where Python's ``sys.stdout`` is
+    None): what is written goes nowhere, as with ``print``."""
+
+    def writable(self) -> bool:
+        return True
+
+    def write(self, text) -> int:
+        return len(text)
+
+
+def _standard_output():
+    """``sys.stdout`` as the commands write to it: a character its encoding lacks as a backslash
+    escape (an ASCII-only stream: ``LC_ALL=C``, ``PYTHONIOENCODING=ascii``; the docstrings that
+    ``list`` and ``--help`` print have dashes and Greek letters; under the C locale Python's
+    handler is ``surrogateescape``, which fails there too), and a closed stream as one that
+    discards (the commands still write their files)."""
+    for stream in (sys.stdout, sys.stderr):
+        if (stream is not None and not getattr(stream, "closed", False) and hasattr(stream, "reconfigure")
+                and getattr(stream, "errors", None) in ("strict", "surrogateescape")):
+            stream.reconfigure(errors="backslashreplace")
+    if sys.stdout is None or getattr(sys.stdout, "closed", False):
+        return _Discard()
+    return sys.stdout
+
+
 def main(argv=None) -> int:
     """Run the ``tubefsi`` command with ``argv`` (default ``sys.argv[1:]``); return the exit status."""
+    out = _standard_output()
     parser = _parser()
     argv = _join_negative_values(sys.argv[1:] if argv is None else list(argv))
     try:
-        args = parser.parse_args(argv)
+        with contextlib.redirect_stdout(out):      # --help and --version print to sys.stdout
+            args = parser.parse_args(argv)
     except UsageError as exc:
         return _error(exc)
     except SystemExit as exc:  # --help, --version
@@ -623,19 +770,20 @@ def main(argv=None) -> int:
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", ModelValidityWarning)
-            status = args.run(args, sys.stdout)
+            status = args.run(args, out)
         for w in caught:
-            if issubclass(w.category, ModelValidityWarning):
+            if issubclass(w.category, (ModelValidityWarning, registry.PluginWarning)):
                 print(f"{PROG}: warning: {' '.join(str(w.message).split())}", file=sys.stderr)
             else:
                 warnings.showwarning(w.message, w.category, w.filename, w.lineno)
         return status
-    except (UsageError, ValueError, TubefsiError) as exc:
-        # InvalidParameterError and NoSteadyStateError are ValueErrors; ConvergenceError a TubefsiError
+    except (UsageError, ValueError, TubefsiError, Warning) as exc:
+        # InvalidParameterError and NoSteadyStateError are ValueErrors; ConvergenceError a TubefsiError;
+        # a Warning raised is one made an error (python -W error), e.g. a broken plugin's
         return _error(exc)
     except KeyError as exc:  # a registry lookup with its own message
         return _error(exc.args[0] if exc.args else exc)
-    except BrokenPipeError:  # `tubefsi list | head`
+    except BrokenPipeError:  # `tubefsi list | head`: the reader has what it wanted, as with a closed stdout
         return 0
     except OSError as exc:  # an output path that cannot be written: the user's to fix, not a bug
         where = f" {exc.filename}" if getattr(exc, "filename", None) else ""

@@ -22,6 +22,7 @@ __all__ = [
     "StretchRangeError",
     "AccuracyWarning",
     "ModelValidityWarning",
+    "FitWarning",
     "warn_user",
 ]
 
@@ -174,6 +175,12 @@ class ModelValidityWarning(UserWarning):
     filter, ``warnings.filterwarnings("ignore", category=tubefsi.ModelValidityWarning)``
     (``docs/scope.md``).
     """
+
+
+class FitWarning(UserWarning):
+    """A fit whose result the data do not support: the optimizer did not converge, a parameter
+    ended at the edge of its search range, or a standard error is not finite or exceeds its
+    value (:func:`tubefsi.fit`; the message says which, and what to try)."""
 
 
 _PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__))

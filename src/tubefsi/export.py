@@ -114,8 +114,8 @@ def table(solution, dims=None) -> Table:
             continue
         data[name] = np.asarray(getattr(solution, name), dtype=float).reshape(shape)
         units[name] = unit
-    if solution.feasible is not None:
-        data["feasible"] = np.asarray(solution.feasible, dtype=bool).reshape(shape)
+    if not np.all(solution.feasible):
+        data["feasible"] = solution.feasible.reshape(shape)
         units["feasible"] = ""
     info = {"coupler": solution.coupler_name, "rheology": repr(solution.rheology), "wall": repr(solution.wall),
             "tube": repr(solution.tube)}

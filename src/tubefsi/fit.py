@@ -20,7 +20,7 @@ import numpy as np
 from scipy import optimize
 
 from ._progress import bar
-from .errors import InvalidParameterError, TubefsiError
+from .errors import FitWarning, InvalidParameterError, TubefsiError, warn_user
 from ._keywords import checked_keywords
 from .scene import make_scene
 from .solve import solve_unchecked
@@ -49,17 +49,59 @@ class FitResult:
         return "\n".join(lines) + f"\nrms relative residual {rms:.3g} ({self.message})"
 
 
+#: How far (a factor) a parameter fitted through its logarithm may move from its starting value.
+SEARCH_FACTOR = 1e4
+
+_NAMES = "a list of names like 'wall.shear_modulus' or 'rheology.index', each once"
+
+
 def _split(name):
-    owner, _, field = name.partition(".")
+    owner, _, field = name.partition(".") if isinstance(name, str) else ("", "", "")
     if owner not in ("wall", "rheology") or not field:
-        raise InvalidParameterError("parameters", "names like 'wall.shear_modulus' or 'rheology.index'", name)
+        raise InvalidParameterError("parameters", _NAMES, name)
     return owner, field
+
+
+def _parameter_names(parameters):
+    """The fitted names, checked: a sequence of distinct strings (a single string is one name)."""
+    if isinstance(parameters, str):
+        parameters = [parameters]
+    try:
+        names = list(parameters)
+    except TypeError:
+        raise InvalidParameterError("parameters", _NAMES, parameters) from None
+    if not names:
+        raise InvalidParameterError("parameters", _NAMES, parameters, "no parameter to fit")
+    for name in names:
+        _split(name)
+    twice = sorted({name for name in names if names.count(name) > 1})
+    if twice:
+        raise InvalidParameterError("parameters", _NAMES, parameters, f"{', '.join(twice)} named twice")
+    return names
+
+
+def _warn_if_unsupported(names, result, at_edge, standard_errors, values):
+    """A :class:`~tubefsi.FitWarning` where the data do not support the fit, saying what to try."""
+    problems = []
+    if not result.success:
+        problems.append(f"the optimizer stopped without converging ({result.message})")
+    for name in (n for n, edge in zip(names, at_edge) if edge):
+        problems.append(f"{name} ended at the edge of its search range (a factor {SEARCH_FACTOR:g} from its start)")
+    for name, value in zip(names, values):
+        error = standard_errors[name]
+        if not math.isfinite(error) or error > abs(value):
+            problems.append(f"{name} is not determined by the data (standard error {error:.3g} for a value of "
+                            f"{value:.6g})")
+    if problems:
+        warn_user("tubefsi.fit: " + "; ".join(problems) + ". Try starting values closer to the data (fit one "
+                  "parameter first, then the others from its result), fewer parameters, or data over a wider "
+                  "range of flow rates.", FitWarning)
 
 
 @checked_keywords
 def fit(flow_rate, pressure_drop, rheology, wall, tube, *, parameters, outlet_pressure=0.0,
         coupler="auto", progress=False) -> FitResult:
-    """Least-squares calibration of ``parameters`` from data.
+    r"""Least-squares calibration of ``parameters`` from data.
 
     Parameters
     ----------
@@ -69,8 +111,10 @@ def fit(flow_rate, pressure_drop, rheology, wall, tube, *, parameters, outlet_pr
         Starting values for the fitted parameters; the others stay fixed.
     tube : Tube
     parameters : sequence of str
-        Fields to fit, as ``"wall.<field>"`` or ``"rheology.<field>"``,
-        e.g. ``["wall.shear_modulus", "rheology.consistency", "rheology.index"]``.
+        Fields to fit, each once, as ``"wall.<field>"`` or ``"rheology.<field>"``,
+        e.g. ``["wall.shear_modulus", "rheology.consistency", "rheology.index"]``. A field whose
+        admissible range is :math:`(0, \infty)` moves at most a factor ``SEARCH_FACTOR`` (1e4)
+        from its starting value.
     progress : bool or "auto"
         Show a progress bar counting the model evaluations (one solve over every data point
         each; tqdm, ``pip install 'tubefsi[progress]'``); ``"auto"``: only if tqdm is installed
@@ -79,6 +123,13 @@ def fit(flow_rate, pressure_drop, rheology, wall, tube, *, parameters, outlet_pr
     Returns
     -------
     FitResult
+
+    Warns
+    -----
+    FitWarning
+        Where the data do not support the result: the optimizer did not converge, a parameter
+        ended at the edge of its search range, or a standard error is not finite or exceeds the
+        value; the message says which, and what to try.
     """
     scene = make_scene(rheology, wall, tube, outlet_pressure=outlet_pressure)
     models = {"rheology": scene.rheology, "wall": scene.wall}
@@ -88,7 +139,7 @@ def fit(flow_rate, pressure_drop, rheology, wall, tube, *, parameters, outlet_pr
         raise InvalidParameterError("flow_rate / pressure_drop", "1-D arrays of one length", q.shape)
     if np.any(~np.isfinite(q) | (q <= 0)) or np.any(~np.isfinite(dp) | (dp <= 0)):
         raise InvalidParameterError("flow_rate / pressure_drop", "(0, inf) elementwise", None)
-    names = list(parameters)
+    names = _parameter_names(parameters)
     if len(names) >= q.size:
         raise InvalidParameterError("parameters", f"fewer than the {q.size} data points", len(names))
     logs, start = [], []
@@ -183,7 +234,7 @@ def fit(flow_rate, pressure_drop, rheology, wall, tube, *, parameters, outlet_pr
     cache: dict = {}
     # log parameters may move by a factor of up to 1e4 from their starting values
     start = np.array(start)
-    span = np.where(logs, math.log(1e4), np.inf)
+    span = np.where(logs, math.log(SEARCH_FACTOR), np.inf)
     shown = bar(None, progress, "tubefsi.fit", unit="evaluation")   # the count of evaluations is not known
     try:
         # dogbox: for a few bounded parameters it converged in 6-8 model evaluations where the default
@@ -202,7 +253,11 @@ def fit(flow_rate, pressure_drop, rheology, wall, tube, *, parameters, outlet_pr
     scale = np.where(logs, values, 1.0)                    # delta method for log parameters
     cov = cov_theta * np.outer(scale, scale)
     fitted = build(res.x)
+    standard_errors = {n: float(math.sqrt(max(cov[i, i], 0.0))) if np.isfinite(cov[i, i]) else math.inf
+                       for i, n in enumerate(names)}
+    at_edge = np.isfinite(span) & (np.abs(np.abs(res.x - start) - span) <= 1e-6 * span)
+    _warn_if_unsupported(names, res, at_edge, standard_errors, values)
     return FitResult(rheology=fitted["rheology"], wall=fitted["wall"],
                      parameters={n: float(v) for n, v in zip(names, values)},
-                     standard_errors={n: float(math.sqrt(max(cov[i, i], 0.0))) for i, n in enumerate(names)},
+                     standard_errors=standard_errors,
                      covariance=cov, residuals=res.fun, success=bool(res.success), message=str(res.message))

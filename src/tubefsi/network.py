@@ -44,7 +44,6 @@ import copy
 import csv
 import json
 import math
-import warnings
 
 import attrs
 import numpy as np
@@ -56,14 +55,13 @@ from ._keywords import checked_keywords
 from ._progress import bar
 from ._validation import as_array
 from . import validity
-from .errors import (AccuracyWarning, ConvergenceError, InvalidParameterError, ModelValidityWarning,
-                     NoSteadyStateError, warn_user)
+from .errors import (AccuracyWarning, ConvergenceError, InvalidParameterError, NoSteadyStateError, warn_user)
 from .fields import varies, _array_fields, parameter_shape
 from .geometry import Tube
 from .scene import make_scene, resolve
 from .solution import Solution
 from .solve import max_flow_rate as tubefsi_max_flow
-from .solve import solve
+from .solve import solve, solve_unchecked
 
 __all__ = ["Network", "NetworkSolution"]
 
@@ -197,7 +195,9 @@ class Network:
     def from_networkx(cls, graph, *, rheology=None, wall="wall", tube="tube", fluid="rheology",
                       pressure="pressure", inflow="inflow", pos="pos"):
         """A network from a networkx graph whose edges hold a ``wall`` and a ``tube`` attribute
-        (and optionally ``fluid``); nodes may hold ``pressure``, ``inflow`` and ``pos``.
+        (and optionally a ``rheology`` attribute, the fluid of that tube); nodes may hold
+        ``pressure``, ``inflow`` and ``pos``. Each keyword names the attribute to read (``fluid``:
+        the edge attribute holding a tube's rheology, ``"rheology"`` by default).
 
         Edges run from the first node to the second as networkx lists them; a multigraph's
         tubes are named ``(u, v, key)``.
@@ -317,10 +317,10 @@ class _Groups:
         controlled; zeros for the tubes of no group)."""
         q, d_in, d_out, radius_in, radius_out = (np.zeros(drop.size) for _ in range(5))
         for (index, fluid, wall, tube), p_e in zip(self.parts, self.external):
-            with warnings.catch_warnings():    # Newton's trial pressures: the result is checked once
-                warnings.simplefilter("ignore", ModelValidityWarning)
-                sol = solve(fluid, wall, tube, pressure_drop=drop[index], outlet_pressure=outlet[index],
-                            external_pressure=p_e)
+            # Newton's trial pressures: unchecked (the result is checked once; no process-wide
+            # warning filter, which would silence other threads too)
+            sol = solve_unchecked(fluid, wall, tube, pressure_drop=drop[index], outlet_pressure=outlet[index],
+                                  external_pressure=p_e)
             q[index] = sol.flow_rate
             _, d_in[index], d_out[index] = sol._sensitivities()
             radius_in[index] = sol.inlet_radius
@@ -346,11 +346,10 @@ class _Groups:
         ``q > 0`` with ``outlet`` pressure; a flow rate beyond a tube's maximum raises, naming it."""
         p_in, radius_in, radius_out = (np.zeros(q.size) for _ in range(3))
         for (index, fluid, wall, tube), p_e in zip(self.parts, self.external):
-            with warnings.catch_warnings():    # checked with the rest of the result
-                warnings.simplefilter("ignore", ModelValidityWarning)
-                sol = solve(fluid, wall, tube, flow_rate=q[index], outlet_pressure=outlet[index],
-                            external_pressure=p_e, on_infeasible="nan")
-            if sol.feasible is not None:
+            # checked with the rest of the result
+            sol = solve_unchecked(fluid, wall, tube, flow_rate=q[index], outlet_pressure=outlet[index],
+                                  external_pressure=p_e, on_infeasible="nan")
+            if not np.all(sol.feasible):
                 j = int(np.flatnonzero(~sol.feasible)[0])
                 limit = np.broadcast_to(tubefsi_max_flow(fluid, wall, tube, outlet_pressure=outlet[index],
                                                          external_pressure=p_e), index.shape)[j]
@@ -624,20 +623,22 @@ class _Solver:
                 if t_balance is not None and np.linalg.norm(t_balance[free]) <= (1 - 1e-4 * alpha) * norm:
                     break
                 alpha *= 0.5
-                if alpha < 1e-10 and np.all(np.abs(F) <= 10 * self._noise(p, q, gu, gv)):
-                    warn_user(f"network: mass balance to {worst / through:.1e} of the throughput, not rtol = "
+                if alpha < 1e-10 and np.all(np.abs(F) <= 10 * self._noise(p, q, gu, gv)) \
+                        and _share(worst, through) <= _WORST_ROUNDED:
+                    warn_user(f"network: mass balance to {_share(worst, through):.1e} of the throughput, not rtol = "
                               f"{rtol:g}: pressures close to a limit pressure amplify the rounding of the "
                               f"pressures into the flows beyond that", AccuracyWarning)
-                    return self._result(p, q, r_u, r_v, iteration, worst / through)
+                    return self._result(p, q, r_u, r_v, iteration, _share(worst, through))
                 if alpha < 1e-10:
                     raise ConvergenceError(f"network: the line search stalled after {iteration} Newton iterations; "
-                                           f"largest mass imbalance {worst:.3e} m^3/s = {worst / through:.3e} of the "
-                                           f"throughput (rtol {rtol:g})")
+                                           f"largest mass imbalance {worst:.3e} m^3/s = {_share(worst, through):.3e} of "
+                                           f"the throughput (rtol {rtol:g}){_UNRESOLVED if through == 0 else ''}")
             p, q, gu, gv, r_u, r_v, balance = trial, t_q, t_gu, t_gv, t_ru, t_rv, t_balance
             if shown is not None:
                 shown.update()
         raise ConvergenceError(f"network: no convergence in {max_iterations} Newton iterations; largest mass "
-                               f"imbalance {worst:.3e} m^3/s = {worst / through:.3e} of the throughput (rtol {rtol:g})")
+                               f"imbalance {worst:.3e} m^3/s = {_share(worst, through):.3e} of the throughput "
+                               f"(rtol {rtol:g}){_UNRESOLVED if through == 0 else ''}")
 
     def _result(self, p, q, r_u, r_v, iterations, residual):
         if self.feed_groups.parts:
@@ -802,9 +803,40 @@ class NetworkSolution:
 
         return plot_network(self, **kwargs)
 
+    def _repr_html_(self) -> str:
+        """The notebook summary: the size and convergence, then the first rows of the node and tube
+        tables with units."""
+        from . import _html
+
+        units = {"pressure": "Pa", "inflow": "m^3/s", "flow_rate": "m^3/s", "pressure_u": "Pa",
+                 "pressure_v": "Pa", "radius_u": "m", "radius_v": "m", "length": "m"}
+        return "\n".join([
+            _html.table("NetworkSolution", [("nodes", len(self.nodes)), ("tubes", len(self.tubes)),
+                                            ("Newton iterations", self.iterations),
+                                            ("residual", f"{self.residual:.2e}")]),
+            _html.columns_html("nodes", self.node_table(), units),
+            _html.columns_html("tubes", self.tube_table(), units)])
+
     def __repr__(self) -> str:
         return (f"NetworkSolution({len(self.nodes)} nodes, {len(self.tubes)} tubes, "
                 f"{self.iterations} iterations, residual {self.residual:.2e})")
+
+
+#: Why a network can have no resolvable throughput: tubes in series whose conductances differ by
+#: more than double precision resolves (the drop over the wide one is below one rounding unit of
+#: the pressures, so its flow is either 0 or far too large).
+_UNRESOLVED = ("; no flow is resolved at all: tubes in series whose conductances differ beyond double "
+               "precision (e.g. radii 5 m and 0.1 mm) cannot balance; model the wide one as a node")
+
+
+#: The largest mass imbalance (a share of the throughput) accepted, with an AccuracyWarning, where
+#: the rounding of the pressures allows no better; beyond it the line search's stall is an error.
+_WORST_ROUNDED = 1e-6
+
+
+def _share(worst, through) -> float:
+    """The imbalance as a share of the throughput (inf where nothing flows but something should)."""
+    return worst / through if through > 0 else (0.0 if worst == 0 else float("inf"))
 
 
 def _hashable(x) -> bool:

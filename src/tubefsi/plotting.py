@@ -43,7 +43,7 @@ import attrs
 import numpy as np
 
 from . import registry
-from .errors import InvalidParameterError, NoSteadyStateError, StretchRangeError
+from .errors import InvalidParameterError, NoSteadyStateError, StretchRangeError, TubefsiError
 from .solve import max_flow_rate, solve, solve_unchecked
 from .validity import SLENDERNESS
 from .walls.hyperelastic import HyperelasticWall
@@ -241,7 +241,36 @@ def _pressure_scale(ax, wall, tb, normalize, scale_name, magnitude):
     return scale
 
 
-def plot_tube_law(wall, reduced_thickness, *, ax=None, max_stretch=3.0, normalize=False, scale_name=None,
+#: The default tube-law plot ends at this stretch, or earlier where the law stiffens: where its
+#: pressure reaches ``_STIFFENING_SPAN`` times its small-strain modulus (an exponential law there
+#: is already far beyond any tissue's range; drawn further, its physiological part is a flat line).
+_DEFAULT_MAX_STRETCH = 3.0
+_STIFFENING_SPAN = 20.0
+#: A finite limit pressure is drawn (tube law, flow curve) only when it lies within this multiple
+#: of the largest pressure drawn: a stiffening law's "limit" is where double precision ends, not
+#: a physical bound, and drawn it would flatten the curve onto the axis.
+_LIMIT_IN_VIEW = 3.0
+
+
+def _default_max_stretch(wall, tb):
+    """The physical end of a tube-law plot: 3, or where the pressure reaches 20 small-strain moduli."""
+    k0 = float(wall.small_strain_modulus(tb))
+    target = _STIFFENING_SPAN * k0
+    lim = float(wall.limit_pressure(tb))
+    if not (math.isfinite(target) and target > 0) or target >= lim:
+        return _DEFAULT_MAX_STRETCH
+    try:
+        lam = float(wall.stretch(target, tb))
+    except TubefsiError:          # beyond the wall's range: the default
+        return _DEFAULT_MAX_STRETCH
+    return min(_DEFAULT_MAX_STRETCH, lam) if math.isfinite(lam) and lam > 1.0 else _DEFAULT_MAX_STRETCH
+
+
+def _limit_in_view(limit, top) -> bool:
+    return math.isfinite(limit) and limit <= _LIMIT_IN_VIEW * top
+
+
+def plot_tube_law(wall, reduced_thickness, *, ax=None, max_stretch=None, normalize=False, scale_name=None,
                   label=None, color=None):
     r"""Plot a wall's tube law: transmural pressure :math:`p` against hoop stretch :math:`\lambda = R/a`.
 
@@ -252,9 +281,10 @@ def plot_tube_law(wall, reduced_thickness, *, ax=None, max_stretch=3.0, normaliz
         :math:`\bar t = t/a`.
     ax : matplotlib Axes, optional
         Draw here (several walls can share one Axes); a new figure otherwise.
-    max_stretch : float
+    max_stretch : float, optional
         Right end of the stretch axis (> 1); clipped just below the wall's own
-        maximum stretch, if it has one.
+        maximum stretch, if it has one. By default 3, or less for a law that stiffens: the
+        stretch where its pressure reaches 20 times its small-strain modulus :math:`k_0`.
     normalize : bool or float
         The pressure scale, **one per Axes** (the first wall drawn on an Axes fixes it, and
         the walls drawn after it share it, so their curves compare): ``False`` (default)
@@ -271,9 +301,10 @@ def plot_tube_law(wall, reduced_thickness, *, ax=None, max_stretch=3.0, normaliz
         Colour of the curve (and its limit line); the Axes' colour cycle otherwise.
 
     Draws the tube law (solid), its linear small-strain tangent :math:`k_0(\lambda-1)`
-    (faint, in the curve's colour; one legend entry per Axes) and, when finite, the limit
-    pressure as a dashed horizontal line in the curve's colour, labelled in the axis' own
-    scale. A rigid wall is the vertical line :math:`\lambda = 1` on a pressure axis in
+    (faint, in the curve's colour; one legend entry per Axes) and, when finite and within three
+    times the highest pressure drawn, the limit pressure as a dashed horizontal line in the
+    curve's colour, labelled in the axis' own scale (the "limit" of a stiffening law is where
+    double precision ends, astronomically high: not drawn). A rigid wall is the vertical line :math:`\lambda = 1` on a pressure axis in
     pascals, and is not drawn on a dimensionless one (it has no small-strain modulus; its
     law is :math:`\lambda = 1` at every pressure).
 
@@ -282,6 +313,8 @@ def plot_tube_law(wall, reduced_thickness, *, ax=None, max_stretch=3.0, normaliz
     matplotlib.axes.Axes
     """
     tb = wall._check_thickness(reduced_thickness)
+    if max_stretch is None:
+        max_stretch = _DEFAULT_MAX_STRETCH if wall.is_rigid else _default_max_stretch(wall, tb)
     try:
         max_stretch = float(max_stretch)
     except (TypeError, ValueError):
@@ -319,13 +352,14 @@ def plot_tube_law(wall, reduced_thickness, *, ax=None, max_stretch=3.0, normaliz
 
     # the small-strain tangent, drawn only as high as the curve goes (so it does not set the scale)
     lim = wall.limit_pressure(tb)
-    top = max(float(p[-1]), lim if math.isfinite(lim) else 0.0) * 1.08
+    shown = _limit_in_view(lim, float(np.max(p)))
+    top = max(float(p[-1]), lim if shown else 0.0) * 1.08
     lam_t = np.linspace(1.0, min(hi, 1.0 + top / k0), 50)
     first = not any(ln.get_gid() == _TANGENT_GID for ln in ax.get_lines())
     ax.plot(lam_t, k0 * (lam_t - 1.0) / scale, color=color, lw=1.0, alpha=0.4, ls="-",
             label="small-strain tangents" if first else "_nolegend_", gid=_TANGENT_GID)
 
-    if math.isfinite(lim):
+    if shown:
         ax.axhline(lim / scale, color=color, lw=1.0, ls="--", label="_nolegend_")
         text = f"limit {lim / scale:.3g}" if unit is None else f"limit {_fmt_p(lim)}"
         ax.annotate(text, xy=(hi, lim / scale), xytext=(-4, 3),
@@ -423,9 +457,9 @@ def plot_flow_curve(rheology, wall, tube, *, flow_rates=None, ax=None, n=200, la
         Passed to :func:`tubefsi.solve`.
 
     Draws the curve (one solve over the whole array of flow rates), the rigid
-    reference, and, when finite, the maximum flow rate (dashed horizontal) and the
-    largest possible pressure drop, limit pressure minus outlet pressure (dotted
-    vertical), in the curve's colour. The axes are in the units that suit the first curve
+    reference, and, when finite, the maximum flow rate (dashed horizontal) and, within three
+    times the largest drop drawn, the largest possible pressure drop, limit pressure minus
+    outlet pressure (dotted vertical), in the curve's colour. The axes are in the units that suit the first curve
     drawn on them (flow rates in nL/min, µL/min or mL/min, pressures in Pa or kPa; the labels
     say which), kept for the curves drawn after it.
 
@@ -473,7 +507,7 @@ def plot_flow_curve(rheology, wall, tube, *, flow_rates=None, ax=None, n=200, la
                     xycoords=("axes fraction", "data"), xytext=(4, -3), textcoords="offset points",
                     ha="left", va="top", color=color, fontsize=8)
     lim = wall.limit_pressure(tube.reduced_thickness)
-    if math.isfinite(lim):
+    if _limit_in_view(lim - outlet_pressure, float(np.max(dp, initial=0.0))):
         x_lim = (lim - outlet_pressure) / p_unit
         ax.axvline(x_lim, color=color, lw=1.0, ls=":", label="_nolegend_")
         ax.annotate(f"limit {_fmt_p(lim - outlet_pressure)}", xy=(x_lim, 0.4),

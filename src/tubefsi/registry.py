@@ -20,14 +20,20 @@ the order of ``sys.path`` or of the entry points:
    each run of ``-``, ``_`` and ``.`` as one ``-``) sorts first wins.
 
 Each provider left out is a :class:`PluginWarning` naming both distributions and the
-one used; its entry point is not imported. An entry point that fails to import is a
-:class:`PluginWarning` naming the distribution and the error, never an error, and the
-next provider in that order is tried. The same distribution seen twice (editable
-installs can list it twice) counts once, silently.
+one used; its entry point is not imported. An entry point that fails to import (whatever
+it raises, ``SystemExit`` included; only ``KeyboardInterrupt`` goes through) or that gives
+something other than a subclass of the group's base class (:class:`~tubefsi.rheology.Rheology`,
+:class:`~tubefsi.walls.WallModel`, :class:`~tubefsi.couplers.Coupler`) is a
+:class:`PluginWarning` naming the distribution, the entry point and what went wrong, never an
+error, and the next provider in that order is tried. The warnings are given once the
+registry is consistent, so that under warnings-as-errors the first one raises but loses
+nothing: the next access finds every name resolved. The same distribution seen twice
+(editable installs can list it twice) counts once, silently.
 """
 
 from __future__ import annotations
 
+import importlib
 import re
 import sys
 import threading
@@ -40,6 +46,18 @@ __all__ = ["rheologies", "walls", "couplers", "refresh", "Registry", "PluginWarn
 BUILTIN_DISTRIBUTION = "tubefsi"
 _UNKNOWN = "<unknown distribution>"
 
+#: What one entry of each group is, in messages.
+_KINDS = {"tubefsi.rheologies": "rheology", "tubefsi.walls": "wall", "tubefsi.couplers": "coupler"}
+
+#: The class every entry point of a group must give a subclass of: (module, name, public name).
+#: Imported when a name is first resolved (the models import it anyway), not with the registry,
+#: which ``tubefsi --help`` imports alone.
+_BASES = {
+    "tubefsi.rheologies": ("tubefsi.rheology.base", "Rheology", "tubefsi.rheology.Rheology"),
+    "tubefsi.walls": ("tubefsi.walls.base", "WallModel", "tubefsi.walls.WallModel"),
+    "tubefsi.couplers": ("tubefsi.couplers.base", "Coupler", "tubefsi.couplers.Coupler"),
+}
+
 
 class PluginWarning(UserWarning):
     """A plugin could not be loaded, or declared a name already taken."""
@@ -48,6 +66,13 @@ class PluginWarning(UserWarning):
 def _normalize(name: str) -> str:
     """PEP 503 normalized distribution name."""
     return re.sub(r"[-_.]+", "-", name).lower()
+
+
+def _warn_all(messages) -> None:
+    """Give each warning (under warnings-as-errors the first one raises: the registry is
+    consistent by then, so nothing is lost)."""
+    for message in messages:
+        _warn(message)
 
 
 def _warn(message: str) -> None:
@@ -90,16 +115,24 @@ class Registry(Mapping):
             self._entries, self._origin = {}, {}
         return self._entries
 
-    def _resolve(self, name: str) -> None:
-        """Import the first provider of ``name`` that loads; warn of failures and of providers left out."""
-        candidates = self._pending.pop(name, None)
-        if not candidates:
-            return
+    def _resolve(self, name: str) -> list[str]:
+        """Import the first provider of ``name`` that loads and gives a model of this group;
+        return the warnings to give (failures, wrong kinds, providers left out), which the
+        caller gives once the registry is consistent."""
+        candidates = self._pending.pop(name, None) or []
+        messages = []
         for i, (dist, ep) in enumerate(candidates):
+            where, entry = f"{self.group}: {name!r} from {dist}", f"(entry point {name} = {ep.value}); left out"
             try:
                 obj = ep.load()
-            except Exception as exc:  # a broken plugin must not break the registry
-                _warn(f"{self.group}: {name!r} from {dist} failed to load: {type(exc).__name__}: {exc}")
+            except KeyboardInterrupt:
+                raise
+            except BaseException as exc:  # a broken plugin, even one calling sys.exit, must not break the registry
+                messages.append(f"{where} failed to load: {type(exc).__name__}: {exc} {entry}")
+                continue
+            wrong = self._wrong_kind(obj)
+            if wrong:
+                messages.append(f"{where} {wrong} {entry}")
                 continue
             self._entries[name], self._origin[name] = obj, dist
             if _normalize(dist) == BUILTIN_DISTRIBUTION:
@@ -107,16 +140,27 @@ class Registry(Mapping):
             else:
                 why = "between plugins, the distribution whose normalized name sorts first wins"
             for other, _ in candidates[i + 1:]:
-                _warn(f"{self.group}: {name!r} is provided by both {dist} and {other}; using {dist} ({why})")
-            return
+                messages.append(f"{self.group}: {name!r} is provided by both {dist} and {other}; using {dist} ({why})")
+            break
+        return messages
+
+    def _wrong_kind(self, obj) -> str | None:
+        """None, or what is wrong with ``obj`` as a model of this group (not a subclass of its base)."""
+        if self.group not in _BASES:
+            return None
+        module, attr, public = _BASES[self.group]
+        if isinstance(obj, type) and issubclass(obj, getattr(importlib.import_module(module), attr)):
+            return None
+        what = f"the class {obj.__module__}.{obj.__qualname__}" if isinstance(obj, type) else f"a {type(obj).__name__}"
+        return f"gives {what}, not a subclass of {public}"
 
     def _load(self) -> dict[str, type]:
-        """Resolve every name."""
+        """Resolve every name, then warn."""
         with self._lock:
             entries = self._read()
-            for name in list(self._pending):
-                self._resolve(name)
-            return entries
+            messages = [m for name in list(self._pending) for m in self._resolve(name)]
+        _warn_all(messages)
+        return entries
 
     def _get(self, name: str) -> type | None:
         entries = self._entries
@@ -125,14 +169,14 @@ class Registry(Mapping):
             return found
         with self._lock:
             entries = self._read()
-            if name in self._pending:
-                self._resolve(name)
-            return entries.get(name)
+            messages = self._resolve(name) if name in self._pending else []
+        _warn_all(messages)
+        return entries.get(name)
 
     def __getitem__(self, name: str) -> type:
         obj = self._get(name)
         if obj is None:
-            raise KeyError(f"{name!r} is not a registered {self.group.split('.')[-1][:-1]}; "
+            raise KeyError(f"{name!r} is not a registered {_KINDS.get(self.group, self.group)}; "
                            f"known: {', '.join(sorted(self._load()))}")
         return obj
 

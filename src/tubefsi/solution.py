@@ -25,6 +25,30 @@ __all__ = ["Solution"]
 _CHUNK = 1 << 14
 
 
+def _broadcast_with(name, value, shape, what="the solution's shape"):
+    """The shape of ``value`` broadcast with ``shape`` by NumPy's rules, or the typed error that
+    says which shapes are allowed."""
+    try:
+        return np.broadcast_shapes(np.shape(value), shape)
+    except ValueError:
+        hint = ("; for every point at each of several positions pass a column, z[:, None]"
+                if name == "z" and len(shape) == 1 and np.ndim(value) == 1 else "")
+        raise InvalidParameterError(name, f"a number or an array that broadcasts with {what} {shape}{hint}",
+                                    value) from None
+
+
+def max_flow_rate_of(scene, coupler):
+    """The coupler's maximum flow rate of ``scene``: a float, or an array of the scene's shape
+    (one coupler call per part of the flat scene, as :meth:`~tubefsi.scene.Scene.split` gives)."""
+    if scene.shape == ():
+        return float(coupler.max_flow_rate(scene))
+    flat = scene.flat(scene.shape)
+    out = np.empty(flat.size)
+    for index, part in flat.split(np.arange(flat.size)):
+        out[index] = coupler.max_flow_rate(part)
+    return out.reshape(scene.shape)
+
+
 @attrs.frozen(kw_only=True)
 class Solution:
     """Flow rate, pressure drop, inlet state and profiles of a steady FSI problem.
@@ -40,8 +64,9 @@ class Solution:
     scalar: bool = True
     #: The registered name of the coupler (its class name if it is not registered).
     coupler_name: str = ""
-    #: Where ``solve(..., on_infeasible="nan")`` found a steady state (None: everywhere).
-    feasible: object = None
+    #: Where ``solve(..., on_infeasible="nan")`` found no steady state (None: nowhere); read
+    #: :attr:`feasible`.
+    _feasible: object = attrs.field(default=None, alias="feasible")
     #: The fluid density given to ``solve`` (kg/m^3; None if not given), for the Reynolds number.
     density: object = None
     #: The load ``solve`` was given: ``"flow_rate"`` or ``"pressure_drop"``.
@@ -101,9 +126,21 @@ class Solution:
         return a(np.asarray(z, dtype=float)) if isinstance(a, Profile) else a
 
     @property
-    def max_flow_rate(self) -> float:
-        """The largest flow rate with a steady state in this scene (m^3/s; ``inf`` if none)."""
-        return float(self.coupler.max_flow_rate(self.scene))
+    def feasible(self) -> np.ndarray:
+        """Where the load has a steady state: a boolean array of the results' shape (0-d for a
+        scalar solve); ``False`` only at the points that ``solve(..., on_infeasible="nan")`` gave
+        NaN results."""
+        shape = np.shape(self.state.flow_rate)
+        if self._feasible is None:
+            return np.ones(shape, dtype=bool)
+        return np.array(np.broadcast_to(self._feasible, shape), dtype=bool)
+
+    @property
+    def max_flow_rate(self):
+        """The largest flow rate with a steady state in this scene (m^3/s; ``inf`` where there is
+        none): a float, or an array of the scene's shape where its parameters are arrays (as
+        :func:`tubefsi.max_flow_rate` gives it)."""
+        return max_flow_rate_of(self.scene, self.coupler)
 
     # ------------------------------------------------------------------ profiles
     def _profile(self, z):
@@ -111,7 +148,7 @@ class Solution:
         (and the scene's array parameters); NaN at infeasible points."""
         z = as_array("z", z, "[0, L] (m)", lambda a: a >= 0)
         st = self.state
-        shape = np.broadcast_shapes(z.shape, np.shape(st.flow_rate))
+        shape = _broadcast_with("z", z, np.shape(st.flow_rate))
         length = np.broadcast_to(np.asarray(self.tube.length, dtype=float), shape) if np.ndim(self.tube.length) \
             else self.tube.length
         zz = np.broadcast_to(z, shape)
@@ -183,9 +220,11 @@ class Solution:
 
         From the separated identity (``docs/theory.md``, section "Sensitivities"): for a rheology
         parameter, :math:`G_{in}\int_0^L \partial_\theta\ln G\,dz` (closed forms for the power
-        law and the Newtonian fluid, a central difference of :math:`G` otherwise); for the
-        modulus that the tube law is proportional to (``P = \mu\hat P``: the shear modulus of a
-        neo-Hookean wall, Young's modulus of a linear one) with an unloaded outlet,
+        law and the Newtonian fluid; otherwise central differences of :math:`\ln G` at relative
+        steps 1e-3 and 5e-4, Richardson-extrapolated). For the wall, only the modulus that scales
+        its tube law, :math:`P = \mu\hat P` with :math:`\hat P` free of it (the shear modulus of a
+        neo-Hookean wall, Young's modulus of a linear one: the field whose doubling doubles the
+        tube law and leaves the wall's shape parameters unchanged), with an unloaded outlet:
         :math:`(\Delta p - L G_{in})/\mu`. Other wall parameters raise
         ``InvalidParameterError`` (difference two solves). 0 where ``q = 0``.
         """
@@ -286,6 +325,7 @@ class Solution:
         strain, _, q = self._profile(z)
         big_r = self._undeformed(z) * (1.0 + strain)
         g = self.rheology.pressure_gradient(q, big_r)
+        _broadcast_with("r", r_arr, np.shape(big_r), "the shape of the solution and z")
         r_arr, big_r, g = np.broadcast_arrays(r_arr, big_r, g)
         if np.any(r_arr > big_r * (1 + 1e-12)) or np.any(r_arr < 0):
             raise InvalidParameterError("r", "[0, R(z)] (m)", r_arr[(r_arr > big_r) | (r_arr < 0)].flat[0])
@@ -338,6 +378,28 @@ class Solution:
         from .plotting import plot_profiles
 
         return plot_profiles(self, **kwargs)
+
+    def _repr_html_(self) -> str:
+        """The notebook summary: the load and the key results with units, the models and the tube."""
+        from . import _html
+
+        control = "flow-controlled" if self.controlled == "flow_rate" else "pressure-controlled"
+        results = [("flow rate", _html.number(self.flow_rate, "m^3/s")),
+                   ("pressure drop", _html.number(self.pressure_drop, "Pa")),
+                   ("inlet pressure", _html.number(self.inlet_pressure, "Pa")),
+                   ("outlet pressure", _html.number(self.outlet_pressure, "Pa")),
+                   ("inlet displacement", _html.number(self.inlet_displacement, "m")),
+                   ("inlet radius", _html.number(self.inlet_radius, "m"))]
+        feasible = self.feasible
+        if not feasible.all():
+            results.append(("feasible", f"{int(feasible.sum())} of {feasible.size} points"))
+        tube = self.tube
+        geometry = [(name, _html.number(getattr(tube, name), "m")) for name in ("radius", "thickness", "length")]
+        return "\n".join([
+            _html.table(f"Solution ({control}, coupler '{self.coupler_name}', shape {np.shape(self.state.flow_rate)})",
+                        results),
+            _html.model_html(self.rheology, "rheology"), _html.model_html(self.wall, "wall"),
+            _html.table("tube", geometry)])
 
     def __repr__(self) -> str:
         return (f"Solution(flow_rate={self.flow_rate!r}, pressure_drop={self.pressure_drop!r}, "

@@ -17,6 +17,7 @@ import attrs
 import numpy as np
 
 from . import registry
+from .registry import PluginWarning
 from ._keywords import checked_keywords
 from ._progress import bar
 from ._validation import as_load
@@ -24,11 +25,11 @@ from .couplers.base import Coupler
 from .couplers.checked import checked
 from .couplers.graded import Graded
 from .couplers.rescaled import Rescaled, in_units
-from .errors import InvalidParameterError, NoSteadyStateError
+from .errors import InvalidParameterError, NoSteadyStateError, warn_user
 from .geometry import Tube
 from .rheology.power_law import FactorRangeError
-from .scene import Scene, State, _resolve, make_scene
-from .solution import Solution
+from .scene import Scene, State, _resolve, make_scene, resolve
+from .solution import Solution, max_flow_rate_of
 from .validity import check_and_warn
 
 __all__ = ["solve", "max_flow_rate", "select_coupler", "Problem", "CHUNK"]
@@ -39,22 +40,43 @@ _STATE_FIELDS = State._fields
 
 
 def _ranked(couplers):
-    """The registered couplers that meet the accuracy contract, one instance each, cheapest first."""
+    """The registered couplers that meet the accuracy contract, one instance each, cheapest first
+    (a plugin coupler that cannot be built with its defaults is left out, with a PluginWarning)."""
     ranked = sorted((couplers[name].cost_rank, name) for name in couplers if couplers[name].meets_accuracy_contract)
-    return tuple((couplers[name](), name) for _, name in ranked)
+    out = []
+    for _, name in ranked:
+        try:
+            out.append((couplers[name](), name))
+        except Exception as exc:          # noqa: BLE001 (a plugin's failure, whatever it is, is its own)
+            warn_user(f"coupler {name!r} is left out of 'auto': building it raised {type(exc).__name__}: {exc}",
+                      PluginWarning)
+    return tuple(out)
+
+
+def _supports(instance, name, rheology, wall) -> bool:
+    """Whether ``auto``'s candidate supports the pair; a plugin coupler whose ``supports`` raises
+    does not (with a PluginWarning)."""
+    try:
+        return bool(instance.supports(rheology, wall))
+    except Exception as exc:              # noqa: BLE001
+        warn_user(f"coupler {name!r} is passed over by 'auto': its supports() raised {type(exc).__name__}: {exc}",
+                  PluginWarning)
+        return False
 
 
 @checked_keywords
 def select_coupler(rheology, wall, coupler="auto") -> Coupler:
-    """The coupler ``solve`` would use: a name, an instance, or ``"auto"`` (cheapest accurate)."""
-    return _select(rheology, wall, coupler)[0]
+    """The coupler ``solve`` would use for ``rheology`` and ``wall`` (instances, classes or
+    registered names, as ``solve`` takes them): a name, an instance, or ``"auto"`` (cheapest
+    accurate)."""
+    return _select(resolve("rheology", rheology), resolve("wall", wall), coupler)[0]
 
 
 def _select(rheology, wall, coupler):
     """``(coupler, name)``: the coupler that answers for the pair and its registered name."""
     if type(coupler) is str and coupler == "auto":
         for instance, name in registry.couplers.derived("auto", _ranked):
-            if instance.supports(rheology, wall):
+            if _supports(instance, name, rheology, wall):
                 return instance, name
         raise InvalidParameterError("coupler", "a coupler that supports this pair", "auto",
                                     "no registered coupler supports it")
@@ -290,6 +312,7 @@ def _solve_points(runner, scene, controlled, load, shape, on_infeasible, progres
     out = {f: np.full(n, np.nan) for f in _STATE_FIELDS}
     feasible = np.ones(n, dtype=bool)
     shown = bar(n, progress, "tubefsi.solve")
+    done = 0
     for index, part in flat.split(np.arange(n)):
         for start in range(0, index.size, CHUNK):
             idx = index[start:start + CHUNK]
@@ -300,6 +323,8 @@ def _solve_points(runner, scene, controlled, load, shape, on_infeasible, progres
             if ok is not None:
                 feasible[idx] = ok
             shown.update(idx.size)
+            done += idx.size
+    shown.update(n - done)          # (points no part holds: the bar still ends at its total)
     shown.close()
     state = State(*(out[f].reshape(shape) for f in _STATE_FIELDS))
     return state, (None if np.all(feasible) else feasible)
@@ -357,17 +382,7 @@ def max_flow_rate(rheology, wall, tube, *, outlet_pressure=0.0, external_pressur
         unit = tube.radius       # in units of the radius (the limit is a flow rate: times unit^3)
         return max_flow_rate(rheology, wall, in_units(tube, unit), outlet_pressure=outlet_pressure,
                              external_pressure=external_pressure, coupler=coupler) * unit**3
-    return _max_flow_rate(scene, _choose(scene, coupler)[0])
-
-
-def _max_flow_rate(scene, chosen):
-    if scene.shape == ():
-        return float(chosen.max_flow_rate(scene))
-    flat = scene.flat(scene.shape)
-    out = np.empty(flat.size)
-    for index, part in flat.split(np.arange(flat.size)):
-        out[index] = chosen.max_flow_rate(part)
-    return out.reshape(scene.shape)
+    return max_flow_rate_of(scene, _choose(scene, coupler)[0])
 
 
 @attrs.frozen(init=False)
@@ -410,7 +425,7 @@ class Problem:
 
     def max_flow_rate(self):
         """:func:`tubefsi.max_flow_rate` of this problem (m^3/s; ``inf`` where there is none)."""
-        return _max_flow_rate(self.scene, self.coupler)
+        return max_flow_rate_of(self.scene, self.coupler)
 
 
 def _radius_units(function, args, kwargs):
@@ -445,7 +460,7 @@ def _radius_units(function, args, kwargs):
     state = State(q if q.ndim else float(q), inner.state.pressure_drop, inner.state.inlet_strain,
                   inner.state.log_stretch)
     return Solution(scene=scene, coupler=Rescaled(inner=inner.coupler, unit=unit), state=state, scalar=inner.scalar,
-                    coupler_name=inner.coupler_name, feasible=inner.feasible, controlled=inner.controlled)
+                    coupler_name=inner.coupler_name, feasible=inner._feasible, controlled=inner.controlled)
 
 
 def _radius_power_in_range(scene):

@@ -399,8 +399,10 @@ def warn_unconverged(what: str, result: Integral, where=None) -> None:
     with np.errstate(divide="ignore", invalid="ignore"):
         rel = np.where(result.value != 0, np.abs(result.error / result.value), np.inf)
     worst = float(np.max(np.where(bad, rel, -np.inf)))
-    warn_user(f"{what} did not reach its tolerance at {int(np.count_nonzero(bad))} point(s); estimated "
-              f"relative error up to {worst:.2g}", AccuracyWarning)
+    estimate = f"estimated relative error up to {worst:.2g}" if math.isfinite(worst) else \
+        "its error could not be estimated (a non-finite or zero value)"
+    warn_user(f"{what} did not reach its tolerance at {int(np.count_nonzero(bad))} point(s); {estimate}",
+              AccuracyWarning)
 
 
 # ------------------------------------------------------------------ fixed rules (no error estimate)

@@ -119,6 +119,12 @@ class Rheology(abc.ABC):
             return _finite_result("stress", t, "shear rate",
                                   self._evaluate(lambda m, t: _masked(m, "_shear_rate", t > 0, t), t))
 
+    def _repr_html_(self) -> str:
+        """The notebook summary: the class, its registered name and the parameters with units."""
+        from .._html import model_html
+
+        return model_html(self, "rheology")
+
     def apparent_viscosity(self, shear_rate):
         r"""Apparent viscosity :math:`\eta = \tau/\dot\gamma` (Pa s), shear rate > 0."""
         g = as_array("shear_rate", shear_rate, "(0, inf)", lambda a: a > 0)

@@ -77,7 +77,12 @@ def __getattr__(name):
     module = _LAZY.get(name)
     if module is None:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    from . import contracts, strategies     # noqa: F401 - imported here on purpose (the docstring says why)
+    try:
+        from . import contracts, strategies     # noqa: F401 - imported here on purpose (the docstring says why)
+    except ModuleNotFoundError as exc:
+        raise ModuleNotFoundError(f"tubefsi.testing.{name} needs {exc.name}, from the test extra: "
+                                  "pip install '.[test]' in a clone of tubefsi (docs/installation.md)",
+                                  name=exc.name) from exc
 
     value = getattr({"contracts": contracts, "strategies": strategies}[module], name)
     globals()[name] = value

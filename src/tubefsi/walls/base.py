@@ -212,7 +212,13 @@ class WallModel(abc.ABC):
             return _finite("reduced_thickness", tb, "small-strain modulus",
                            evaluate(self, lambda wall, tb: wall._stiffness(np.ones(np.shape(tb)), tb), tb))
 
-    def plot(self, reduced_thickness, *, ax=None, max_stretch=3.0, **kwargs):
+    def _repr_html_(self) -> str:
+        """The notebook summary: the class, its registered name and the parameters with units."""
+        from .._html import model_html
+
+        return model_html(self, "wall")
+
+    def plot(self, reduced_thickness, *, ax=None, max_stretch=None, **kwargs):
         """Plot this wall's tube law; see :func:`tubefsi.plotting.plot_tube_law`."""
         from ..plotting import plot_tube_law
 

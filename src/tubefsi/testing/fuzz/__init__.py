@@ -61,14 +61,23 @@ import dataclasses
 import time
 from typing import NamedTuple
 
+try:
+    import hypothesis  # noqa: F401 - the random scenes need it; say so before anything fails inside
+except ModuleNotFoundError as exc:
+    raise ModuleNotFoundError("tubefsi.testing.fuzz needs hypothesis, from the test extra: pip install '.[test]' "
+                              "in a clone of tubefsi (docs/installation.md)", name=exc.name) from exc
+
 from ... import registry
 from ...geometry import Tube
 from ._extremes import extremes_family
 from ._core import BREACHES, TIME_LIMIT, _TUBE, Outcome, Probe, Report, run_probe
+from ._cli import _cli_family
 from ._known import _known_probes
 from ._models import (_advise_probes, _entry_keyword_probes, _model_probes, _rheology_probes, _solution_probes,
                       _solve_probes, _tube_probes, _wall_probes)
+from ._plugins import _plugins_family
 from ._scenes import scene_outcomes
+from ._solutions import solution_probes
 
 __all__ = ["Probe", "Outcome", "Report", "BREACHES", "TIME_LIMIT", "FAMILIES", "Selection", "bad_input_probes", "run_probe", "scene_outcomes",
            "campaign", "FuzzContract", "main"]
@@ -113,6 +122,14 @@ def _keywords_family(chosen):
         yield from _entry_keyword_probes()
 
 
+def _solutions_family(chosen):
+    """A solution's accessors at every shape of argument, for the first pair of each model."""
+    tube = Tube(**_TUBE)
+    for fluid, wall, tag in chosen.pairs():
+        if tag.split()[0].endswith("#0"):
+            yield from solution_probes(fluid, wall, tube, tag)
+
+
 def _known_family(chosen):
     if chosen.core:
         yield from _known_probes()
@@ -134,7 +151,10 @@ FAMILIES = {
     "fields": _fields_family,
     "keywords": _keywords_family,
     "entry points": _entry_points_family,
+    "solutions": _solutions_family,
     "known": _known_family,
+    "cli files": _cli_family,
+    "hostile plugins": _plugins_family,
     "extremes": extremes_family,
 }
 
