@@ -15,7 +15,11 @@ A model author writes, for a new material::
 
 Each factory converts the value to a float and validates it: NaN, infinities, booleans,
 strings and values outside the range raise :class:`~tubefsi.InvalidParameterError` naming
-the parameter and its admissible range. The unit, the range and the description go into
+the parameter and its admissible range. What counts as a number is one rule, shared with the
+loads of :func:`~tubefsi.solve` (:func:`tubefsi._validation.real_array`): a real number of any type
+is rounded to the nearest double but refused where the doubles cannot hold it (``10**400``,
+``np.longdouble("1e-400")``); masked entries and arrays of more than 32 dimensions are refused;
+an empty array is an empty set of points. The unit, the range and the description go into
 the field's metadata, where ``tubefsi list`` and :func:`parameters` read them, so a plugin's
 parameters are documented the same way as the built-ins'. A variant of a model is made with
 :func:`attrs.evolve`, which validates again.
@@ -39,6 +43,7 @@ import attrs
 import numpy as np
 
 from ._units import is_quantity, to_si
+from ._validation import real_array
 from .errors import InvalidParameterError
 from .numerics.cache import keep_on_class
 from .profiles import Profile, as_profile
@@ -48,14 +53,11 @@ __all__ = ["real", "positive", "nonnegative", "choice", "Parameter", "parameters
            "at_position"]
 
 
-def _invalid_type(field, value):
-    return InvalidParameterError(field.name, "the real numbers", value,
-                                 "give a plain number in SI units, or an array of them")
-
-
 def _convert_real(value, field, instance=None):
-    """A float for a scalar, a read-only float ndarray for an array (any shape); a pint Quantity
-    is converted to SI first."""
+    """A float for a scalar, a read-only float ndarray for an array (any shape), a
+    :class:`~tubefsi.Profile` for a function of z; a pint Quantity is converted to SI first. What
+    is a real number is :func:`~tubefsi._validation.real_array`'s rule, shared with the arguments
+    of the entry points (the loads, the outlet pressure...)."""
     if type(value) is float:                 # the common case (a Monte Carlo loop builds models)
         return value
     value = to_si(field.name, value, field.metadata.get("unit", ""))
@@ -64,18 +66,11 @@ def _convert_real(value, field, instance=None):
             raise InvalidParameterError(field.name, f"a number or an array ({type(instance).__name__}'s parameters "
                                         "do not vary along the tube)", value)
         return as_profile(value, field)
-    if isinstance(value, (bool, str, bytes)):
-        raise _invalid_type(field, value)
-    if isinstance(value, (int, float)):
-        return float(value)
-    try:
-        a = np.asarray(value)
-    except Exception:
-        raise _invalid_type(field, value) from None
-    if a.dtype.kind not in "iuf":           # booleans, complex numbers, strings, objects
-        raise _invalid_type(field, value)
+    a = real_array(field.name, value, field.metadata.get("admissible", "the real numbers"))
     if a.ndim == 0:
         return float(a)
+    if not field.metadata.get("array", True):
+        raise InvalidParameterError(field.name, field.metadata["admissible"], value, "a single number")
     a = np.array(a, dtype=float)            # a private copy: the model is immutable
     a.setflags(write=False)
     return a
@@ -159,7 +154,7 @@ def _eq_key(value):
 
 
 def real(*, low=-math.inf, high=math.inf, low_open=True, high_open=True, unit="", doc="",
-         default=attrs.NOTHING, along=True):
+         default=attrs.NOTHING, along=True, array=True):
     """A real parameter in the interval from ``low`` to ``high`` (open ends by default).
 
     The value is a float, or an array of any shape (read-only, broadcast against the other
@@ -169,7 +164,8 @@ def real(*, low=-math.inf, high=math.inf, low_open=True, high_open=True, unit=""
     text (``"Pa"``, ``"Pa s^n"``, ``""`` for a number), ``doc`` a few words for
     ``tubefsi list``. With ``along`` (the default) the value may also be a function of the axial
     position z, a :class:`~tubefsi.Profile` (a graded tube, ``docs/graded.md``); options that are
-    not properties of the tube pass ``along=False``.
+    not properties of the tube pass ``along=False``, and options that are one setting, not a
+    parameter of each point (a coupler's tolerance), ``array=False``: a single number.
     """
     lo = "(" if low_open else "["
     hi = ")" if high_open else "]"
@@ -178,20 +174,20 @@ def real(*, low=-math.inf, high=math.inf, low_open=True, high_open=True, unit=""
         converter=_real_converter,
         validator=_interval_validator(low, high, low_open, high_open, admissible),
         eq=_eq_key,
-        metadata={"unit": unit, "doc": doc, "admissible": admissible, "array": True, "along": along,
+        metadata={"unit": unit, "doc": doc, "admissible": admissible, "array": array, "along": along,
                   "low": low, "high": high, "low_open": low_open, "high_open": high_open},
         default=default,
     )
 
 
-def positive(*, unit="", doc="", default=attrs.NOTHING, along=True):
+def positive(*, unit="", doc="", default=attrs.NOTHING, along=True, array=True):
     """A finite float parameter that must be ``> 0``."""
-    return real(low=0.0, unit=unit, doc=doc, default=default, along=along)
+    return real(low=0.0, unit=unit, doc=doc, default=default, along=along, array=array)
 
 
-def nonnegative(*, unit="", doc="", default=attrs.NOTHING, along=True):
+def nonnegative(*, unit="", doc="", default=attrs.NOTHING, along=True, array=True):
     """A finite float parameter that must be ``>= 0``."""
-    return real(low=0.0, low_open=False, unit=unit, doc=doc, default=default, along=along)
+    return real(low=0.0, low_open=False, unit=unit, doc=doc, default=default, along=along, array=array)
 
 
 def choice(options, *, doc="", default=attrs.NOTHING):

@@ -87,7 +87,7 @@ def _load(flow_rate, pressure_drop):
                                     None, "give flow_rate= or pressure_drop=, not both or neither")
     controlled = "flow_rate" if flow_rate is not None else "pressure_drop"
     value = flow_rate if flow_rate is not None else pressure_drop
-    if isinstance(value, float) or type(value) is int:         # a Python or NumPy float, an int
+    if isinstance(value, float):               # a Python or NumPy float (an int may leave the doubles)
         number = float(value)
         if 0.0 <= number < math.inf:
             return controlled, number
