@@ -196,8 +196,10 @@ def choice(options, *, doc="", default=attrs.NOTHING):
     admissible = "{" + ", ".join(repr(o) for o in options) + "}"
 
     def check(instance, attribute, value):
-        if value not in options:
-            raise InvalidParameterError(attribute.name, admissible, value)
+        # a string first: ``in`` would compare an array elementwise ("truth value ... ambiguous")
+        if not (isinstance(value, str) and value in options):
+            raise InvalidParameterError(attribute.name, admissible, value,
+                                        "" if isinstance(value, str) else "give one of these strings")
 
     return attrs.field(validator=check, default=default,
                        metadata={"unit": "", "doc": doc, "admissible": admissible, "options": options})

@@ -96,7 +96,7 @@ def _load(flow_rate, pressure_drop):
 
 
 def _options(on_infeasible, density):
-    if on_infeasible not in ("raise", "nan"):
+    if not (isinstance(on_infeasible, str) and on_infeasible in ("raise", "nan")):    # (not an array: ambiguous)
         raise InvalidParameterError("on_infeasible", "{'raise', 'nan'}", on_infeasible)
     return None if density is None else as_load("density", density, allow_zero=False)
 
