@@ -189,10 +189,12 @@ def _secant_slope(wall, h, reach):
     return np.array(np.broadcast_to(m, shape)), np.array(np.broadcast_to(ok, shape))
 
 
-def axial_stretch():
+def axial_stretch(*, array=True):
     """The ``axial_stretch`` parameter of a material that supports an axial pre-stretch
-    (``docs/walls_beyond.md``, section "Axial pre-stretch"): positive, default 1."""
-    return positive(default=1.0, doc="axial pre-stretch lambda_z: installed / stress-free length", along=False)
+    (``docs/walls_beyond.md``, section "Axial pre-stretch"): positive, default 1; a single number
+    with ``array=False`` (a material whose other parameters are no arrays either)."""
+    return positive(default=1.0, doc="axial pre-stretch lambda_z: installed / stress-free length", along=False,
+                    array=array)
 
 
 class HyperelasticWall(WallModel):
