@@ -301,6 +301,8 @@ def parameter_sets(model, shape):
     n = int(np.prod(shape, dtype=int))
     if not arrays:
         return [(np.arange(n), model)]
+    if n == 0:                              # no point, no parameter set
+        return []
     names = list(arrays)
     stack = np.stack([np.broadcast_to(arrays[k], shape).ravel() for k in names], axis=1)
     rows, inverse = np.unique(stack, axis=0, return_inverse=True)
@@ -325,6 +327,8 @@ def evaluate(model, fn, *args, per_set=False):
     shape = np.broadcast_shapes(*(a.shape for a in arrays), parameter_shape(model))
     if shape == ():
         return float(np.asarray(fn(model, *arrays), dtype=float))
+    if 0 in shape:                          # no point (an empty array, NumPy's convention): nothing to ask fn
+        return np.zeros(shape)
     flat = [np.broadcast_to(a, shape).ravel() if a.ndim else a for a in arrays]
     n = int(np.prod(shape, dtype=int))
     if getattr(type(model), "broadcasts", True) and not per_set:

@@ -281,6 +281,8 @@ def _solve_points(runner, scene, controlled, load, shape, on_infeasible, progres
     flat = scene.flat(shape)
     values = np.broadcast_to(np.asarray(load, dtype=float), shape).ravel()
     n = values.size
+    if n == 0:                           # an empty array (NumPy's convention): empty results, no coupler call
+        return State(*(np.zeros(shape) for _ in _STATE_FIELDS)), None
     if n <= CHUNK and flat.is_one_part():                # one coupler call on every point
         state, feasible = _run(runner, flat, controlled, values.copy(), on_infeasible)
         shown = bar(n, progress, "tubefsi.solve")
@@ -459,7 +461,7 @@ def _radius_power_in_range(scene):
     if type(a) is float:
         if k * abs(math.log(a)) <= 700.0:
             return
-    elif not isinstance(a, np.ndarray) or k * float(np.max(np.abs(np.log(a)))) <= 700.0:
+    elif not isinstance(a, np.ndarray) or k * float(np.max(np.abs(np.log(a)), initial=0.0)) <= 700.0:
         return                       # (a radius along z: the graded coupler's own range checks)
     raise FactorRangeError("index", "indices with a^(3n+1) within double precision at radius a", k,
                            "R^-(3n+1) leaves the range of double precision")
