@@ -433,6 +433,8 @@ def _radius_units(function, args, kwargs):
     if scene.graded:             # a model varying along z: z would need the change of unit too
         return None
     unit = tube.radius
+    if 3.0 * math.log(unit) > 709.0:   # unit**3 would overflow (a radius over 5e102 m): the error stands
+        return None
     if given["flow_rate"] is not None:
         given["flow_rate"] = as_load("flow_rate", given["flow_rate"]) / unit**3
     given["tube"] = in_units(tube, unit)
