@@ -111,7 +111,11 @@ class Solution:
         (and the scene's array parameters); NaN at infeasible points."""
         z = as_array("z", z, "[0, L] (m)", lambda a: a >= 0)
         st = self.state
-        shape = np.broadcast_shapes(z.shape, np.shape(st.flow_rate))
+        try:
+            shape = np.broadcast_shapes(z.shape, np.shape(st.flow_rate))
+        except ValueError:
+            raise InvalidParameterError("z", f"positions that broadcast with the results' shape {np.shape(st.flow_rate)}",
+                                        z) from None
         length = np.broadcast_to(np.asarray(self.tube.length, dtype=float), shape) if np.ndim(self.tube.length) \
             else self.tube.length
         zz = np.broadcast_to(z, shape)
@@ -286,7 +290,11 @@ class Solution:
         strain, _, q = self._profile(z)
         big_r = self._undeformed(z) * (1.0 + strain)
         g = self.rheology.pressure_gradient(q, big_r)
-        r_arr, big_r, g = np.broadcast_arrays(r_arr, big_r, g)
+        try:
+            r_arr, big_r, g = np.broadcast_arrays(r_arr, big_r, g)
+        except ValueError:
+            raise InvalidParameterError("r", f"positions that broadcast with the profiles' shape {np.shape(g)}",
+                                        r_arr) from None
         if np.any(r_arr > big_r * (1 + 1e-12)) or np.any(r_arr < 0):
             raise InvalidParameterError("r", "[0, R(z)] (m)", r_arr[(r_arr > big_r) | (r_arr < 0)].flat[0])
         return self._out(self.rheology.velocity(np.minimum(r_arr, big_r), big_r, g), z, r)
