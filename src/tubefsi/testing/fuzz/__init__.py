@@ -64,6 +64,7 @@ from typing import NamedTuple
 from ... import registry
 from ...geometry import Tube
 from ._core import BREACHES, TIME_LIMIT, _TUBE, Outcome, Probe, Report, run_probe
+from ._inputs import _inputs_family
 from ._known import _known_probes
 from ._models import (_advise_probes, _entry_keyword_probes, _model_probes, _rheology_probes, _solution_probes,
                       _solve_probes, _tube_probes, _wall_probes)
@@ -134,6 +135,7 @@ FAMILIES = {
     "keywords": _keywords_family,
     "entry points": _entry_points_family,
     "known": _known_family,
+    "inputs": _inputs_family,
 }
 
 
