@@ -20,6 +20,9 @@ from .errors import InvalidParameterError
 #: may have 64), and broadcasting never adds dimensions, so arguments of at most 32 broadcast too.
 MAX_DIMS = 32
 
+#: The common real numbers: Python's ints and floats, NumPy's integer and float scalars.
+_NUMBERS = (int, float, np.integer, np.floating)
+
 
 def real_array(name, value, admissible):
     """``value`` as a float array: a real number or an array of them (any shape up to
@@ -38,9 +41,11 @@ def real_array(name, value, admissible):
         return np.asarray(value)
     if isinstance(value, (bool, np.bool_, str, bytes)) or value is None:
         raise _not_a_number(name, admissible, value)
+    if isinstance(value, _NUMBERS):          # (before the abstract classes below: cheaper)
+        return np.asarray(_double(name, admissible, value))
     if isinstance(value, np.ma.MaskedArray):
         value = _unmasked(name, admissible, value)
-    if isinstance(value, (numbers.Real, decimal.Decimal)):     # an int, a Fraction, a NumPy scalar
+    if isinstance(value, (numbers.Real, decimal.Decimal)):     # a Fraction, a Decimal, another Real
         return np.asarray(_double(name, admissible, value))
     try:
         a = np.asarray(value)

@@ -60,6 +60,8 @@ def _convert_real(value, field, instance=None):
     of the entry points (the loads, the outlet pressure...)."""
     if type(value) is float:                 # the common case (a Monte Carlo loop builds models)
         return value
+    if isinstance(value, float):             # a NumPy float64: a double already
+        return float(value)
     value = to_si(field.name, value, field.metadata.get("unit", ""))
     if callable(value) and field.metadata.get("along") and not is_quantity(value):   # a function of z
         if instance is not None and not getattr(type(instance), "varies_along_z", True):
