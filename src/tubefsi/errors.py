@@ -157,7 +157,11 @@ class ConvergenceError(TubefsiError, ArithmeticError):
 
 
 def _short(value) -> str:
-    a = np.asarray(value)
+    try:
+        a = np.asarray(value)
+    except Exception:          # noqa: BLE001 (a ragged list: the error must still be raised, with its words)
+        text = repr(value)
+        return text if len(text) <= 60 else text[:57] + "..."
     if a.ndim == 0:
         return f"{a.item()!r}"
     return f"array of shape {a.shape}"

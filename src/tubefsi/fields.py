@@ -15,7 +15,11 @@ A model author writes, for a new material::
 
 Each factory converts the value to a float and validates it: NaN, infinities, booleans,
 strings and values outside the range raise :class:`~tubefsi.InvalidParameterError` naming
-the parameter and its admissible range. The unit, the range and the description go into
+the parameter and its admissible range. What counts as a number is one rule, shared with the
+loads of :func:`~tubefsi.solve` (:func:`tubefsi._validation.real_array`): a real number of any type
+is rounded to the nearest double but refused where the doubles cannot hold it (``10**400``,
+``np.longdouble("1e-400")``); masked entries and arrays of more than 32 dimensions are refused;
+an empty array is an empty set of points. The unit, the range and the description go into
 the field's metadata, where ``tubefsi list`` and :func:`parameters` read them, so a plugin's
 parameters are documented the same way as the built-ins'. A variant of a model is made with
 :func:`attrs.evolve`, which validates again.
@@ -39,6 +43,7 @@ import attrs
 import numpy as np
 
 from ._units import is_quantity, to_si
+from ._validation import real_array
 from .errors import InvalidParameterError
 from .numerics.cache import keep_on_class
 from .profiles import Profile, as_profile
@@ -48,34 +53,26 @@ __all__ = ["real", "positive", "nonnegative", "choice", "Parameter", "parameters
            "at_position"]
 
 
-def _invalid_type(field, value):
-    return InvalidParameterError(field.name, "the real numbers", value,
-                                 "give a plain number in SI units, or an array of them")
-
-
 def _convert_real(value, field, instance=None):
-    """A float for a scalar, a read-only float ndarray for an array (any shape); a pint Quantity
-    is converted to SI first."""
+    """A float for a scalar, a read-only float ndarray for an array (any shape), a
+    :class:`~tubefsi.Profile` for a function of z; a pint Quantity is converted to SI first. What
+    is a real number is :func:`~tubefsi._validation.real_array`'s rule, shared with the arguments
+    of the entry points (the loads, the outlet pressure...)."""
     if type(value) is float:                 # the common case (a Monte Carlo loop builds models)
         return value
+    if isinstance(value, float):             # a NumPy float64: a double already
+        return float(value)
     value = to_si(field.name, value, field.metadata.get("unit", ""))
     if callable(value) and field.metadata.get("along") and not is_quantity(value):   # a function of z
         if instance is not None and not getattr(type(instance), "varies_along_z", True):
             raise InvalidParameterError(field.name, f"a number or an array ({type(instance).__name__}'s parameters "
                                         "do not vary along the tube)", value)
         return as_profile(value, field)
-    if isinstance(value, (bool, str, bytes)):
-        raise _invalid_type(field, value)
-    if isinstance(value, (int, float)):
-        return float(value)
-    try:
-        a = np.asarray(value)
-    except Exception:
-        raise _invalid_type(field, value) from None
-    if a.dtype.kind not in "iuf":           # booleans, complex numbers, strings, objects
-        raise _invalid_type(field, value)
+    a = real_array(field.name, value, field.metadata.get("admissible", "the real numbers"))
     if a.ndim == 0:
         return float(a)
+    if not field.metadata.get("array", True):
+        raise InvalidParameterError(field.name, field.metadata["admissible"], value, "a single number")
     a = np.array(a, dtype=float)            # a private copy: the model is immutable
     a.setflags(write=False)
     return a
@@ -159,7 +156,7 @@ def _eq_key(value):
 
 
 def real(*, low=-math.inf, high=math.inf, low_open=True, high_open=True, unit="", doc="",
-         default=attrs.NOTHING, along=True):
+         default=attrs.NOTHING, along=True, array=True):
     """A real parameter in the interval from ``low`` to ``high`` (open ends by default).
 
     The value is a float, or an array of any shape (read-only, broadcast against the other
@@ -169,7 +166,8 @@ def real(*, low=-math.inf, high=math.inf, low_open=True, high_open=True, unit=""
     text (``"Pa"``, ``"Pa s^n"``, ``""`` for a number), ``doc`` a few words for
     ``tubefsi list``. With ``along`` (the default) the value may also be a function of the axial
     position z, a :class:`~tubefsi.Profile` (a graded tube, ``docs/graded.md``); options that are
-    not properties of the tube pass ``along=False``.
+    not properties of the tube pass ``along=False``, and options that are one setting, not a
+    parameter of each point (a coupler's tolerance), ``array=False``: a single number.
     """
     lo = "(" if low_open else "["
     hi = ")" if high_open else "]"
@@ -178,20 +176,20 @@ def real(*, low=-math.inf, high=math.inf, low_open=True, high_open=True, unit=""
         converter=_real_converter,
         validator=_interval_validator(low, high, low_open, high_open, admissible),
         eq=_eq_key,
-        metadata={"unit": unit, "doc": doc, "admissible": admissible, "array": True, "along": along,
+        metadata={"unit": unit, "doc": doc, "admissible": admissible, "array": array, "along": along,
                   "low": low, "high": high, "low_open": low_open, "high_open": high_open},
         default=default,
     )
 
 
-def positive(*, unit="", doc="", default=attrs.NOTHING, along=True):
+def positive(*, unit="", doc="", default=attrs.NOTHING, along=True, array=True):
     """A finite float parameter that must be ``> 0``."""
-    return real(low=0.0, unit=unit, doc=doc, default=default, along=along)
+    return real(low=0.0, unit=unit, doc=doc, default=default, along=along, array=array)
 
 
-def nonnegative(*, unit="", doc="", default=attrs.NOTHING, along=True):
+def nonnegative(*, unit="", doc="", default=attrs.NOTHING, along=True, array=True):
     """A finite float parameter that must be ``>= 0``."""
-    return real(low=0.0, low_open=False, unit=unit, doc=doc, default=default, along=along)
+    return real(low=0.0, low_open=False, unit=unit, doc=doc, default=default, along=along, array=array)
 
 
 def choice(options, *, doc="", default=attrs.NOTHING):
@@ -200,8 +198,10 @@ def choice(options, *, doc="", default=attrs.NOTHING):
     admissible = "{" + ", ".join(repr(o) for o in options) + "}"
 
     def check(instance, attribute, value):
-        if value not in options:
-            raise InvalidParameterError(attribute.name, admissible, value)
+        # a string first: ``in`` would compare an array elementwise ("truth value ... ambiguous")
+        if not (isinstance(value, str) and value in options):
+            raise InvalidParameterError(attribute.name, admissible, value,
+                                        "" if isinstance(value, str) else "give one of these strings")
 
     return attrs.field(validator=check, default=default,
                        metadata={"unit": "", "doc": doc, "admissible": admissible, "options": options})
@@ -303,6 +303,8 @@ def parameter_sets(model, shape):
     n = int(np.prod(shape, dtype=int))
     if not arrays:
         return [(np.arange(n), model)]
+    if n == 0:                              # no point, no parameter set
+        return []
     names = list(arrays)
     stack = np.stack([np.broadcast_to(arrays[k], shape).ravel() for k in names], axis=1)
     rows, inverse = np.unique(stack, axis=0, return_inverse=True)
@@ -327,6 +329,8 @@ def evaluate(model, fn, *args, per_set=False):
     shape = np.broadcast_shapes(*(a.shape for a in arrays), parameter_shape(model))
     if shape == ():
         return float(np.asarray(fn(model, *arrays), dtype=float))
+    if 0 in shape:                          # no point (an empty array, NumPy's convention): nothing to ask fn
+        return np.zeros(shape)
     flat = [np.broadcast_to(a, shape).ravel() if a.ndim else a for a in arrays]
     n = int(np.prod(shape, dtype=int))
     if getattr(type(model), "broadcasts", True) and not per_set:

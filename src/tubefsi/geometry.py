@@ -44,7 +44,7 @@ class Tube:
                     getattr(self, name).check_span(self.length)
             return
         tb = np.asarray(self.thickness) / np.asarray(self.radius)
-        if not (tb.min() > 0 and tb.max() < math.inf):    # t/a beyond double range (NaN fails both)
+        if tb.size and not (tb.min() > 0 and tb.max() < math.inf):   # t/a beyond the doubles (NaN fails both)
             raise InvalidParameterError("thickness", "values with a finite, nonzero t/a", self.thickness,
                                         f"t/a = {np.ravel(tb)[np.argmin(np.isfinite(tb) & (tb > 0))]!r} with radius "
                                         f"{self.radius!r}")

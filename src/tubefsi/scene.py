@@ -242,9 +242,13 @@ class Scene:
 
     def flat(self, shape) -> Scene:
         """This scene broadcast to ``shape`` and flattened: every array quantity becomes a 1-D
-        array with one entry per point of ``shape`` (scalars stay scalars)."""
-        if self.shape == () or (len(self.shape) == 1 and tuple(shape) == self.shape):
+        array with one entry per point of ``shape`` (scalars stay scalars). A shape of one point
+        gives a scene of scalars (arrays of one entry, of any dimensions: the couplers' route of
+        one point takes floats)."""
+        if self.shape == () or (len(self.shape) == 1 and tuple(shape) == self.shape and self.size > 1):
             return self
+        if math.prod(shape) == 1:
+            return _evolve_arrays(self, lambda v: float(np.ravel(v)[0]))
         return _evolve_arrays(self, lambda v: np.broadcast_to(v, shape).ravel())
 
     def take(self, index) -> Scene:

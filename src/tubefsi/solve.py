@@ -109,7 +109,7 @@ def _load(flow_rate, pressure_drop):
                                     None, "give flow_rate= or pressure_drop=, not both or neither")
     controlled = "flow_rate" if flow_rate is not None else "pressure_drop"
     value = flow_rate if flow_rate is not None else pressure_drop
-    if isinstance(value, float) or type(value) is int:         # a Python or NumPy float, an int
+    if isinstance(value, float):               # a Python or NumPy float (an int may leave the doubles)
         number = float(value)
         if 0.0 <= number < math.inf:
             return controlled, number
@@ -118,7 +118,7 @@ def _load(flow_rate, pressure_drop):
 
 
 def _options(on_infeasible, density):
-    if on_infeasible not in ("raise", "nan"):
+    if not (isinstance(on_infeasible, str) and on_infeasible in ("raise", "nan")):    # (not an array: ambiguous)
         raise InvalidParameterError("on_infeasible", "{'raise', 'nan'}", on_infeasible)
     return None if density is None else as_load("density", density, allow_zero=False)
 
@@ -303,6 +303,8 @@ def _solve_points(runner, scene, controlled, load, shape, on_infeasible, progres
     flat = scene.flat(shape)
     values = np.broadcast_to(np.asarray(load, dtype=float), shape).ravel()
     n = values.size
+    if n == 0:                           # an empty array (NumPy's convention): empty results, no coupler call
+        return State(*(np.zeros(shape) for _ in _STATE_FIELDS)), None
     if n <= CHUNK and flat.is_one_part():                # one coupler call on every point
         state, feasible = _run(runner, flat, controlled, values.copy(), on_infeasible)
         shown = bar(n, progress, "tubefsi.solve")
@@ -446,6 +448,8 @@ def _radius_units(function, args, kwargs):
     if scene.graded:             # a model varying along z: z would need the change of unit too
         return None
     unit = tube.radius
+    if 3.0 * math.log(unit) > 709.0:   # unit**3 would overflow (a radius over 5e102 m): the error stands
+        return None
     if given["flow_rate"] is not None:
         given["flow_rate"] = as_load("flow_rate", given["flow_rate"]) / unit**3
     given["tube"] = in_units(tube, unit)
@@ -474,7 +478,7 @@ def _radius_power_in_range(scene):
     if type(a) is float:
         if k * abs(math.log(a)) <= 700.0:
             return
-    elif not isinstance(a, np.ndarray) or k * float(np.max(np.abs(np.log(a)))) <= 700.0:
+    elif not isinstance(a, np.ndarray) or k * float(np.max(np.abs(np.log(a)), initial=0.0)) <= 700.0:
         return                       # (a radius along z: the graded coupler's own range checks)
     raise FactorRangeError("index", "indices with a^(3n+1) within double precision at radius a", k,
                            "R^-(3n+1) leaves the range of double precision")

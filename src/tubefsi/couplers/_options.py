@@ -45,7 +45,7 @@ def flag(*, default, doc=""):
 def tolerance(low, high, *, default, optional=False, doc=""):
     """A tolerance in ``(low, high]`` (``None`` too if ``optional``: the method's own default)."""
     if not optional:
-        return real(low=low, high=high, high_open=False, doc=doc, default=default, along=False)
+        return real(low=low, high=high, high_open=False, doc=doc, default=default, along=False, array=False)
     admissible = f"({low:g}, {high:g}] or None"
     check = _interval_validator(low, high, True, False, admissible)
 

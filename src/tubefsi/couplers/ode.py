@@ -31,7 +31,8 @@ import attrs
 import numpy as np
 
 from .._lazy import lazy_module
-from ..errors import ConvergenceError, InvalidParameterError, NoSteadyStateError
+from ..errors import ConvergenceError, NoSteadyStateError
+from ..fields import choice
 from ..scene import State
 from ._options import flag, tolerance
 from .base import Coupler
@@ -53,17 +54,12 @@ _METHODS = ("odeint", "RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 _ENGINE = Quadrature()
 
 
-def _check_method(instance, attribute, value):
-    if value not in _METHODS:
-        raise InvalidParameterError("method", "{" + ", ".join(_METHODS) + "}", value)
-
-
 @final
 @attrs.frozen(kw_only=True)
 class ODE(Coupler):
     """Integrate dp/dz = -G(q, R(p)) with SciPy (reference path, one ODE per point)."""
 
-    method: str = attrs.field(default="LSODA", validator=_check_method)
+    method: str = choice(_METHODS, default="LSODA", doc="SciPy's integrator (odeint or a solve_ivp method)")
     rtol: float | None = tolerance(0.0, 0.1, default=None, optional=True, doc="relative tolerance (None: the default)")
     atol: float | None = tolerance(0.0, 1e300, default=None, optional=True,
                                    doc="absolute tolerance (None: the default)")

@@ -39,7 +39,7 @@ class Quadrature(SeparatedVariables):
 
     order: int | None = integer(1, 200, default=None, optional=True, doc="fixed Gauss-Legendre order, or None")
     panel_width: float = real(low=0.01, high=100.0, low_open=False, high_open=False, default=2.0,
-                              doc="panel width of a fixed rule (log-stretch)", along=False)
+                              doc="panel width of a fixed rule (log-stretch)", along=False, array=False)
     rtol: float = tolerance(1e-15, 0.1, default=1e-14, doc="relative tolerance of the adaptive rule")
     check_error: bool = flag(default=True, doc="check a fixed rule against the adaptive one")
 

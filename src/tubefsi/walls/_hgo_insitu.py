@@ -238,9 +238,12 @@ def rest(wall, tb, kind):
         out = np.array([_rest_scalar(tuple(float(c) for c in constants), float(t), kind) for t in values])
         return out[inverse].reshape(tb.shape)
     law = Law(*constants)
-    n = max(np.broadcast(tb, *constants).size, 1)
+    points = np.broadcast(tb, *constants)
+    if points.size == 0:                        # an empty array of parameters: no point
+        return np.zeros(points.shape)
+    n = points.size
     if kind == "membrane":
-        return membrane_rest(law, n).reshape(np.broadcast(tb, *constants).shape)
+        return membrane_rest(law, n).reshape(points.shape)
     return thick_rest(law, np.broadcast_to(tb, (n,)), kind == "installed")
 
 

@@ -205,12 +205,13 @@ def _secant_slope(wall, h, reach):
 AXIAL_STRETCH_RANGE = (1e-100, 1e100)
 
 
-def axial_stretch():
+def axial_stretch(*, array=True):
     """The ``axial_stretch`` parameter of a material that supports an axial pre-stretch
-    (``docs/walls_beyond.md``, section "Axial pre-stretch"): in :data:`AXIAL_STRETCH_RANGE`, default 1."""
+    (``docs/walls_beyond.md``, section "Axial pre-stretch"): in :data:`AXIAL_STRETCH_RANGE`, default 1;
+    a single number with ``array=False`` (a material whose other parameters are no arrays either)."""
     low, high = AXIAL_STRETCH_RANGE
     return real(low=low, high=high, low_open=False, high_open=False, default=1.0,
-                doc="axial pre-stretch lambda_z: installed / stress-free length", along=False)
+                doc="axial pre-stretch lambda_z: installed / stress-free length", along=False, array=array)
 
 
 class HyperelasticWall(WallModel):

@@ -28,6 +28,7 @@ import math
 import attrs
 import numpy as np
 from tubefsi import InvalidParameterError
+from tubefsi._validation import real_array
 from tubefsi.walls import HyperelasticWall, ThickWall, ThinWall
 from tubefsi.walls.hyperelastic import axial_stretch
 
@@ -36,12 +37,14 @@ from ._limit_point import LimitPoint
 __all__ = ["Ogden", "ThinOgden", "ThickOgden"]
 
 
-def _floats(values):
-    try:
-        out = tuple(float(v) for v in np.atleast_1d(np.asarray(values, dtype=float)))
-    except (TypeError, ValueError):
-        raise InvalidParameterError("moduli / exponents", "sequences of real numbers", values) from None
-    return out
+def _floats(values, field):
+    # tubefsi's rule for what is a real number (no masked entries, nothing beyond the doubles, no
+    # strings or dates), then a flat sequence
+    a = real_array(field.name, values, "a non-empty sequence of finite numbers")
+    if a.ndim > 1:
+        raise InvalidParameterError(field.name, "a non-empty sequence of finite numbers", values,
+                                    f"an array of shape {a.shape}: give a flat sequence")
+    return tuple(float(v) for v in np.atleast_1d(a))
 
 
 def _check_terms(instance, attribute, value):
@@ -89,9 +92,9 @@ def _difference_ratio(a, s, u):
 class Ogden(LimitPoint, HyperelasticWall):
     """Ogden material (abstract: pick a theory, :class:`ThinOgden` or :class:`ThickOgden`)."""
 
-    moduli: tuple = attrs.field(converter=_floats, validator=_check_terms,
+    moduli: tuple = attrs.field(converter=attrs.Converter(_floats, takes_field=True), validator=_check_terms,
                                 metadata={"unit": "Pa", "doc": "moduli mu_p (sum = shear modulus)"})
-    exponents: tuple = attrs.field(converter=_floats, validator=_check_terms,
+    exponents: tuple = attrs.field(converter=attrs.Converter(_floats, takes_field=True), validator=_check_terms,
                                    metadata={"unit": "", "doc": "exponents alpha_p (nonzero)"})
     axial_stretch: float = axial_stretch()
 

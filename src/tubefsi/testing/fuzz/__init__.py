@@ -72,6 +72,7 @@ from ...geometry import Tube
 from ._extremes import extremes_family
 from ._core import BREACHES, TIME_LIMIT, _TUBE, Outcome, Probe, Report, run_probe
 from ._cli import _cli_family
+from ._inputs import _inputs_family
 from ._known import _known_probes
 from ._models import (_advise_probes, _entry_keyword_probes, _model_probes, _rheology_probes, _solution_probes,
                       _solve_probes, _tube_probes, _wall_probes)
@@ -156,6 +157,7 @@ FAMILIES = {
     "cli files": _cli_family,
     "hostile plugins": _plugins_family,
     "extremes": extremes_family,
+    "inputs": _inputs_family,
 }
 
 
