@@ -20,7 +20,7 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "tubefsi"
 LAYERS = [
     {"tubefsi.errors", "tubefsi.fields", "tubefsi.numerics", "tubefsi._validation",
      "tubefsi._progress", "tubefsi._units", "tubefsi._lazy", "tubefsi.profiles", "tubefsi._keywords",
-     "tubefsi.registry"},
+     "tubefsi.registry", "tubefsi._html"},
     {"tubefsi.geometry", "tubefsi.rheology", "tubefsi.walls"},
     {"tubefsi.scene"},
     {"tubefsi.couplers"},

@@ -11,6 +11,7 @@ import html
 
 import numpy as np
 
+from . import registry
 from .fields import parameters
 
 #: Rows of a network's node and tube tables shown before "... N more".
@@ -54,8 +55,6 @@ def model_rows(model):
 
 def model_html(model, kind: str) -> str:
     """A model's class, registered name and parameters."""
-    from . import registry
-
     names = registry.rheologies if kind == "rheology" else registry.walls
     name = names.name_of(model)
     title = f"{kind}: {type(model).__name__}" + (f" ('{name}')" if name else "")

@@ -51,6 +51,7 @@ import scipy.sparse as sp
 from scipy.sparse import csgraph
 from scipy.sparse import linalg as spla
 
+from . import _html
 from ._keywords import checked_keywords
 from ._progress import bar
 from ._validation import as_array
@@ -806,8 +807,6 @@ class NetworkSolution:
     def _repr_html_(self) -> str:
         """The notebook summary: the size and convergence, then the first rows of the node and tube
         tables with units."""
-        from . import _html
-
         units = {"pressure": "Pa", "inflow": "m^3/s", "flow_rate": "m^3/s", "pressure_u": "Pa",
                  "pressure_v": "Pa", "radius_u": "m", "radius_v": "m", "length": "m"}
         return "\n".join([

@@ -247,7 +247,7 @@ def _pressure_scale(ax, wall, tb, normalize, scale_name, magnitude):
 _DEFAULT_MAX_STRETCH = 3.0
 _STIFFENING_SPAN = 20.0
 #: A finite limit pressure is drawn (tube law, flow curve) only when it lies within this multiple
-#: of the largest pressure drawn: a stiffening law's "limit" is where double precision ends, not
+#: of the largest pressure drawn on the axes: a stiffening law's "limit" is where double precision ends, not
 #: a physical bound, and drawn it would flatten the curve onto the axis.
 _LIMIT_IN_VIEW = 3.0
 
@@ -507,7 +507,9 @@ def plot_flow_curve(rheology, wall, tube, *, flow_rates=None, ax=None, n=200, la
                     xycoords=("axes fraction", "data"), xytext=(4, -3), textcoords="offset points",
                     ha="left", va="top", color=color, fontsize=8)
     lim = wall.limit_pressure(tube.reduced_thickness)
-    if _limit_in_view(lim - outlet_pressure, float(np.max(dp, initial=0.0))):
+    # in view of every curve on these axes (a shared axis keeps the first curve's range)
+    drawn = max(float(np.max(dp, initial=0.0)), float(ax.dataLim.x1) * p_unit if ax.dataLim.x1 > 0 else 0.0)
+    if _limit_in_view(lim - outlet_pressure, drawn):
         x_lim = (lim - outlet_pressure) / p_unit
         ax.axvline(x_lim, color=color, lw=1.0, ls=":", label="_nolegend_")
         ax.annotate(f"limit {_fmt_p(lim - outlet_pressure)}", xy=(x_lim, 0.4),

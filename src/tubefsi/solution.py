@@ -11,6 +11,7 @@ from __future__ import annotations
 import attrs
 import numpy as np
 
+from . import _html
 from . import export
 from .numerics.kernels import as_output
 from ._validation import as_array
@@ -381,8 +382,6 @@ class Solution:
 
     def _repr_html_(self) -> str:
         """The notebook summary: the load and the key results with units, the models and the tube."""
-        from . import _html
-
         control = "flow-controlled" if self.controlled == "flow_rate" else "pressure-controlled"
         results = [("flow rate", _html.number(self.flow_rate, "m^3/s")),
                    ("pressure drop", _html.number(self.pressure_drop, "Pa")),

@@ -34,6 +34,7 @@ from typing import ClassVar
 import attrs
 import numpy as np
 
+from .._html import model_html
 from .._validation import as_array
 from ..errors import InvalidParameterError
 from ..fields import _array_fields, evaluate, model_at
@@ -121,8 +122,6 @@ class Rheology(abc.ABC):
 
     def _repr_html_(self) -> str:
         """The notebook summary: the class, its registered name and the parameters with units."""
-        from .._html import model_html
-
         return model_html(self, "rheology")
 
     def apparent_viscosity(self, shear_rate):

@@ -25,6 +25,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from .._html import model_html
 from .._lazy import lazy_module
 from ..numerics.quadrature import Integral
 from ..numerics.roots import solve_signed
@@ -214,8 +215,6 @@ class WallModel(abc.ABC):
 
     def _repr_html_(self) -> str:
         """The notebook summary: the class, its registered name and the parameters with units."""
-        from .._html import model_html
-
         return model_html(self, "wall")
 
     def plot(self, reduced_thickness, *, ax=None, max_stretch=None, **kwargs):
