@@ -18,6 +18,11 @@ __all__ = ["Tube"]
 class Tube:
     r"""An undeformed straight tube, clamped at both ends.
 
+    ``radius`` and ``thickness`` may be functions of the axial position :math:`z` (m, 0 at the
+    inlet): a callable, a :class:`~tubefsi.Profile` or a :func:`~tubefsi.sampled` table (a
+    tapered or stenosed tube, ``docs/graded.md``); :attr:`graded` is then True and
+    :attr:`reduced_thickness` is the profile :math:`t(z)/a(z)`.
+
     Parameters
     ----------
     radius : float, array or function of z
@@ -26,11 +31,6 @@ class Tube:
         Wall thickness :math:`t` (m).
     length : float or array
         Length :math:`L` (m). Lubrication theory assumes :math:`a/L \ll 1`.
-
-    ``radius`` and ``thickness`` may be functions of the axial position :math:`z` (m, 0 at the
-    inlet): a callable, a :class:`~tubefsi.Profile` or a :func:`~tubefsi.sampled` table (a
-    tapered or stenosed tube, ``docs/graded.md``); :attr:`graded` is then True and
-    :attr:`reduced_thickness` is the profile :math:`t(z)/a(z)`.
     """
 
     radius: float = positive(unit="m", doc="undeformed inner radius a")

@@ -96,7 +96,9 @@ class Network:
     rheology : model instance, class or registered name, optional
         The fluid of every tube that does not name its own.
 
-    Example::
+    Examples
+    --------
+    ::
 
         net = tubefsi.Network(rheology=fluid)
         net.add_tube("in", "j", wall, tube)
