@@ -23,6 +23,7 @@ script that only needs the errors or the registry does not pay for SciPy.
 import importlib as _importlib
 import sys as _sys
 import types as _types
+import typing as _typing
 
 from .errors import (AccuracyWarning, BucklingError, ConvergenceError, FitWarning, InvalidParameterError, KeywordError,
                      ModelValidityWarning, NoSteadyStateError, StretchRangeError, TubefsiError)
@@ -46,6 +47,18 @@ _LAZY = {
     "fit": "fit", "FitResult": "fit",
     "Network": "network", "NetworkSolution": "network",
 }
+
+
+if _typing.TYPE_CHECKING:      # never run: tells type checkers what the lazy names below are
+    from . import dimensionless, fields, registry
+    from .advise import Advice, Diagnostics, advise
+    from .couplers.tables import cache_clear, cache_info
+    from .fit import FitResult, fit
+    from .geometry import Tube
+    from .network import Network, NetworkSolution
+    from .profiles import Profile, sampled
+    from .solution import Solution
+    from .solve import Problem, max_flow_rate, select_coupler, solve
 
 
 def __getattr__(name):

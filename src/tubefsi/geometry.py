@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import attrs
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .errors import InvalidParameterError
 from .fields import positive
@@ -33,9 +35,9 @@ class Tube:
         Length :math:`L` (m). Lubrication theory assumes :math:`a/L \ll 1`.
     """
 
-    radius: float = positive(unit="m", doc="undeformed inner radius a")
-    thickness: float = positive(unit="m", doc="wall thickness t")
-    length: float = positive(unit="m", doc="tube length L", along=False)
+    radius: float | ArrayLike | Profile | Callable = positive(unit="m", doc="undeformed inner radius a")
+    thickness: float | ArrayLike | Profile | Callable = positive(unit="m", doc="wall thickness t")
+    length: float | ArrayLike = positive(unit="m", doc="tube length L", along=False)
 
     def __attrs_post_init__(self):
         if self.graded:                  # checked along z where the scene evaluates it
