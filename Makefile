@@ -56,12 +56,19 @@ FUZZ_SCENES ?= 300
 fuzz: $(STAMP)
 	MPLBACKEND=Agg $(PY) -m tubefsi.testing.fuzz --scenes $(FUZZ_SCENES)
 
-# the documentation site (warnings are errors); figures are regenerated first
+# the documentation site (warnings are errors); figures are regenerated first. Then two checks
+# of the built site that Sphinx does not make: no raw reST markup in its pages
+# (tests/test_docs_build.py), and a look in headless Chromium, offline but for the site itself
+# (docs/check_site.py: the theory page's math typeset by the site's own MathJax, the API's
+# solve entry, a gallery figure; screenshots in docs/_build/screenshots/). It needs Debian's
+# chromium (apt-get install chromium; another browser: make docs CHROMIUM=/path/to/chrome)
 docs: $(STAMP)
 	MPLBACKEND=Agg $(PY) examples/demo.py docs/_generated/demo
 	MPLBACKEND=Agg $(PY) examples/fit_synthetic.py docs/_generated/fit
 	MPLBACKEND=Agg $(PY) examples/network.py docs/_generated/network
 	$(PY) -m sphinx -W --keep-going -q -b html docs docs/_build/html
+	$(PY) -m pytest -q -p no:cacheprovider tests/test_docs_build.py
+	$(PY) docs/check_site.py
 
 # the same tests against the newest releases of everything (not the lock), in their own venv
 test-latest:

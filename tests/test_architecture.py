@@ -56,6 +56,9 @@ def _imports(name: str, path: Path):
     tree = ast.parse(path.read_text(encoding="utf-8"))
     package = name if path.name == "__init__.py" else name.rpartition(".")[0]
     top = {id(node) for node in tree.body}
+    for node in tree.body:       # imports for type checkers only (never run) count as module-level
+        if isinstance(node, ast.If) and ast.unparse(node.test).endswith("TYPE_CHECKING"):
+            top |= {id(n) for n in node.body}
     for node in ast.walk(tree):
         if isinstance(node, ast.ImportFrom):
             if node.level:

@@ -19,9 +19,11 @@ or below (``tests/test_architecture.py``).
 script that only needs the errors or the registry does not pay for SciPy.
 """
 
-import importlib
-import sys
-import types
+# imported under private names: ``tubefsi.sys`` and the like are not part of the package
+import importlib as _importlib
+import sys as _sys
+import types as _types
+import typing as _typing
 
 from .errors import (AccuracyWarning, BucklingError, ConvergenceError, FitWarning, InvalidParameterError, KeywordError,
                      ModelValidityWarning, NoSteadyStateError, StretchRangeError, TubefsiError)
@@ -47,14 +49,26 @@ _LAZY = {
 }
 
 
+if _typing.TYPE_CHECKING:      # never run: tells type checkers what the lazy names below are
+    from . import dimensionless, fields, registry
+    from .advise import Advice, Diagnostics, advise
+    from .couplers.tables import cache_clear, cache_info
+    from .fit import FitResult, fit
+    from .geometry import Tube
+    from .network import Network, NetworkSolution
+    from .profiles import Profile, sampled
+    from .solution import Solution
+    from .solve import Problem, max_flow_rate, select_coupler, solve
+
+
 def __getattr__(name):
     if name not in _LAZY:
         raise AttributeError(f"module 'tubefsi' has no attribute {name!r}")
     where = _LAZY[name]
     if where is None:
-        value = importlib.import_module(f".{name}", __name__)
+        value = _importlib.import_module(f".{name}", __name__)
     else:
-        value = getattr(importlib.import_module(f".{where}", __name__), name)
+        value = getattr(_importlib.import_module(f".{where}", __name__), name)
     globals()[name] = value          # the next access is a plain attribute
     return value
 
@@ -67,18 +81,18 @@ def __dir__():
 _FUNCTIONS = ("solve", "advise", "fit")
 
 
-class _Package(types.ModuleType):
+class _Package(_types.ModuleType):
     def __reduce__(self):
         # pickled by name, as a plain module is (cloudpickle, dask and multiprocessing send
         # functions that refer to ``tubefsi`` to other processes)
-        return importlib.import_module, (self.__name__,)
+        return _importlib.import_module, (self.__name__,)
 
     def __setattr__(self, name, value):
         # importing the submodule ``tubefsi.solve`` sets the package attribute ``solve`` to that
         # module; keep the public function there instead, as an eager import would
-        if name in _FUNCTIONS and isinstance(value, types.ModuleType):
+        if name in _FUNCTIONS and isinstance(value, _types.ModuleType):
             value = getattr(value, name)
         super().__setattr__(name, value)
 
 
-sys.modules[__name__].__class__ = _Package
+_sys.modules[__name__].__class__ = _Package

@@ -17,10 +17,15 @@ from a user's keyword dict it calls :func:`construct`, which gives the ``Keyword
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
+from typing import Any, TypeVar
 
 from .errors import KeywordError
 
 __all__ = ["checked_keywords", "construct", "keyword_error"]
+
+#: the type of a decorated function: the decorators keep its signature for type checkers
+Function = TypeVar("Function", bound=Callable[..., Any])
 
 
 def keyword_error(target, args, kwargs, name=None, *, method=None):
@@ -78,7 +83,7 @@ class _Never(Exception):
     """Raised by nothing: the exception a wrapper without ``recover`` catches."""
 
 
-def checked_keywords(function, recover=None):
+def checked_keywords(function: Function, recover: tuple | None = None) -> Function:
     """Decorate a public function or method: a call whose arguments do not bind raises
     :class:`~tubefsi.KeywordError` instead of Python's ``TypeError``. ``recover``, optional, is
     ``(exception class, handler)``: where the call raises that exception, ``handler(function, args,
@@ -100,7 +105,7 @@ def checked_keywords(function, recover=None):
             return found
         raise error
 
-    return wrapper
+    return wrapper  # type: ignore[return-value]  # functools.wraps: the same signature
 
 
 def construct(cls, kwargs: dict):

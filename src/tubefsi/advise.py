@@ -21,6 +21,7 @@ from typing import Any
 
 import attrs
 import numpy as np
+from numpy.typing import ArrayLike
 
 from . import registry, validity
 from ._validation import as_load
@@ -32,6 +33,11 @@ from .solve import max_flow_rate, solve, solve_unchecked
 from .walls.hyperelastic import HyperelasticWall, ThickWall, ThinWall
 from .walls.linear import ThickLinear, ThinLinear
 from .walls.rigid import Rigid
+# for the annotations
+from .geometry import Tube
+from .rheology.base import Rheology
+from .solution import Solution
+from .walls.base import WallModel
 
 __all__ = ["advise", "Advice", "Candidate", "diagnostics", "Diagnostics", "ModelValidityWarning"]
 
@@ -150,8 +156,9 @@ def _equivalent_viscosity(rheology, tube, load):
 
 
 @checked_keywords
-def advise(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, tolerance=0.01,
-           outlet_pressure=0.0) -> Advice:
+def advise(rheology: Rheology | type[Rheology] | str, wall: WallModel | type[WallModel] | str, tube: Tube, *,
+           flow_rate: float | ArrayLike | None = None, pressure_drop: float | ArrayLike | None = None,
+           tolerance: float = 0.01, outlet_pressure: float | ArrayLike = 0.0) -> Advice:
     """Compare the requested model with simpler ones on the same scene.
 
     The candidates: a rigid wall; the linear wall of the same theory with the same
@@ -257,7 +264,7 @@ class Diagnostics:
 
 
 @checked_keywords
-def diagnostics(solution, *, density=None, warn=True) -> Diagnostics:
+def diagnostics(solution: Solution, *, density: float | ArrayLike | None = None, warn: bool = True) -> Diagnostics:
     """Check a :class:`~tubefsi.Solution`'s assumptions on the deformed tube (see
     :meth:`tubefsi.Solution.diagnostics` and :mod:`tubefsi.validity`), and how close it is to
     the limit pressure and the maximum flow rate."""

@@ -14,9 +14,11 @@ errors come from the Gauss–Newton covariance :math:`s^2 (J^T J)^{-1}`,
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import attrs
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy import optimize
 
 from ._progress import bar
@@ -24,6 +26,11 @@ from .errors import FitWarning, InvalidParameterError, TubefsiError, warn_user
 from ._keywords import checked_keywords
 from .scene import make_scene
 from .solve import solve_unchecked
+# for the annotations
+from .couplers.base import Coupler
+from .geometry import Tube
+from .rheology.base import Rheology
+from .walls.base import WallModel
 
 __all__ = ["fit", "FitResult"]
 
@@ -99,8 +106,9 @@ def _warn_if_unsupported(names, result, at_edge, standard_errors, values):
 
 
 @checked_keywords
-def fit(flow_rate, pressure_drop, rheology, wall, tube, *, parameters, outlet_pressure=0.0,
-        coupler="auto", progress=False) -> FitResult:
+def fit(flow_rate: ArrayLike, pressure_drop: ArrayLike, rheology: Rheology, wall: WallModel, tube: Tube, *,
+        parameters: Sequence[str], outlet_pressure: float = 0.0, coupler: str | Coupler | type[Coupler] = "auto",
+        progress: bool | str = False) -> FitResult:
     r"""Least-squares calibration of ``parameters`` from data.
 
     Parameters

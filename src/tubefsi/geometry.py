@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import attrs
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .errors import InvalidParameterError
 from .fields import positive
@@ -18,6 +20,11 @@ __all__ = ["Tube"]
 class Tube:
     r"""An undeformed straight tube, clamped at both ends.
 
+    ``radius`` and ``thickness`` may be functions of the axial position :math:`z` (m, 0 at the
+    inlet): a callable, a :class:`~tubefsi.Profile` or a :func:`~tubefsi.sampled` table (a
+    tapered or stenosed tube, ``docs/graded.md``); :attr:`graded` is then True and
+    :attr:`reduced_thickness` is the profile :math:`t(z)/a(z)`.
+
     Parameters
     ----------
     radius : float, array or function of z
@@ -26,16 +33,11 @@ class Tube:
         Wall thickness :math:`t` (m).
     length : float or array
         Length :math:`L` (m). Lubrication theory assumes :math:`a/L \ll 1`.
-
-    ``radius`` and ``thickness`` may be functions of the axial position :math:`z` (m, 0 at the
-    inlet): a callable, a :class:`~tubefsi.Profile` or a :func:`~tubefsi.sampled` table (a
-    tapered or stenosed tube, ``docs/graded.md``); :attr:`graded` is then True and
-    :attr:`reduced_thickness` is the profile :math:`t(z)/a(z)`.
     """
 
-    radius: float = positive(unit="m", doc="undeformed inner radius a")
-    thickness: float = positive(unit="m", doc="wall thickness t")
-    length: float = positive(unit="m", doc="tube length L", along=False)
+    radius: float | ArrayLike | Profile | Callable = positive(unit="m", doc="undeformed inner radius a")
+    thickness: float | ArrayLike | Profile | Callable = positive(unit="m", doc="wall thickness t")
+    length: float | ArrayLike = positive(unit="m", doc="tube length L", along=False)
 
     def __attrs_post_init__(self):
         if self.graded:                  # checked along z where the scene evaluates it

@@ -44,6 +44,8 @@ import copy
 import csv
 import json
 import math
+import os
+from collections.abc import Hashable
 
 import attrs
 import numpy as np
@@ -59,6 +61,8 @@ from . import validity
 from .errors import (AccuracyWarning, ConvergenceError, InvalidParameterError, NoSteadyStateError, warn_user)
 from .fields import varies, _array_fields, parameter_shape
 from .geometry import Tube
+from .rheology.base import Rheology
+from .walls.base import WallModel
 from .scene import make_scene, resolve
 from .solution import Solution
 from .solve import max_flow_rate as tubefsi_max_flow
@@ -97,7 +101,9 @@ class Network:
     rheology : model instance, class or registered name, optional
         The fluid of every tube that does not name its own.
 
-    Example::
+    Examples
+    --------
+    ::
 
         net = tubefsi.Network(rheology=fluid)
         net.add_tube("in", "j", wall, tube)
@@ -111,7 +117,7 @@ class Network:
     """
 
     @checked_keywords
-    def __init__(self, rheology=None):
+    def __init__(self, rheology: Rheology | type[Rheology] | str | None = None):
         self.rheology = None if rheology is None else resolve("rheology", rheology)
         self._tubes: dict = {}
         self._nodes: dict = {}
@@ -122,7 +128,9 @@ class Network:
 
     # ------------------------------------------------------------------ building
     @checked_keywords
-    def add_tube(self, u, v, wall, tube, *, name=None, rheology=None, external_pressure=0.0):
+    def add_tube(self, u: Hashable, v: Hashable, wall: WallModel | type[WallModel] | str, tube: Tube, *,
+                 name: Hashable | None = None, rheology: Rheology | type[Rheology] | str | None = None,
+                 external_pressure: float = 0.0) -> Network:
         """Add a tube from node ``u`` to node ``v`` (positive flow runs from ``u`` to ``v``).
 
         ``name`` (any hashable) defaults to ``(u, v)``; two tubes between the same nodes need
@@ -159,7 +167,7 @@ class Network:
         return self
 
     @checked_keywords
-    def set_pressure(self, node, pressure):
+    def set_pressure(self, node: Hashable, pressure: float) -> Network:
         """Fix the (transmural, gauge) pressure of ``node`` (Pa, >= 0)."""
         if node in self._inflow:
             raise InvalidParameterError("node", "a node with a pressure or an inflow, not both", node,
@@ -168,7 +176,7 @@ class Network:
         return self
 
     @checked_keywords
-    def set_inflow(self, node, flow_rate):
+    def set_inflow(self, node: Hashable, flow_rate: float) -> Network:
         """Inject ``flow_rate`` (m^3/s; negative: withdraw) at ``node``."""
         if node in self._pressure:
             raise InvalidParameterError("node", "a node with a pressure or an inflow, not both", node,
@@ -177,7 +185,7 @@ class Network:
         return self
 
     @checked_keywords
-    def set_position(self, node, xy):
+    def set_position(self, node: Hashable, xy: tuple[float, float]) -> Network:
         """Place ``node`` at ``xy = (x, y)`` for the plot."""
         self.positions[node] = (float(xy[0]), float(xy[1]))
         return self
@@ -243,7 +251,7 @@ class Network:
 
     # ------------------------------------------------------------------ solving
     @checked_keywords
-    def solve(self, *, rtol=1e-13, max_iterations=100, progress=False) -> NetworkSolution:
+    def solve(self, *, rtol: float = 1e-13, max_iterations: int = 100, progress: bool | str = False) -> NetworkSolution:
         """The steady state: node pressures and tube flow rates (a :class:`NetworkSolution`).
 
         ``progress`` (bool or ``"auto"``) shows a progress bar over the Newton iterations (tqdm,
@@ -744,7 +752,7 @@ class NetworkSolution:
         return self.q.copy()
 
     @checked_keywords
-    def solution(self, name) -> Solution:
+    def solution(self, name: Hashable) -> Solution:
         """The full single-tube :class:`~tubefsi.Solution` of tube ``name`` (profiles included): its
         flow rate at its outlet pressure, oriented from its higher-pressure end (``z = 0`` is ``u``
         if the flow runs u -> v, else ``v``)."""
@@ -775,7 +783,7 @@ class NetworkSolution:
                 "radius_v": self.radius_v.tolist(), "length": [t.tube.length for t in self.tubes]}
 
     @checked_keywords
-    def to_csv(self, prefix) -> tuple:
+    def to_csv(self, prefix: str | os.PathLike) -> tuple:
         """Write ``<prefix>_nodes.csv`` and ``<prefix>_tubes.csv``; returns the two paths."""
         paths = (f"{prefix}_nodes.csv", f"{prefix}_tubes.csv")
         for path, table in zip(paths, (self.node_table(), self.tube_table())):
@@ -787,7 +795,7 @@ class NetworkSolution:
         return paths
 
     @checked_keywords
-    def to_json(self, path=None) -> str:
+    def to_json(self, path: str | os.PathLike | None = None) -> str:
         """The node and tube tables as JSON (node and tube names as text); written to ``path`` if given."""
         data = {"nodes": _records(self.node_table()), "tubes": _records(self.tube_table()),
                 "iterations": self.iterations, "residual": self.residual}

@@ -300,6 +300,8 @@ def plot_tube_law(wall, reduced_thickness, *, ax=None, max_stretch=None, normali
     color : matplotlib color, optional
         Colour of the curve (and its limit line); the Axes' colour cycle otherwise.
 
+    Notes
+    -----
     Draws the tube law (solid), its linear small-strain tangent :math:`k_0(\lambda-1)`
     (faint, in the curve's colour; one legend entry per Axes) and, when finite and within three
     times the highest pressure drawn, the limit pressure as a dashed horizontal line in the
@@ -456,6 +458,8 @@ def plot_flow_curve(rheology, wall, tube, *, flow_rates=None, ax=None, n=200, la
     outlet_pressure, coupler
         Passed to :func:`tubefsi.solve`.
 
+    Notes
+    -----
     Draws the curve (one solve over the whole array of flow rates), the rigid
     reference, and, when finite, the maximum flow rate (dashed horizontal) and, within three
     times the largest drop drawn, the largest possible pressure drop, limit pressure minus
@@ -550,6 +554,8 @@ def plot_profiles(solution, *, axes=None, n=200, max_loads=8):
     max_loads : int
         Most lines per panel for a curve of loads.
 
+    Notes
+    -----
     The radius panel shows the undeformed radius :math:`R/a = 1` (black dashed, drawn over the
     profiles: a load of zero flow rate lies on it). The pressure panel shows the wall's limit
     pressure (dashed) when it is finite and within 1.25 times the largest pressure drawn;

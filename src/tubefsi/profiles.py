@@ -32,6 +32,9 @@ def _constant(value):
 class Profile:
     r"""A parameter as a function of the axial position :math:`z` (m): ``Profile(function)``.
 
+    The parameter it stands for (its name and admissible range) is bound when a model or a
+    :class:`~tubefsi.Tube` takes it; calling the profile then validates the values.
+
     Parameters
     ----------
     function : callable
@@ -43,9 +46,6 @@ class Profile:
     span : (float, float), optional
         The positions the function is defined on (default: all); a tube longer than the span
         is an :class:`~tubefsi.InvalidParameterError`.
-
-    The parameter it stands for (its name and admissible range) is bound when a model or a
-    :class:`~tubefsi.Tube` takes it; calling the profile then validates the values.
     """
 
     function: object

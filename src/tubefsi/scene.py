@@ -100,7 +100,10 @@ class Scene:
     and threads share it; it is not frozen only so that the commonest scene, one per scalar solve,
     is cheap to build). Every model parameter, every tube field
     and the outlet pressure may be an array: the scene's :attr:`shape` is their broadcast shape,
-    and the loads of a solve broadcast against it. The outlet state is derived once:
+    and the loads of a solve broadcast against it. :meth:`flat` broadcasts everything to a shape
+    and flattens it (what couplers work on: one entry per point), :meth:`take` selects points of a
+    flat scene, and :meth:`at` gathers the per-point quantities of some points for an integrand.
+    The outlet state is derived once:
 
     Attributes
     ----------
@@ -113,10 +116,6 @@ class Scene:
     log_stretch_max : float or ndarray
         :math:`\ln(\lambda_{max}/\lambda_{out})`, the largest log-stretch the wall admits
         (``inf`` unless it locks or its tube law peaks).
-
-    :meth:`flat` broadcasts everything to a shape and flattens it (what couplers work on: one
-    entry per point), :meth:`take` selects points of a flat scene, and :meth:`at` gathers the
-    per-point quantities of some points for an integrand.
     """
 
     rheology: Rheology

@@ -8,8 +8,11 @@ that reach :mod:`tubefsi.advise` and :mod:`tubefsi.plotting` on purpose, at call
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import attrs
 import numpy as np
+from numpy.typing import ArrayLike
 
 from . import _html
 from . import export
@@ -294,33 +297,33 @@ class Solution:
     def _out(self, value, *arguments):
         return as_output(value, self.scalar and all(np.ndim(a) == 0 for a in arguments))
 
-    def pressure(self, z):
+    def pressure(self, z: float | ArrayLike) -> float | np.ndarray:
         """Pressure p(z) (Pa) at axial position ``z`` in [0, L] (m)."""
         _, rise, _ = self._profile(z)
         return self._out(self.outlet_pressure + rise, z)
 
-    def radius(self, z):
+    def radius(self, z: float | ArrayLike) -> float | np.ndarray:
         """Deformed inner radius R(z) (m)."""
         strain, _, _ = self._profile(z)
         return self._out(self._undeformed(z) * (1.0 + strain), z)
 
-    def displacement(self, z):
+    def displacement(self, z: float | ArrayLike) -> float | np.ndarray:
         """Radial wall displacement R(z) - a (m), without cancellation."""
         strain, _, _ = self._profile(z)
         return self._out(self._undeformed(z) * strain, z)
 
-    def pressure_gradient(self, z):
+    def pressure_gradient(self, z: float | ArrayLike) -> float | np.ndarray:
         """Local pressure gradient G = -dp/dz (Pa/m)."""
         strain, _, q = self._profile(z)
         return self._out(self.rheology.pressure_gradient(q, self._undeformed(z) * (1.0 + strain)), z)
 
-    def wall_shear_stress(self, z):
+    def wall_shear_stress(self, z: float | ArrayLike) -> float | np.ndarray:
         """Wall shear stress tau_w = G R / 2 (Pa)."""
         strain, _, q = self._profile(z)
         big_r = self._undeformed(z) * (1.0 + strain)
         return self._out(0.5 * self.rheology.pressure_gradient(q, big_r) * big_r, z)
 
-    def velocity(self, r, z):
+    def velocity(self, r: float | ArrayLike, z: float | ArrayLike) -> float | np.ndarray:
         """Axial velocity v(r, z) (m/s) at radial position ``r`` in [0, R(z)] (m)."""
         r_arr = as_array("r", r, "[0, R(z)] (m)", lambda a: a >= 0)
         strain, _, q = self._profile(z)
@@ -333,14 +336,14 @@ class Solution:
         return self._out(self.rheology.velocity(np.minimum(r_arr, big_r), big_r, g), z, r)
 
     # ------------------------------------------------------------------ tables (optional extras)
-    def to_dataframe(self, dims=None):
+    def to_dataframe(self, dims: Sequence[str] | None = None):
         """The results as a :class:`pandas.DataFrame`, one row per point: the inputs that vary
         (the load, array parameters), then pressure drop, flow rate, inlet pressure, inlet
         displacement and inlet radius (SI; units in ``frame.attrs["units"]``). Needs pandas
         (``pip install 'tubefsi[pandas]'``); ``dims`` names the axes (:mod:`tubefsi.export`)."""
         return export.to_dataframe(self, dims)
 
-    def to_xarray(self, dims=None):
+    def to_xarray(self, dims: Sequence[str] | None = None):
         """The results as an :class:`xarray.Dataset`: one named dimension per broadcast axis
         (the input that varies along it, or ``dims``), the varying inputs as coordinates, the
         results as data variables with ``units`` attributes. Needs xarray
@@ -355,7 +358,7 @@ class Solution:
         return export.to_quantities(self, registry)
 
     # ------------------------------------------------------------------ accessors (upper layers)
-    def diagnostics(self, *, density=None, warn=True):
+    def diagnostics(self, *, density: float | ArrayLike | None = None, warn: bool = True):
         """Validity of the model's assumptions for this solution.
 
         Reports the slenderness a/L, the largest hoop strain, the closeness to a

@@ -15,10 +15,11 @@ import math
 
 import attrs
 import numpy as np
+from numpy.typing import ArrayLike
 
 from . import registry
 from .registry import PluginWarning
-from ._keywords import checked_keywords
+from ._keywords import Function, checked_keywords
 from ._progress import bar
 from ._validation import as_load
 from .couplers.base import Coupler
@@ -27,10 +28,12 @@ from .couplers.graded import Graded
 from .couplers.rescaled import Rescaled, in_units
 from .errors import InvalidParameterError, NoSteadyStateError, warn_user
 from .geometry import Tube
+from .rheology.base import Rheology
 from .rheology.power_law import FactorRangeError
 from .scene import Scene, State, _resolve, make_scene, resolve
 from .solution import Solution, max_flow_rate_of
 from .validity import check_and_warn
+from .walls.base import WallModel
 
 __all__ = ["solve", "max_flow_rate", "select_coupler", "Problem", "CHUNK"]
 
@@ -65,7 +68,8 @@ def _supports(instance, name, rheology, wall) -> bool:
 
 
 @checked_keywords
-def select_coupler(rheology, wall, coupler="auto") -> Coupler:
+def select_coupler(rheology: Rheology | type[Rheology] | str, wall: WallModel | type[WallModel] | str,
+                   coupler: str | Coupler | type[Coupler] = "auto") -> Coupler:
     """The coupler ``solve`` would use for ``rheology`` and ``wall`` (instances, classes or
     registered names, as ``solve`` takes them): a name, an instance, or ``"auto"`` (cheapest
     accurate)."""
@@ -123,7 +127,7 @@ def _options(on_infeasible, density):
     return None if density is None else as_load("density", density, allow_zero=False)
 
 
-def _in_radius_units(function):
+def _in_radius_units(function: Function) -> Function:
     """:func:`~tubefsi._keywords.checked_keywords`, recovering from
     :class:`~tubefsi.rheology.power_law.FactorRangeError` (a factor of the separated form left the
     doubles: a power law of a large index) by solving again in units of the tube's radius
@@ -132,8 +136,11 @@ def _in_radius_units(function):
 
 
 @_in_radius_units
-def solve(rheology, wall, tube, *, flow_rate=None, pressure_drop=None, coupler="auto",
-          outlet_pressure=0.0, external_pressure=0.0, on_infeasible="raise", density=None, progress=False) -> Solution:
+def solve(rheology: Rheology | type[Rheology] | str, wall: WallModel | type[WallModel] | str, tube: Tube, *,
+          flow_rate: float | ArrayLike | None = None, pressure_drop: float | ArrayLike | None = None,
+          coupler: str | Coupler | type[Coupler] = "auto", outlet_pressure: float | ArrayLike = 0.0,
+          external_pressure: float | ArrayLike = 0.0, on_infeasible: str = "raise",
+          density: float | ArrayLike | None = None, progress: bool | str = False) -> Solution:
     r"""Solve steady flow of ``rheology`` through ``tube`` with wall ``wall``.
 
     Exactly one of ``flow_rate`` (flow-controlled) and ``pressure_drop`` (pressure-controlled) is
@@ -366,7 +373,9 @@ def _beyond_range(controlled, values, why):
 
 
 @checked_keywords
-def max_flow_rate(rheology, wall, tube, *, outlet_pressure=0.0, external_pressure=0.0, coupler="auto"):
+def max_flow_rate(rheology: Rheology | type[Rheology] | str, wall: WallModel | type[WallModel] | str, tube: Tube, *,
+                  outlet_pressure: float | ArrayLike = 0.0, external_pressure: float | ArrayLike = 0.0,
+                  coupler: str | Coupler | type[Coupler] = "auto") -> float | np.ndarray:
     r"""The largest flow rate with a steady state (m^3/s); ``inf`` where every flow rate has one.
 
     Finite only for a wall with a limit pressure (thick or thin-current Mooney–Rivlin/neo-Hookean)
@@ -411,21 +420,24 @@ class Problem:
     coupler_name: str
 
     @checked_keywords
-    def __init__(self, rheology, wall, tube, *, coupler="auto", outlet_pressure=0.0, external_pressure=0.0):
+    def __init__(self, rheology: Rheology | type[Rheology] | str, wall: WallModel | type[WallModel] | str,
+                 tube: Tube, *, coupler: str | Coupler | type[Coupler] = "auto",
+                 outlet_pressure: float | ArrayLike = 0.0, external_pressure: float | ArrayLike = 0.0):
         scene = make_scene(rheology, wall, tube, outlet_pressure=outlet_pressure, external_pressure=external_pressure)
         chosen, name = _choose(scene, coupler)
         self.__attrs_init__(scene=scene, coupler=chosen, coupler_name=name)
 
     @checked_keywords
-    def solve(self, *, flow_rate=None, pressure_drop=None, on_infeasible="raise", density=None,
-              progress=False) -> Solution:
+    def solve(self, *, flow_rate: float | ArrayLike | None = None, pressure_drop: float | ArrayLike | None = None,
+              on_infeasible: str = "raise", density: float | ArrayLike | None = None,
+              progress: bool | str = False) -> Solution:
         """:func:`tubefsi.solve` of this problem at the given load (see there)."""
         controlled, load = _load(flow_rate, pressure_drop)
         rho = _options(on_infeasible, density)
         return _solve_scene(self.scene, self.coupler, self.coupler_name, controlled, load, on_infeasible, rho,
                             progress)
 
-    def max_flow_rate(self):
+    def max_flow_rate(self) -> float | np.ndarray:
         """:func:`tubefsi.max_flow_rate` of this problem (m^3/s; ``inf`` where there is none)."""
         return max_flow_rate_of(self.scene, self.coupler)
 
