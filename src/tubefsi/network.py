@@ -41,8 +41,6 @@ throughput (the total flow that enters the network); otherwise :class:`Convergen
 from __future__ import annotations
 
 import copy
-import csv
-import json
 import math
 
 import attrs
@@ -58,10 +56,10 @@ from . import validity
 from .errors import (AccuracyWarning, ConvergenceError, InvalidParameterError, NoSteadyStateError, warn_user)
 from .fields import varies, _array_fields, parameter_shape
 from .geometry import Tube
+from .network_solution import NetworkSolution
 from .scene import make_scene, resolve
-from .solution import Solution
 from .solve import max_flow_rate as tubefsi_max_flow
-from .solve import solve, solve_unchecked
+from .solve import solve_unchecked
 
 __all__ = ["Network", "NetworkSolution"]
 
@@ -86,6 +84,10 @@ class _Tube:
     tube: Tube
     rheology: object
     external_pressure: float = 0.0
+
+    def models(self):
+        """This tube's wall, tube and fluid."""
+        return self.wall, self.tube, self.rheology
 
 
 class Network:
@@ -306,11 +308,13 @@ class _Groups:
         n = len(tubes)
         self.limit = np.zeros(n)
         self.radius = np.zeros(n)
+        self.length = np.zeros(n)
         for (index, fluid, wall, tube), p_e in zip(self.parts, self.external):
             # the node (gauge) pressure at which the transmural one reaches the limit pressure
             self.limit[index] = np.broadcast_to(wall.limit_pressure(tube.reduced_thickness) + np.asarray(p_e),
                                                 index.shape)
             self.radius[index] = np.broadcast_to(tube.radius, index.shape)
+            self.length[index] = np.broadcast_to(tube.length, index.shape)
 
     def evaluate(self, drop, outlet):
         """Flow rates and the derivatives by the inlet and outlet pressures of the tubes (pressure-
@@ -441,6 +445,7 @@ class _Solver:
         self.feed_groups = _Groups(self.tubes, self.feeder)
         self.limit = np.where(self.feeder, self.feed_groups.limit, self.groups.limit)
         self.radius = np.where(self.feeder, self.feed_groups.radius, self.groups.radius)
+        self.length = np.where(self.feeder, self.feed_groups.length, self.groups.length)
         # a node's bound: the smallest limit pressure of its tubes (an inlet must stay below it)
         self.p_limit = np.full(n_nodes, np.inf)
         np.minimum.at(self.p_limit, self.U, self.limit)
@@ -499,8 +504,7 @@ class _Solver:
 
     def _rigid_start(self):
         """Pressures of the rigid Newtonian network (apparent viscosities, three Picard sweeps)."""
-        a = self.radius
-        length = np.array([t.tube.length for t in self.tubes])
+        a, length = self.radius, self.length
         mu = np.where(self.feeder, self.feed_groups.nominal_viscosity(self.n_tubes),
                       self.groups.nominal_viscosity(self.n_tubes))
         good = np.isfinite(mu) & (mu > 0)
@@ -653,8 +657,11 @@ class _Solver:
             r_v = np.where(self.feeder, np.where(at_u, r_out, r_in), r_v)
         for groups in (self.groups, self.feed_groups):
             groups.check(q, r_u, r_v, self.tubes)
+        fluids = tuple((index, fluid) for groups in (self.groups, self.feed_groups)
+                       for index, fluid, _, _ in groups.parts)
         return NetworkSolution(net=self.net, nodes=self.nodes, tubes=self.tubes, p=p, q=q, radius_u=r_u,
-                               radius_v=r_v, iterations=iterations, residual=residual)
+                               radius_v=r_v, iterations=iterations, residual=residual, U=self.U, V=self.V,
+                               radius0=self.radius, length=self.length, fluids=fluids)
 
     def _noise(self, p, q, gu, gv):
         """Per free node, the mass imbalance that rounding alone leaves: the pressures' rounding
@@ -694,134 +701,6 @@ class _Solver:
         return float(frac[i])
 
 
-@attrs.frozen(kw_only=True, repr=False, eq=False)
-class NetworkSolution:
-    """The steady state of a :class:`Network`.
-
-    Attributes
-    ----------
-    pressure : dict
-        node -> pressure (Pa).
-    flow_rate : dict
-        tube name -> flow rate (m^3/s), positive from the tube's ``u`` to its ``v``.
-    iterations : int
-        Newton iterations taken.
-    residual : float
-        The largest mass imbalance of a free node over the throughput.
-    """
-
-    net: Network
-    nodes: list
-    tubes: list
-    p: np.ndarray
-    q: np.ndarray
-    radius_u: np.ndarray
-    radius_v: np.ndarray
-    iterations: int
-    residual: float
-
-    @property
-    def pressure(self) -> dict:
-        return dict(zip(self.nodes, self.p.tolist()))
-
-    @property
-    def flow_rate(self) -> dict:
-        return {t.name: q for t, q in zip(self.tubes, self.q.tolist())}
-
-    @property
-    def tube_names(self) -> list:
-        return [t.name for t in self.tubes]
-
-    @property
-    def pressures(self) -> np.ndarray:
-        """Node pressures (Pa) in the order of :attr:`nodes`."""
-        return self.p.copy()
-
-    @property
-    def flow_rates(self) -> np.ndarray:
-        """Tube flow rates (m^3/s) in the order of :attr:`tube_names`."""
-        return self.q.copy()
-
-    @checked_keywords
-    def solution(self, name) -> Solution:
-        """The full single-tube :class:`~tubefsi.Solution` of tube ``name`` (profiles included): its
-        flow rate at its outlet pressure, oriented from its higher-pressure end (``z = 0`` is ``u``
-        if the flow runs u -> v, else ``v``)."""
-        t = self.net._tubes.get(name) if _hashable(name) else None
-        if t is None:
-            raise InvalidParameterError("name", "the name of a tube of the network", name)
-        pu, pv = self.pressure[t.u], self.pressure[t.v]
-        return solve(t.rheology, t.wall, t.tube, flow_rate=abs(self.flow_rate[name]), outlet_pressure=min(pu, pv),
-                     external_pressure=t.external_pressure)
-
-    def node_table(self) -> dict:
-        """Columns ``node``, ``pressure`` (Pa), ``inflow`` (m^3/s, net flow injected; at a fixed
-        node, what the boundary supplies) and ``fixed``."""
-        n = len(self.nodes)
-        U = np.array([self.net._nodes[t.u] for t in self.tubes])
-        V = np.array([self.net._nodes[t.v] for t in self.tubes])
-        injected = np.bincount(U, self.q, n) - np.bincount(V, self.q, n)
-        return {"node": list(self.nodes), "pressure": self.p.tolist(), "inflow": injected.tolist(),
-                "fixed": [node in self.net._pressure for node in self.nodes]}
-
-    def tube_table(self) -> dict:
-        """Columns ``name``, ``u``, ``v``, ``flow_rate`` (m^3/s), ``pressure_u``, ``pressure_v``
-        (Pa), ``radius_u``, ``radius_v`` (deformed inner radii at the two ends, m) and ``length`` (m)."""
-        p = self.pressure
-        return {"name": self.tube_names, "u": [t.u for t in self.tubes], "v": [t.v for t in self.tubes],
-                "flow_rate": self.q.tolist(), "pressure_u": [p[t.u] for t in self.tubes],
-                "pressure_v": [p[t.v] for t in self.tubes], "radius_u": self.radius_u.tolist(),
-                "radius_v": self.radius_v.tolist(), "length": [t.tube.length for t in self.tubes]}
-
-    @checked_keywords
-    def to_csv(self, prefix) -> tuple:
-        """Write ``<prefix>_nodes.csv`` and ``<prefix>_tubes.csv``; returns the two paths."""
-        paths = (f"{prefix}_nodes.csv", f"{prefix}_tubes.csv")
-        for path, table in zip(paths, (self.node_table(), self.tube_table())):
-            with open(path, "w", newline="", encoding="utf-8") as fh:
-                writer = csv.writer(fh)
-                writer.writerow(list(table))
-                for row in zip(*table.values()):
-                    writer.writerow([_text(x) if not isinstance(x, float) else repr(x) for x in row])
-        return paths
-
-    @checked_keywords
-    def to_json(self, path=None) -> str:
-        """The node and tube tables as JSON (node and tube names as text); written to ``path`` if given."""
-        data = {"nodes": _records(self.node_table()), "tubes": _records(self.tube_table()),
-                "iterations": self.iterations, "residual": self.residual}
-        text = json.dumps(data, indent=1)
-        if path is not None:
-            with open(path, "w", encoding="utf-8") as fh:
-                fh.write(text)
-        return text
-
-    def plot(self, **kwargs):
-        """The network coloured by pressure, tubes as wide as their deformed radius; see
-        :func:`tubefsi.plotting.plot_network`."""
-        from .plotting import plot_network
-
-        return plot_network(self, **kwargs)
-
-    def _repr_html_(self) -> str:
-        """The notebook summary: the size and convergence, then the first rows of the node and tube
-        tables with units."""
-        from . import _html
-
-        units = {"pressure": "Pa", "inflow": "m^3/s", "flow_rate": "m^3/s", "pressure_u": "Pa",
-                 "pressure_v": "Pa", "radius_u": "m", "radius_v": "m", "length": "m"}
-        return "\n".join([
-            _html.table("NetworkSolution", [("nodes", len(self.nodes)), ("tubes", len(self.tubes)),
-                                            ("Newton iterations", self.iterations),
-                                            ("residual", f"{self.residual:.2e}")]),
-            _html.columns_html("nodes", self.node_table(), units),
-            _html.columns_html("tubes", self.tube_table(), units)])
-
-    def __repr__(self) -> str:
-        return (f"NetworkSolution({len(self.nodes)} nodes, {len(self.tubes)} tubes, "
-                f"{self.iterations} iterations, residual {self.residual:.2e})")
-
-
 #: Why a network can have no resolvable throughput: tubes in series whose conductances differ by
 #: more than double precision resolves (the drop over the wide one is below one rounding unit of
 #: the pressures, so its flow is either 0 or far too large).
@@ -837,20 +716,3 @@ _WORST_ROUNDED = 1e-6
 def _share(worst, through) -> float:
     """The imbalance as a share of the throughput (inf where nothing flows but something should)."""
     return worst / through if through > 0 else (0.0 if worst == 0 else float("inf"))
-
-
-def _hashable(x) -> bool:
-    try:
-        hash(x)
-    except TypeError:
-        return False
-    return True
-
-
-def _text(x):
-    return x if isinstance(x, (str, int, bool)) else str(x)
-
-
-def _records(table):
-    return [{k: (v if isinstance(v, (float, int, bool, str)) else str(v)) for k, v in zip(table, row)}
-            for row in zip(*table.values())]
