@@ -54,7 +54,7 @@ from ._progress import bar
 from ._validation import as_array
 from . import validity
 from .errors import (AccuracyWarning, ConvergenceError, InvalidParameterError, NoSteadyStateError, warn_user)
-from .fields import varies, _array_fields, parameter_shape
+from .fields import broadcast_model, varies, _array_fields, parameter_shape
 from .geometry import Tube
 from .network_solution import NetworkSolution
 from .scene import make_scene, resolve
@@ -77,6 +77,10 @@ _AT_BOUND = 1e-12
 
 @attrs.define(eq=False)
 class _Tube:
+    """One tube. ``row`` is None for a tube of :meth:`Network.add_tube`; for a tube of
+    :meth:`Network.add_tubes` it is the tube's entry in the flat (1-D) array parameters of the
+    models it shares with the other tubes of that call."""
+
     name: object
     u: object
     v: object
@@ -84,10 +88,19 @@ class _Tube:
     tube: Tube
     rheology: object
     external_pressure: float = 0.0
+    row: object = None
 
     def models(self):
-        """This tube's wall, tube and fluid."""
-        return self.wall, self.tube, self.rheology
+        """This tube's wall, tube and fluid, each with scalar parameters."""
+        if self.row is None:
+            return self.wall, self.tube, self.rheology
+        return tuple(_entry(m, self.row) for m in (self.wall, self.tube, self.rheology))
+
+
+def _entry(model, row):
+    """``model`` with its flat array parameters taken at ``row`` (validated scalars)."""
+    arrays = {f: float(v[row]) for f in _array_fields(type(model)) if isinstance(v := getattr(model, f), np.ndarray)}
+    return attrs.evolve(model, **arrays) if arrays else model
 
 
 class Network:
@@ -118,6 +131,8 @@ class Network:
         self._nodes: dict = {}
         self._pressure: dict = {}
         self._inflow: dict = {}
+        #: node -> (resistance, distal pressure) of a resistance outlet
+        self._resistance: dict = {}
         #: node -> (x, y), for :meth:`NetworkSolution.plot`
         self.positions: dict = {}
 
@@ -157,6 +172,82 @@ class Network:
         for node in (u, v):
             self._nodes.setdefault(node, len(self._nodes))
         self._tubes[name] = _Tube(name, u, v, wall, tube, fluid, float(p_e))
+        return self
+
+    @checked_keywords
+    def add_tubes(self, u, v, wall, tube, *, names=None, rheology=None, external_pressure=0.0):
+        """Add ``n`` tubes at once, from node ``u[k]`` to node ``v[k]`` (sequences or arrays of
+        node names of length ``n``), as :meth:`add_tube` does for one.
+
+        ``wall``, ``tube`` and ``rheology`` are one model each whose parameters are scalars
+        (shared by every tube) or arrays of length ``n`` (one entry per tube), e.g.
+        ``Tube(radius=radii, thickness=0.3 * radii, length=lengths)``; ``external_pressure`` is a
+        number or an array of length ``n``; ``names`` (default ``(u[k], v[k])``) a sequence of
+        ``n`` distinct names. Everything is checked before any tube is added. Building from
+        arrays costs a fraction of calling :meth:`add_tube` per tube (``docs/network.md``).
+        """
+        u, v = _names_of("u", u), _names_of("v", v)
+        n = len(u)
+        if n == 0 or len(v) != n:
+            raise InvalidParameterError("v", f"a sequence as long as u ({n} >= 1 node names)", len(v))
+        names = [(a, b) for a, b in zip(u, v)] if names is None else _names_of("names", names)
+        if len(names) != n:
+            raise InvalidParameterError("names", f"{n} names, one per tube", len(names))
+        for k, (a, b) in enumerate(zip(u, v)):
+            if a == b:
+                raise InvalidParameterError(f"v[{k}]", "a node other than u[k]", b, "a tube joins two distinct nodes")
+        taken = self._tubes.keys()
+        seen = set()
+        for k, name in enumerate(names):
+            if name in taken or name in seen:
+                raise InvalidParameterError(f"names[{k}]", "a name no other tube has", name,
+                                            "tubes between the same two nodes need distinct names")
+            seen.add(name)
+        wall = resolve("wall", wall)
+        fluid = self.rheology if rheology is None else resolve("rheology", rheology)
+        if fluid is None:
+            raise InvalidParameterError("rheology", "a fluid, here or in Network(rheology=...)", None)
+        if not isinstance(tube, Tube):
+            raise InvalidParameterError("tube", "a tubefsi.Tube", tube)
+        models = []
+        for label, model in (("wall", wall), ("tube", tube), ("rheology", fluid)):
+            if parameter_shape(model) not in ((), (n,)):
+                raise InvalidParameterError(label, f"scalar parameters or arrays of length {n} (one entry per "
+                                            f"tube)", model, f"its parameters have the shape {parameter_shape(model)}")
+            if varies(model):
+                raise InvalidParameterError(label, "a uniform tube and wall (a network takes no tube that varies "
+                                            "along z)", model)
+            models.append(broadcast_model(model, (n,)))
+        wall, tube, fluid = models
+        p_e = as_array("external_pressure", external_pressure, "the real numbers", np.isfinite)
+        if p_e.shape not in ((), (n,)):
+            raise InvalidParameterError("external_pressure", f"a number or an array of length {n}", p_e.shape)
+        p_e = np.broadcast_to(p_e.astype(float), (n,)).tolist()
+        shared = parameter_shape(wall) == parameter_shape(tube) == parameter_shape(fluid) == ()
+        for node in u + v:
+            self._nodes.setdefault(node, len(self._nodes))
+        tubes = self._tubes
+        for k in range(n):
+            tubes[names[k]] = _Tube(names[k], u[k], v[k], wall, tube, fluid, p_e[k], None if shared else k)
+        return self
+
+    @checked_keywords
+    def remove_tube(self, name):
+        """Remove tube ``name``. A node left without a tube leaves the network with its
+        boundary condition and position."""
+        t = self._tubes.pop(name, None) if _hashable(name) else None
+        if t is None:
+            raise InvalidParameterError("name", "the name of a tube of the network", name)
+        used = set()
+        for other in self._tubes.values():
+            used.add(other.u)
+            used.add(other.v)
+        gone = [node for node in (t.u, t.v) if node not in used]
+        if gone:
+            for node in gone:
+                for store in (self._pressure, self._inflow, self._resistance, self.positions):
+                    store.pop(node, None)
+            self._nodes = {node: i for i, node in enumerate(k for k in self._nodes if k not in gone)}
         return self
 
     @checked_keywords
@@ -238,7 +329,8 @@ class Network:
                 data["pos"] = self.positions[node]
             graph.add_node(node, **data)
         for t in self._tubes.values():
-            graph.add_edge(t.u, t.v, key=t.name, wall=t.wall, tube=t.tube, rheology=t.rheology,
+            wall, tube, fluid = t.models()
+            graph.add_edge(t.u, t.v, key=t.name, wall=wall, tube=tube, rheology=fluid,
                            external_pressure=t.external_pressure)
         return graph
 
@@ -280,7 +372,7 @@ class Network:
     def _snapshot(self):
         """A copy that later changes to this network do not reach (the solution keeps it)."""
         new = copy.copy(self)
-        for name in ("_tubes", "_nodes", "_pressure", "_inflow", "positions"):
+        for name in ("_tubes", "_nodes", "_pressure", "_inflow", "_resistance", "positions"):
             setattr(new, name, dict(getattr(self, name)))
         return new
 
@@ -291,18 +383,23 @@ class _Groups:
 
     def __init__(self, tubes, subset):
         groups: dict = {}
+        keys: dict = {}               # id(model) -> its class and non-array parameters
         self.external = []            # per part: the external pressure of its tubes (float or array)
         for i, t in enumerate(tubes):
             if not subset[i]:
                 continue
-            key = (type(t.wall), _fixed(t.wall), type(t.rheology), _fixed(t.rheology))
-            groups.setdefault(key, []).append(i)
+            wall, fluid = t.wall, t.rheology
+            if id(wall) not in keys:
+                keys[id(wall)] = (type(wall), _fixed(wall))
+            if id(fluid) not in keys:
+                keys[id(fluid)] = (type(fluid), _fixed(fluid))
+            groups.setdefault((keys[id(wall)], keys[id(fluid)]), []).append(i)
         self.parts = []
         for index in groups.values():
             members = [tubes[i] for i in index]
-            wall = _stack([m.wall for m in members])
-            fluid = _stack([m.rheology for m in members])
-            tube = Tube(**{f: _column([getattr(m.tube, f) for m in members]) for f in ("radius", "thickness", "length")})
+            wall = _stack(members, "wall")
+            fluid = _stack(members, "rheology")
+            tube = Tube(**_gather(members, "tube", ("radius", "thickness", "length")))
             self.parts.append((np.asarray(index), fluid, wall, tube))
             self.external.append(_column([m.external_pressure for m in members]))
         n = len(tubes)
@@ -402,13 +499,33 @@ def _column(values):
     return float(a[0]) if np.all(a == a[0]) else a
 
 
-def _stack(models):
+def _gather(members, which, fields) -> dict:
+    """field -> the members' values of that parameter of their ``which`` model (a float where all
+    agree, else an array aligned with ``members``). Tubes added together by
+    :meth:`Network.add_tubes` share one model: their entries are taken at their rows, in one
+    indexing per model rather than one lookup per tube."""
+    by_model: dict = {}
+    for j, m in enumerate(members):
+        model = getattr(m, which)
+        entry = by_model.get(id(model))
+        if entry is None:
+            entry = by_model[id(model)] = (model, [], [])
+        entry[1].append(j)
+        entry[2].append(m.row)
+    out = {f: np.empty(len(members)) for f in fields}
+    for model, positions, rows in by_model.values():
+        for f in fields:
+            value = getattr(model, f)
+            out[f][positions] = value[rows] if isinstance(value, np.ndarray) and value.ndim else value
+    return {f: _column(column) for f, column in out.items()}
+
+
+def _stack(members, which):
     """One model whose array parameters hold the members' values (a scalar where all agree)."""
-    first = models[0]
-    if len(models) == 1 or all(m is first for m in models):
+    first = getattr(members[0], which)
+    if all(getattr(m, which) is first and m.row is None for m in members):
         return first
-    arrays = {f: _column([getattr(m, f) for m in models]) for f in _array_fields(type(first))}
-    return attrs.evolve(first, **arrays)
+    return attrs.evolve(first, **_gather(members, which, _array_fields(type(first))))
 
 
 class _Solver:
@@ -716,3 +833,26 @@ _WORST_ROUNDED = 1e-6
 def _share(worst, through) -> float:
     """The imbalance as a share of the throughput (inf where nothing flows but something should)."""
     return worst / through if through > 0 else (0.0 if worst == 0 else float("inf"))
+
+
+def _names_of(label, values) -> list:
+    """Node or tube names given as a sequence or an array, as a list of plain Python objects."""
+    if isinstance(values, np.ndarray):
+        if values.ndim != 1:
+            raise InvalidParameterError(label, "a 1-D sequence of names", values.shape)
+        return values.tolist()
+    if isinstance(values, (str, bytes)) or not hasattr(values, "__len__"):
+        raise InvalidParameterError(label, "a sequence of names (a list or a 1-D array)", values)
+    values = list(values)
+    for k, x in enumerate(values):
+        if not _hashable(x):
+            raise InvalidParameterError(f"{label}[{k}]", "a hashable name", x)
+    return values
+
+
+def _hashable(x) -> bool:
+    try:
+        hash(x)
+    except TypeError:
+        return False
+    return True
