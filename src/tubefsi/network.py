@@ -253,20 +253,37 @@ class Network:
     @checked_keywords
     def set_pressure(self, node, pressure):
         """Fix the (transmural, gauge) pressure of ``node`` (Pa, >= 0)."""
-        if node in self._inflow:
-            raise InvalidParameterError("node", "a node with a pressure or an inflow, not both", node,
-                                        "it has an inflow already")
+        self._free_of(node, "pressure")
         self._pressure[node] = float(as_array("pressure", pressure, "[0, inf)", lambda a: a >= 0))
         return self
 
     @checked_keywords
     def set_inflow(self, node, flow_rate):
         """Inject ``flow_rate`` (m^3/s; negative: withdraw) at ``node``."""
-        if node in self._pressure:
-            raise InvalidParameterError("node", "a node with a pressure or an inflow, not both", node,
-                                        "it has a fixed pressure already")
+        self._free_of(node, "inflow")
         self._inflow[node] = float(as_array("flow_rate", flow_rate, "(-inf, inf)", np.isfinite))
         return self
+
+    @checked_keywords
+    def set_resistance(self, node, resistance, distal_pressure=0.0):
+        """Make ``node`` a resistance outlet: a terminal resistance ``resistance`` (Pa s/m^3, > 0)
+        to a ``distal_pressure`` (Pa) takes the flow ``(p - distal_pressure) / resistance`` out of
+        the network at ``node`` (the steady state of a Windkessel, whose resistance is R1 + R2).
+        A component with a resistance outlet needs no fixed pressure."""
+        self._free_of(node, "resistance")
+        r = float(as_array("resistance", resistance, "(0, inf) Pa s/m^3", lambda a: np.isfinite(a) & (a > 0)))
+        p_d = float(as_array("distal_pressure", distal_pressure, "the real numbers (Pa)", np.isfinite))
+        self._resistance[node] = (r, p_d)
+        return self
+
+    def _free_of(self, node, kind):
+        """Raise unless ``node`` has no boundary condition but one of ``kind`` (which it replaces)."""
+        for other, store in (("pressure", self._pressure), ("inflow", self._inflow),
+                             ("resistance", self._resistance)):
+            if other != kind and _hashable(node) and node in store:
+                raise InvalidParameterError("node", "a node with one boundary condition: a pressure, an inflow or "
+                                            "a resistance", node, f"it has a {'fixed ' if other == 'pressure' else ''}"
+                                            f"{other} already")
 
     @checked_keywords
     def set_position(self, node, xy):
@@ -289,7 +306,8 @@ class Network:
                       pressure="pressure", inflow="inflow", pos="pos"):
         """A network from a networkx graph whose edges hold a ``wall`` and a ``tube`` attribute
         (and optionally a ``rheology`` attribute, the fluid of that tube); nodes may hold
-        ``pressure``, ``inflow`` and ``pos``. Each keyword names the attribute to read (``fluid``:
+        ``pressure``, ``inflow``, ``pos`` and ``resistance`` (with ``distal_pressure``, default 0: a
+        resistance outlet, :meth:`set_resistance`). Each keyword names the attribute to read (``fluid``:
         the edge attribute holding a tube's rheology, ``"rheology"`` by default).
 
         Edges run from the first node to the second as networkx lists them; a multigraph's
@@ -309,6 +327,8 @@ class Network:
                 net.set_pressure(node, data[pressure])
             if inflow in data:
                 net.set_inflow(node, data[inflow])
+            if "resistance" in data:
+                net.set_resistance(node, data["resistance"], data.get("distal_pressure", 0.0))
             if pos in data:
                 net.set_position(node, data[pos])
         return net
@@ -325,6 +345,8 @@ class Network:
                 data["pressure"] = self._pressure[node]
             if node in self._inflow:
                 data["inflow"] = self._inflow[node]
+            if node in self._resistance:
+                data["resistance"], data["distal_pressure"] = self._resistance[node]
             if node in self.positions:
                 data["pos"] = self.positions[node]
             graph.add_node(node, **data)
@@ -532,9 +554,9 @@ class _Solver:
     def __init__(self, net: Network):
         if not net._tubes:
             raise InvalidParameterError("network", "at least one tube", 0)
-        for node in list(net._pressure) + list(net._inflow):
+        for node in list(net._pressure) + list(net._inflow) + list(net._resistance):
             if node not in net._nodes:
-                raise InvalidParameterError("node", "a node of some tube", node, "it has a pressure or an inflow "
+                raise InvalidParameterError("node", "a node of some tube", node, "it has a boundary condition "
                                             "but no tube")
         self.net = net
         self.tubes = list(net._tubes.values())
@@ -550,6 +572,11 @@ class _Solver:
         self.source = np.zeros(n_nodes)
         for node, s in net._inflow.items():
             self.source[index[node]] = s
+        # resistance outlets: q = g (p - p_d) leaves node i, g = 1/R (0 elsewhere)
+        self.g_out = np.zeros(n_nodes)
+        self.p_distal = np.zeros(n_nodes)
+        for node, (r, p_d) in net._resistance.items():
+            self.g_out[index[node]], self.p_distal[index[node]] = 1.0 / r, p_d
         self._check_connected(n_nodes)
         # a feeder: a node with an inflow and one tube; that tube's flow is known, so it is solved
         # flow-controlled after the rest (no pressure unknown near a limit pressure at the inlet)
@@ -579,15 +606,17 @@ class _Solver:
     def _check_connected(self, n):
         graph = sp.coo_matrix((np.ones(self.U.size), (self.U, self.V)), shape=(n, n))
         count, labels = csgraph.connected_components(graph, directed=False)
-        if not np.any(self.fixed):
-            raise InvalidParameterError("network", "at least one node with a fixed pressure", None,
-                                        "set_pressure(node, p) on an outlet")
+        anchor = self.fixed | (self.g_out > 0)
+        if not np.any(anchor):
+            raise InvalidParameterError("network", "at least one node with a fixed pressure or a resistance outlet",
+                                        None, "set_pressure(node, p) or set_resistance(node, R) on an outlet")
         anchored = np.zeros(count, dtype=bool)
-        anchored[labels[self.fixed]] = True
+        anchored[labels[anchor]] = True
         if not np.all(anchored):
             c = int(np.flatnonzero(~anchored)[0])
             members = [self.nodes[i] for i in np.flatnonzero(labels == c)]
-            raise InvalidParameterError("network", "every node connected to a node of fixed pressure",
+            raise InvalidParameterError("network", "every node connected to a fixed pressure or a resistance "
+                                        "outlet",
                                         members[0], f"a component of {len(members)} node(s), disconnected "
                                         f"from every fixed pressure: {members[:5]!r}")
 
@@ -605,19 +634,27 @@ class _Solver:
 
     # ------------------------------------------------------------------ linear algebra
     def _jacobian(self, gu, gv):
-        """dF/dp over the free nodes from dq_e/dp_u = gu, dq_e/dp_v = gv."""
+        """dF/dp over the free nodes from dq_e/dp_u = gu, dq_e/dp_v = gv, and the exact -1/R of
+        each resistance outlet on the diagonal."""
         U, V = self.U, self.V
-        rows = np.concatenate([U, U, V, V])
-        cols = np.concatenate([U, V, U, V])
-        vals = np.concatenate([-gu, -gv, gu, gv])
+        outlets = np.flatnonzero(self.g_out)
+        rows = np.concatenate([U, U, V, V, outlets])
+        cols = np.concatenate([U, V, U, V, outlets])
+        vals = np.concatenate([-gu, -gv, gu, gv, -self.g_out[outlets]])
         keep = self.unknown[rows] & self.unknown[cols]
         m = self.free.size
         return sp.csc_matrix((vals[keep], (self.where[rows[keep]], self.where[cols[keep]])), shape=(m, m))
 
-    def _balance(self, q):
-        """Net inflow at every node: sum of q into it - sum out of it + injection."""
+    def _balance(self, q, p):
+        """Net inflow at every node: sum of q into it - sum out of it + injection + what a
+        resistance outlet supplies, (p_d - p)/R."""
         n = len(self.nodes)
-        return (np.bincount(self.V, q, n) - np.bincount(self.U, q, n)) + self.source
+        return (np.bincount(self.V, q, n) - np.bincount(self.U, q, n)) + self._supplied(p)
+
+    def _supplied(self, p):
+        """What the boundary supplies at the nodes without a fixed pressure: the injections and the
+        resistance outlets' flows (negative where they take flow out)."""
+        return self.source + self.g_out * (self.p_distal - p)
 
     def _rigid_start(self):
         """Pressures of the rigid Newtonian network (apparent viscosities, three Picard sweeps)."""
@@ -629,7 +666,7 @@ class _Solver:
         p = self.p_fixed.copy()
         for sweep in range(4):
             c = math.pi * a**4 / (8 * mu * length)
-            rhs = self.source.copy()
+            rhs = self._supplied(np.zeros_like(p))
             # K p = s with K the weighted Laplacian; move the fixed columns to the right
             known = np.where(self.fixed, self.p_fixed, 0.0)
             flow = c * (known[self.U] - known[self.V])
@@ -718,10 +755,10 @@ class _Solver:
                 p[free] *= 0.5
         else:
             q, gu, gv, r_u, r_v = self._edges(p)
-        balance = self._balance(q)
+        balance = self._balance(q, p)
         for iteration in range(max_iterations + 1):
             F = balance[free]
-            through = self._throughput(balance)
+            through = self._throughput(balance, p)
             worst = float(np.max(np.abs(F), initial=0.0))
             if worst <= rtol * through or through == 0.0 and worst == 0.0:
                 return self._result(p, q, r_u, r_v, iteration, worst / through if through else 0.0)
@@ -740,7 +777,7 @@ class _Solver:
                 except NoSteadyStateError:    # beyond what a wall law reaches (a peak): shorter
                     t_balance = None
                 else:
-                    t_balance = self._balance(t_q)
+                    t_balance = self._balance(t_q, trial)
                 if t_balance is not None and np.linalg.norm(t_balance[free]) <= (1 - 1e-4 * alpha) * norm:
                     break
                 alpha *= 0.5
@@ -784,12 +821,15 @@ class _Solver:
         """Per free node, the mass imbalance that rounding alone leaves: the pressures' rounding
         through the tubes' conductances plus the flows' own relative accuracy (~1e-14)."""
         n = len(self.nodes)
-        per_tube = 4 * np.finfo(float).eps * (np.abs(gu * p[self.U]) + np.abs(gv * p[self.V])) + 1e-14 * np.abs(q)
-        return (np.bincount(self.U, per_tube, n) + np.bincount(self.V, per_tube, n))[self.free]
+        eps = np.finfo(float).eps
+        per_tube = 4 * eps * (np.abs(gu * p[self.U]) + np.abs(gv * p[self.V])) + 1e-14 * np.abs(q)
+        per_outlet = 4 * eps * self.g_out * (np.abs(p) + np.abs(self.p_distal))
+        return (np.bincount(self.U, per_tube, n) + np.bincount(self.V, per_tube, n) + per_outlet)[self.free]
 
-    def _throughput(self, balance):
-        """The flow that enters the network: injections plus what the fixed nodes supply."""
-        supplied = np.where(self.fixed, -balance, self.source)
+    def _throughput(self, balance, p):
+        """The flow that enters the network: injections plus what the fixed nodes and the
+        resistance outlets supply."""
+        supplied = np.where(self.fixed, -balance, self._supplied(p))
         return float(np.sum(np.maximum(supplied, 0.0)))
 
     def _to_bound(self, p, step):
