@@ -358,8 +358,13 @@ class Network:
 
     # ------------------------------------------------------------------ solving
     @checked_keywords
-    def solve(self, *, rtol=1e-13, max_iterations=100, progress=False) -> NetworkSolution:
+    def solve(self, *, rtol=1e-13, max_iterations=100, progress=False, initial=None) -> NetworkSolution:
         """The steady state: node pressures and tube flow rates (a :class:`NetworkSolution`).
+
+        ``initial`` (a :class:`NetworkSolution`, e.g. the previous point of a sweep, or a mapping
+        node -> pressure in Pa) starts Newton's method from those pressures at the nodes it
+        names (the rigid start elsewhere): a warm start, which changes the iterations taken,
+        not the answer.
 
         ``progress`` (bool or ``"auto"``) shows a progress bar over the Newton iterations (tqdm,
         ``pip install 'tubefsi[progress]'``; ``"auto"``: only if tqdm is installed and standard
@@ -384,10 +389,11 @@ class Network:
         rtol = float(as_array("rtol", rtol, "[1e-15, 1)", lambda a: (a >= 1e-15) & (a < 1)))
         if isinstance(max_iterations, bool) or not isinstance(max_iterations, int) or max_iterations < 1:
             raise InvalidParameterError("max_iterations", "the integers >= 1", max_iterations)
+        start = _initial_pressures(initial)
         solver = _Solver(self._snapshot())
         shown = bar(max_iterations, progress, "tubefsi.Network.solve", unit="Newton step")
         try:
-            return solver.run(rtol, max_iterations, shown)
+            return solver.run(rtol, max_iterations, shown, start)
         finally:
             shown.close()
 
@@ -741,10 +747,16 @@ class _Solver:
                                    f"rate at pressure drop {drop[i]:.6g} Pa, outlet pressure {outlet[i]:.6g} Pa")
         return q, d_in, d_out
 
-    def run(self, rtol, max_iterations, shown=None):
+    def run(self, rtol, max_iterations, shown=None, start=None):
         p, c = self._rigid_start()
         self.c = c
         free = self.free
+        if start:                      # a warm start: the given pressures at the free nodes they name
+            index = self.net._nodes
+            for node, value in start.items():
+                i = index.get(node) if _hashable(node) else None
+                if i is not None and not self.fixed[i]:
+                    p[i] = value
         room = np.where(np.isfinite(self.p_limit), self.p_limit, np.inf)
         p[free] = np.clip(p[free], 0.0, np.where(np.isfinite(room[free]), _TO_BOUND * room[free], np.inf))
         for _ in range(60):            # a start beyond what a wall law reaches: halve it
@@ -873,6 +885,20 @@ _WORST_ROUNDED = 1e-6
 def _share(worst, through) -> float:
     """The imbalance as a share of the throughput (inf where nothing flows but something should)."""
     return worst / through if through > 0 else (0.0 if worst == 0 else float("inf"))
+
+
+def _initial_pressures(initial):
+    """A warm start as a dict node -> pressure (None: the rigid start)."""
+    if initial is None:
+        return None
+    if isinstance(initial, NetworkSolution):
+        return initial.pressure
+    if not hasattr(initial, "items"):
+        raise InvalidParameterError("initial", "a NetworkSolution or a mapping node -> pressure (Pa)", initial)
+    start = {}
+    for node, value in initial.items():
+        start[node] = float(as_array(f"initial[{node!r}]", value, "[0, inf) Pa", lambda a: np.isfinite(a) & (a >= 0)))
+    return start
 
 
 def _names_of(label, values) -> list:
