@@ -6,9 +6,10 @@ higher-pressure end, so that the edge law is odd in :math:`p_u - p_v`:
 :math:`Q_e = \operatorname{sign}(p_u - p_v)\,Q(|p_u - p_v|;\ \min(p_u, p_v))`. At every node
 without a fixed pressure Kirchhoff's law holds,
 
-.. math::  F_i(p) = \sum_{e:\,v_e = i} q_e - \sum_{e:\,u_e = i} q_e + s_i = 0,
+.. math::  F_i(p) = \sum_{e:\,v_e = i} q_e - \sum_{e:\,u_e = i} q_e + s_i + (p_{d,i} - p_i)/R_i = 0,
 
-with :math:`s_i` the injected flow rate. The free pressures solve :math:`F = 0` by Newton's
+with :math:`s_i` the injected flow rate and, at a resistance outlet, :math:`R_i` its terminal
+resistance to the distal pressure :math:`p_{d,i}` (the term is absent elsewhere). The free pressures solve :math:`F = 0` by Newton's
 method: the Jacobian is assembled from the analytic derivatives :math:`\partial q/\partial p_{in}`
 and :math:`\partial q/\partial p_{out}` of each tube (``docs/theory.md``, section
 "Sensitivities") and factorized by :func:`scipy.sparse.linalg.splu`. Every tube of a network is
