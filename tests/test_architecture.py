@@ -26,7 +26,7 @@ LAYERS = [
     {"tubefsi.couplers"},
     {"tubefsi.solution", "tubefsi.validity", "tubefsi.export"},
     {"tubefsi.solve"},
-    {"tubefsi.advise", "tubefsi.fit", "tubefsi.dimensionless", "tubefsi.network"},
+    {"tubefsi.advise", "tubefsi.fit", "tubefsi.dimensionless", "tubefsi.network", "tubefsi.network_solution"},
     {"tubefsi.fem"},
     {"tubefsi.chapter", "tubefsi.plotting"},
     {"tubefsi.cli", "tubefsi.testing", "tubefsi"},
@@ -37,7 +37,7 @@ ACCESSORS = {
     ("tubefsi.walls.base", "tubefsi.plotting"),       # WallModel.plot
     ("tubefsi.solution", "tubefsi.plotting"),         # Solution.plot
     ("tubefsi.solution", "tubefsi.advise"),           # Solution.diagnostics
-    ("tubefsi.network", "tubefsi.plotting"),          # NetworkSolution.plot
+    ("tubefsi.network_solution", "tubefsi.plotting"),  # NetworkSolution.plot
 }
 
 

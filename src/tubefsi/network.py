@@ -6,9 +6,10 @@ higher-pressure end, so that the edge law is odd in :math:`p_u - p_v`:
 :math:`Q_e = \operatorname{sign}(p_u - p_v)\,Q(|p_u - p_v|;\ \min(p_u, p_v))`. At every node
 without a fixed pressure Kirchhoff's law holds,
 
-.. math::  F_i(p) = \sum_{e:\,v_e = i} q_e - \sum_{e:\,u_e = i} q_e + s_i = 0,
+.. math::  F_i(p) = \sum_{e:\,v_e = i} q_e - \sum_{e:\,u_e = i} q_e + s_i + (p_{d,i} - p_i)/R_i = 0,
 
-with :math:`s_i` the injected flow rate. The free pressures solve :math:`F = 0` by Newton's
+with :math:`s_i` the injected flow rate and, at a resistance outlet, :math:`R_i` its terminal
+resistance to the distal pressure :math:`p_{d,i}` (the term is absent elsewhere). The free pressures solve :math:`F = 0` by Newton's
 method: the Jacobian is assembled from the analytic derivatives :math:`\partial q/\partial p_{in}`
 and :math:`\partial q/\partial p_{out}` of each tube (``docs/theory.md``, section
 "Sensitivities") and factorized by :func:`scipy.sparse.linalg.splu`. Every tube of a network is
@@ -41,10 +42,7 @@ throughput (the total flow that enters the network); otherwise :class:`Convergen
 from __future__ import annotations
 
 import copy
-import csv
-import json
 import math
-import os
 from collections.abc import Hashable
 
 import attrs
@@ -53,20 +51,19 @@ import scipy.sparse as sp
 from scipy.sparse import csgraph
 from scipy.sparse import linalg as spla
 
-from . import _html
 from ._keywords import checked_keywords
 from ._progress import bar
 from ._validation import as_array
 from . import validity
 from .errors import (AccuracyWarning, ConvergenceError, InvalidParameterError, NoSteadyStateError, warn_user)
-from .fields import varies, _array_fields, parameter_shape
+from .fields import broadcast_model, varies, _array_fields, parameter_shape
 from .geometry import Tube
+from .network_solution import NetworkSolution
 from .rheology.base import Rheology
-from .walls.base import WallModel
 from .scene import make_scene, resolve
-from .solution import Solution
 from .solve import max_flow_rate as tubefsi_max_flow
-from .solve import solve, solve_unchecked
+from .solve import solve_unchecked
+from .walls.base import WallModel
 
 __all__ = ["Network", "NetworkSolution"]
 
@@ -84,6 +81,10 @@ _AT_BOUND = 1e-12
 
 @attrs.define(eq=False)
 class _Tube:
+    """One tube. ``row`` is None for a tube of :meth:`Network.add_tube`; for a tube of
+    :meth:`Network.add_tubes` it is the tube's entry in the flat (1-D) array parameters of the
+    models it shares with the other tubes of that call."""
+
     name: object
     u: object
     v: object
@@ -91,6 +92,19 @@ class _Tube:
     tube: Tube
     rheology: object
     external_pressure: float = 0.0
+    row: object = None
+
+    def models(self):
+        """This tube's wall, tube and fluid, each with scalar parameters."""
+        if self.row is None:
+            return self.wall, self.tube, self.rheology
+        return tuple(_entry(m, self.row) for m in (self.wall, self.tube, self.rheology))
+
+
+def _entry(model, row):
+    """``model`` with its flat array parameters taken at ``row`` (validated scalars)."""
+    arrays = {f: float(v[row]) for f in _array_fields(type(model)) if isinstance(v := getattr(model, f), np.ndarray)}
+    return attrs.evolve(model, **arrays) if arrays else model
 
 
 class Network:
@@ -123,6 +137,8 @@ class Network:
         self._nodes: dict = {}
         self._pressure: dict = {}
         self._inflow: dict = {}
+        #: node -> (resistance, distal pressure) of a resistance outlet
+        self._resistance: dict = {}
         #: node -> (x, y), for :meth:`NetworkSolution.plot`
         self.positions: dict = {}
 
@@ -167,22 +183,115 @@ class Network:
         return self
 
     @checked_keywords
+    def add_tubes(self, u, v, wall, tube, *, names=None, rheology=None, external_pressure=0.0):
+        """Add ``n`` tubes at once, from node ``u[k]`` to node ``v[k]`` (sequences or arrays of
+        node names of length ``n``), as :meth:`add_tube` does for one.
+
+        ``wall``, ``tube`` and ``rheology`` are one model each whose parameters are scalars
+        (shared by every tube) or arrays of length ``n`` (one entry per tube), e.g.
+        ``Tube(radius=radii, thickness=0.3 * radii, length=lengths)``; ``external_pressure`` is a
+        number or an array of length ``n``; ``names`` (default ``(u[k], v[k])``) a sequence of
+        ``n`` distinct names. Everything is checked before any tube is added. Building from
+        arrays costs a fraction of calling :meth:`add_tube` per tube (``docs/network.md``).
+        """
+        u, v = _names_of("u", u), _names_of("v", v)
+        n = len(u)
+        if n == 0 or len(v) != n:
+            raise InvalidParameterError("v", f"a sequence as long as u ({n} >= 1 node names)", len(v))
+        names = [(a, b) for a, b in zip(u, v)] if names is None else _names_of("names", names)
+        if len(names) != n:
+            raise InvalidParameterError("names", f"{n} names, one per tube", len(names))
+        for k, (a, b) in enumerate(zip(u, v)):
+            if a == b:
+                raise InvalidParameterError(f"v[{k}]", "a node other than u[k]", b, "a tube joins two distinct nodes")
+        taken = self._tubes.keys()
+        seen = set()
+        for k, name in enumerate(names):
+            if name in taken or name in seen:
+                raise InvalidParameterError(f"names[{k}]", "a name no other tube has", name,
+                                            "tubes between the same two nodes need distinct names")
+            seen.add(name)
+        wall = resolve("wall", wall)
+        fluid = self.rheology if rheology is None else resolve("rheology", rheology)
+        if fluid is None:
+            raise InvalidParameterError("rheology", "a fluid, here or in Network(rheology=...)", None)
+        if not isinstance(tube, Tube):
+            raise InvalidParameterError("tube", "a tubefsi.Tube", tube)
+        models = []
+        for label, model in (("wall", wall), ("tube", tube), ("rheology", fluid)):
+            if parameter_shape(model) not in ((), (n,)):
+                raise InvalidParameterError(label, f"scalar parameters or arrays of length {n} (one entry per "
+                                            f"tube)", model, f"its parameters have the shape {parameter_shape(model)}")
+            if varies(model):
+                raise InvalidParameterError(label, "a uniform tube and wall (a network takes no tube that varies "
+                                            "along z)", model)
+            models.append(broadcast_model(model, (n,)))
+        wall, tube, fluid = models
+        p_e = as_array("external_pressure", external_pressure, "the real numbers", np.isfinite)
+        if p_e.shape not in ((), (n,)):
+            raise InvalidParameterError("external_pressure", f"a number or an array of length {n}", p_e.shape)
+        p_e = np.broadcast_to(p_e.astype(float), (n,)).tolist()
+        shared = parameter_shape(wall) == parameter_shape(tube) == parameter_shape(fluid) == ()
+        for node in u + v:
+            self._nodes.setdefault(node, len(self._nodes))
+        tubes = self._tubes
+        for k in range(n):
+            tubes[names[k]] = _Tube(names[k], u[k], v[k], wall, tube, fluid, p_e[k], None if shared else k)
+        return self
+
+    @checked_keywords
+    def remove_tube(self, name):
+        """Remove tube ``name``. A node left without a tube leaves the network with its
+        boundary condition and position."""
+        t = self._tubes.pop(name, None) if _hashable(name) else None
+        if t is None:
+            raise InvalidParameterError("name", "the name of a tube of the network", name)
+        used = set()
+        for other in self._tubes.values():
+            used.add(other.u)
+            used.add(other.v)
+        gone = [node for node in (t.u, t.v) if node not in used]
+        if gone:
+            for node in gone:
+                for store in (self._pressure, self._inflow, self._resistance, self.positions):
+                    store.pop(node, None)
+            self._nodes = {node: i for i, node in enumerate(k for k in self._nodes if k not in gone)}
+        return self
+
+    @checked_keywords
     def set_pressure(self, node: Hashable, pressure: float) -> Network:
         """Fix the (transmural, gauge) pressure of ``node`` (Pa, >= 0)."""
-        if node in self._inflow:
-            raise InvalidParameterError("node", "a node with a pressure or an inflow, not both", node,
-                                        "it has an inflow already")
+        self._free_of(node, "pressure")
         self._pressure[node] = float(as_array("pressure", pressure, "[0, inf)", lambda a: a >= 0))
         return self
 
     @checked_keywords
     def set_inflow(self, node: Hashable, flow_rate: float) -> Network:
         """Inject ``flow_rate`` (m^3/s; negative: withdraw) at ``node``."""
-        if node in self._pressure:
-            raise InvalidParameterError("node", "a node with a pressure or an inflow, not both", node,
-                                        "it has a fixed pressure already")
+        self._free_of(node, "inflow")
         self._inflow[node] = float(as_array("flow_rate", flow_rate, "(-inf, inf)", np.isfinite))
         return self
+
+    @checked_keywords
+    def set_resistance(self, node, resistance, distal_pressure=0.0):
+        """Make ``node`` a resistance outlet: a terminal resistance ``resistance`` (Pa s/m^3, > 0)
+        to a ``distal_pressure`` (Pa) takes the flow ``(p - distal_pressure) / resistance`` out of
+        the network at ``node`` (the steady state of a Windkessel, whose resistance is R1 + R2).
+        A component with a resistance outlet needs no fixed pressure."""
+        self._free_of(node, "resistance")
+        r = float(as_array("resistance", resistance, "(0, inf) Pa s/m^3", lambda a: np.isfinite(a) & (a > 0)))
+        p_d = float(as_array("distal_pressure", distal_pressure, "the real numbers (Pa)", np.isfinite))
+        self._resistance[node] = (r, p_d)
+        return self
+
+    def _free_of(self, node, kind):
+        """Raise unless ``node`` has no boundary condition but one of ``kind`` (which it replaces)."""
+        for other, store in (("pressure", self._pressure), ("inflow", self._inflow),
+                             ("resistance", self._resistance)):
+            if other != kind and _hashable(node) and node in store:
+                raise InvalidParameterError("node", "a node with one boundary condition: a pressure, an inflow or "
+                                            "a resistance", node, f"it has a {'fixed ' if other == 'pressure' else ''}"
+                                            f"{other} already")
 
     @checked_keywords
     def set_position(self, node: Hashable, xy: tuple[float, float]) -> Network:
@@ -205,7 +314,8 @@ class Network:
                       pressure="pressure", inflow="inflow", pos="pos"):
         """A network from a networkx graph whose edges hold a ``wall`` and a ``tube`` attribute
         (and optionally a ``rheology`` attribute, the fluid of that tube); nodes may hold
-        ``pressure``, ``inflow`` and ``pos``. Each keyword names the attribute to read (``fluid``:
+        ``pressure``, ``inflow``, ``pos`` and ``resistance`` (with ``distal_pressure``, default 0: a
+        resistance outlet, :meth:`set_resistance`). Each keyword names the attribute to read (``fluid``:
         the edge attribute holding a tube's rheology, ``"rheology"`` by default).
 
         Edges run from the first node to the second as networkx lists them; a multigraph's
@@ -225,6 +335,8 @@ class Network:
                 net.set_pressure(node, data[pressure])
             if inflow in data:
                 net.set_inflow(node, data[inflow])
+            if "resistance" in data:
+                net.set_resistance(node, data["resistance"], data.get("distal_pressure", 0.0))
             if pos in data:
                 net.set_position(node, data[pos])
         return net
@@ -241,18 +353,27 @@ class Network:
                 data["pressure"] = self._pressure[node]
             if node in self._inflow:
                 data["inflow"] = self._inflow[node]
+            if node in self._resistance:
+                data["resistance"], data["distal_pressure"] = self._resistance[node]
             if node in self.positions:
                 data["pos"] = self.positions[node]
             graph.add_node(node, **data)
         for t in self._tubes.values():
-            graph.add_edge(t.u, t.v, key=t.name, wall=t.wall, tube=t.tube, rheology=t.rheology,
+            wall, tube, fluid = t.models()
+            graph.add_edge(t.u, t.v, key=t.name, wall=wall, tube=tube, rheology=fluid,
                            external_pressure=t.external_pressure)
         return graph
 
     # ------------------------------------------------------------------ solving
     @checked_keywords
-    def solve(self, *, rtol: float = 1e-13, max_iterations: int = 100, progress: bool | str = False) -> NetworkSolution:
+    def solve(self, *, rtol: float = 1e-13, max_iterations: int = 100, progress: bool | str = False,
+              initial: NetworkSolution | dict | None = None) -> NetworkSolution:
         """The steady state: node pressures and tube flow rates (a :class:`NetworkSolution`).
+
+        ``initial`` (a :class:`NetworkSolution`, e.g. the previous point of a sweep, or a mapping
+        node -> pressure in Pa) starts Newton's method from those pressures at the nodes it
+        names (the rigid start elsewhere): a warm start, which changes the iterations taken,
+        not the answer.
 
         ``progress`` (bool or ``"auto"``) shows a progress bar over the Newton iterations (tqdm,
         ``pip install 'tubefsi[progress]'``; ``"auto"``: only if tqdm is installed and standard
@@ -277,17 +398,18 @@ class Network:
         rtol = float(as_array("rtol", rtol, "[1e-15, 1)", lambda a: (a >= 1e-15) & (a < 1)))
         if isinstance(max_iterations, bool) or not isinstance(max_iterations, int) or max_iterations < 1:
             raise InvalidParameterError("max_iterations", "the integers >= 1", max_iterations)
+        start = _initial_pressures(initial)
         solver = _Solver(self._snapshot())
         shown = bar(max_iterations, progress, "tubefsi.Network.solve", unit="Newton step")
         try:
-            return solver.run(rtol, max_iterations, shown)
+            return solver.run(rtol, max_iterations, shown, start)
         finally:
             shown.close()
 
     def _snapshot(self):
         """A copy that later changes to this network do not reach (the solution keeps it)."""
         new = copy.copy(self)
-        for name in ("_tubes", "_nodes", "_pressure", "_inflow", "positions"):
+        for name in ("_tubes", "_nodes", "_pressure", "_inflow", "_resistance", "positions"):
             setattr(new, name, dict(getattr(self, name)))
         return new
 
@@ -298,28 +420,35 @@ class _Groups:
 
     def __init__(self, tubes, subset):
         groups: dict = {}
+        keys: dict = {}               # id(model) -> its class and non-array parameters
         self.external = []            # per part: the external pressure of its tubes (float or array)
         for i, t in enumerate(tubes):
             if not subset[i]:
                 continue
-            key = (type(t.wall), _fixed(t.wall), type(t.rheology), _fixed(t.rheology))
-            groups.setdefault(key, []).append(i)
+            wall, fluid = t.wall, t.rheology
+            if id(wall) not in keys:
+                keys[id(wall)] = (type(wall), _fixed(wall))
+            if id(fluid) not in keys:
+                keys[id(fluid)] = (type(fluid), _fixed(fluid))
+            groups.setdefault((keys[id(wall)], keys[id(fluid)]), []).append(i)
         self.parts = []
         for index in groups.values():
             members = [tubes[i] for i in index]
-            wall = _stack([m.wall for m in members])
-            fluid = _stack([m.rheology for m in members])
-            tube = Tube(**{f: _column([getattr(m.tube, f) for m in members]) for f in ("radius", "thickness", "length")})
+            wall = _stack(members, "wall")
+            fluid = _stack(members, "rheology")
+            tube = Tube(**_gather(members, "tube", ("radius", "thickness", "length")))
             self.parts.append((np.asarray(index), fluid, wall, tube))
             self.external.append(_column([m.external_pressure for m in members]))
         n = len(tubes)
         self.limit = np.zeros(n)
         self.radius = np.zeros(n)
+        self.length = np.zeros(n)
         for (index, fluid, wall, tube), p_e in zip(self.parts, self.external):
             # the node (gauge) pressure at which the transmural one reaches the limit pressure
             self.limit[index] = np.broadcast_to(wall.limit_pressure(tube.reduced_thickness) + np.asarray(p_e),
                                                 index.shape)
             self.radius[index] = np.broadcast_to(tube.radius, index.shape)
+            self.length[index] = np.broadcast_to(tube.length, index.shape)
 
     def evaluate(self, drop, outlet):
         """Flow rates and the derivatives by the inlet and outlet pressures of the tubes (pressure-
@@ -407,22 +536,42 @@ def _column(values):
     return float(a[0]) if np.all(a == a[0]) else a
 
 
-def _stack(models):
+def _gather(members, which, fields) -> dict:
+    """field -> the members' values of that parameter of their ``which`` model (a float where all
+    agree, else an array aligned with ``members``). Tubes added together by
+    :meth:`Network.add_tubes` share one model: their entries are taken at their rows, in one
+    indexing per model rather than one lookup per tube."""
+    by_model: dict = {}
+    for j, m in enumerate(members):
+        model = getattr(m, which)
+        entry = by_model.get(id(model))
+        if entry is None:
+            entry = by_model[id(model)] = (model, [], [])
+        entry[1].append(j)
+        entry[2].append(m.row)
+    out = {f: np.empty(len(members)) for f in fields}
+    for model, positions, rows in by_model.values():
+        for f in fields:
+            value = getattr(model, f)
+            out[f][positions] = value[rows] if isinstance(value, np.ndarray) and value.ndim else value
+    return {f: _column(column) for f, column in out.items()}
+
+
+def _stack(members, which):
     """One model whose array parameters hold the members' values (a scalar where all agree)."""
-    first = models[0]
-    if len(models) == 1 or all(m is first for m in models):
+    first = getattr(members[0], which)
+    if all(getattr(m, which) is first and m.row is None for m in members):
         return first
-    arrays = {f: _column([getattr(m, f) for m in models]) for f in _array_fields(type(first))}
-    return attrs.evolve(first, **arrays)
+    return attrs.evolve(first, **_gather(members, which, _array_fields(type(first))))
 
 
 class _Solver:
     def __init__(self, net: Network):
         if not net._tubes:
             raise InvalidParameterError("network", "at least one tube", 0)
-        for node in list(net._pressure) + list(net._inflow):
+        for node in list(net._pressure) + list(net._inflow) + list(net._resistance):
             if node not in net._nodes:
-                raise InvalidParameterError("node", "a node of some tube", node, "it has a pressure or an inflow "
+                raise InvalidParameterError("node", "a node of some tube", node, "it has a boundary condition "
                                             "but no tube")
         self.net = net
         self.tubes = list(net._tubes.values())
@@ -438,6 +587,11 @@ class _Solver:
         self.source = np.zeros(n_nodes)
         for node, s in net._inflow.items():
             self.source[index[node]] = s
+        # resistance outlets: q = g (p - p_d) leaves node i, g = 1/R (0 elsewhere)
+        self.g_out = np.zeros(n_nodes)
+        self.p_distal = np.zeros(n_nodes)
+        for node, (r, p_d) in net._resistance.items():
+            self.g_out[index[node]], self.p_distal[index[node]] = 1.0 / r, p_d
         self._check_connected(n_nodes)
         # a feeder: a node with an inflow and one tube; that tube's flow is known, so it is solved
         # flow-controlled after the rest (no pressure unknown near a limit pressure at the inlet)
@@ -450,6 +604,7 @@ class _Solver:
         self.feed_groups = _Groups(self.tubes, self.feeder)
         self.limit = np.where(self.feeder, self.feed_groups.limit, self.groups.limit)
         self.radius = np.where(self.feeder, self.feed_groups.radius, self.groups.radius)
+        self.length = np.where(self.feeder, self.feed_groups.length, self.groups.length)
         # a node's bound: the smallest limit pressure of its tubes (an inlet must stay below it)
         self.p_limit = np.full(n_nodes, np.inf)
         np.minimum.at(self.p_limit, self.U, self.limit)
@@ -466,15 +621,17 @@ class _Solver:
     def _check_connected(self, n):
         graph = sp.coo_matrix((np.ones(self.U.size), (self.U, self.V)), shape=(n, n))
         count, labels = csgraph.connected_components(graph, directed=False)
-        if not np.any(self.fixed):
-            raise InvalidParameterError("network", "at least one node with a fixed pressure", None,
-                                        "set_pressure(node, p) on an outlet")
+        anchor = self.fixed | (self.g_out > 0)
+        if not np.any(anchor):
+            raise InvalidParameterError("network", "at least one node with a fixed pressure or a resistance outlet",
+                                        None, "set_pressure(node, p) or set_resistance(node, R) on an outlet")
         anchored = np.zeros(count, dtype=bool)
-        anchored[labels[self.fixed]] = True
+        anchored[labels[anchor]] = True
         if not np.all(anchored):
             c = int(np.flatnonzero(~anchored)[0])
             members = [self.nodes[i] for i in np.flatnonzero(labels == c)]
-            raise InvalidParameterError("network", "every node connected to a node of fixed pressure",
+            raise InvalidParameterError("network", "every node connected to a fixed pressure or a resistance "
+                                        "outlet",
                                         members[0], f"a component of {len(members)} node(s), disconnected "
                                         f"from every fixed pressure: {members[:5]!r}")
 
@@ -492,24 +649,31 @@ class _Solver:
 
     # ------------------------------------------------------------------ linear algebra
     def _jacobian(self, gu, gv):
-        """dF/dp over the free nodes from dq_e/dp_u = gu, dq_e/dp_v = gv."""
+        """dF/dp over the free nodes from dq_e/dp_u = gu, dq_e/dp_v = gv, and the exact -1/R of
+        each resistance outlet on the diagonal."""
         U, V = self.U, self.V
-        rows = np.concatenate([U, U, V, V])
-        cols = np.concatenate([U, V, U, V])
-        vals = np.concatenate([-gu, -gv, gu, gv])
+        outlets = np.flatnonzero(self.g_out)
+        rows = np.concatenate([U, U, V, V, outlets])
+        cols = np.concatenate([U, V, U, V, outlets])
+        vals = np.concatenate([-gu, -gv, gu, gv, -self.g_out[outlets]])
         keep = self.unknown[rows] & self.unknown[cols]
         m = self.free.size
         return sp.csc_matrix((vals[keep], (self.where[rows[keep]], self.where[cols[keep]])), shape=(m, m))
 
-    def _balance(self, q):
-        """Net inflow at every node: sum of q into it - sum out of it + injection."""
+    def _balance(self, q, p):
+        """Net inflow at every node: sum of q into it - sum out of it + injection + what a
+        resistance outlet supplies, (p_d - p)/R."""
         n = len(self.nodes)
-        return (np.bincount(self.V, q, n) - np.bincount(self.U, q, n)) + self.source
+        return (np.bincount(self.V, q, n) - np.bincount(self.U, q, n)) + self._supplied(p)
+
+    def _supplied(self, p):
+        """What the boundary supplies at the nodes without a fixed pressure: the injections and the
+        resistance outlets' flows (negative where they take flow out)."""
+        return self.source + self.g_out * (self.p_distal - p)
 
     def _rigid_start(self):
         """Pressures of the rigid Newtonian network (apparent viscosities, three Picard sweeps)."""
-        a = self.radius
-        length = np.array([t.tube.length for t in self.tubes])
+        a, length = self.radius, self.length
         mu = np.where(self.feeder, self.feed_groups.nominal_viscosity(self.n_tubes),
                       self.groups.nominal_viscosity(self.n_tubes))
         good = np.isfinite(mu) & (mu > 0)
@@ -517,7 +681,7 @@ class _Solver:
         p = self.p_fixed.copy()
         for sweep in range(4):
             c = math.pi * a**4 / (8 * mu * length)
-            rhs = self.source.copy()
+            rhs = self._supplied(np.zeros_like(p))
             # K p = s with K the weighted Laplacian; move the fixed columns to the right
             known = np.where(self.fixed, self.p_fixed, 0.0)
             flow = c * (known[self.U] - known[self.V])
@@ -592,10 +756,16 @@ class _Solver:
                                    f"rate at pressure drop {drop[i]:.6g} Pa, outlet pressure {outlet[i]:.6g} Pa")
         return q, d_in, d_out
 
-    def run(self, rtol, max_iterations, shown=None):
+    def run(self, rtol, max_iterations, shown=None, start=None):
         p, c = self._rigid_start()
         self.c = c
         free = self.free
+        if start:                      # a warm start: the given pressures at the free nodes they name
+            index = self.net._nodes
+            for node, value in start.items():
+                i = index.get(node) if _hashable(node) else None
+                if i is not None and not self.fixed[i]:
+                    p[i] = value
         room = np.where(np.isfinite(self.p_limit), self.p_limit, np.inf)
         p[free] = np.clip(p[free], 0.0, np.where(np.isfinite(room[free]), _TO_BOUND * room[free], np.inf))
         for _ in range(60):            # a start beyond what a wall law reaches: halve it
@@ -606,10 +776,10 @@ class _Solver:
                 p[free] *= 0.5
         else:
             q, gu, gv, r_u, r_v = self._edges(p)
-        balance = self._balance(q)
+        balance = self._balance(q, p)
         for iteration in range(max_iterations + 1):
             F = balance[free]
-            through = self._throughput(balance)
+            through = self._throughput(balance, p)
             worst = float(np.max(np.abs(F), initial=0.0))
             if worst <= rtol * through or through == 0.0 and worst == 0.0:
                 return self._result(p, q, r_u, r_v, iteration, worst / through if through else 0.0)
@@ -628,7 +798,7 @@ class _Solver:
                 except NoSteadyStateError:    # beyond what a wall law reaches (a peak): shorter
                     t_balance = None
                 else:
-                    t_balance = self._balance(t_q)
+                    t_balance = self._balance(t_q, trial)
                 if t_balance is not None and np.linalg.norm(t_balance[free]) <= (1 - 1e-4 * alpha) * norm:
                     break
                 alpha *= 0.5
@@ -662,19 +832,25 @@ class _Solver:
             r_v = np.where(self.feeder, np.where(at_u, r_out, r_in), r_v)
         for groups in (self.groups, self.feed_groups):
             groups.check(q, r_u, r_v, self.tubes)
+        fluids = tuple((index, fluid) for groups in (self.groups, self.feed_groups)
+                       for index, fluid, _, _ in groups.parts)
         return NetworkSolution(net=self.net, nodes=self.nodes, tubes=self.tubes, p=p, q=q, radius_u=r_u,
-                               radius_v=r_v, iterations=iterations, residual=residual)
+                               radius_v=r_v, iterations=iterations, residual=residual, U=self.U, V=self.V,
+                               radius0=self.radius, length=self.length, fluids=fluids)
 
     def _noise(self, p, q, gu, gv):
         """Per free node, the mass imbalance that rounding alone leaves: the pressures' rounding
         through the tubes' conductances plus the flows' own relative accuracy (~1e-14)."""
         n = len(self.nodes)
-        per_tube = 4 * np.finfo(float).eps * (np.abs(gu * p[self.U]) + np.abs(gv * p[self.V])) + 1e-14 * np.abs(q)
-        return (np.bincount(self.U, per_tube, n) + np.bincount(self.V, per_tube, n))[self.free]
+        eps = np.finfo(float).eps
+        per_tube = 4 * eps * (np.abs(gu * p[self.U]) + np.abs(gv * p[self.V])) + 1e-14 * np.abs(q)
+        per_outlet = 4 * eps * self.g_out * (np.abs(p) + np.abs(self.p_distal))
+        return (np.bincount(self.U, per_tube, n) + np.bincount(self.V, per_tube, n) + per_outlet)[self.free]
 
-    def _throughput(self, balance):
-        """The flow that enters the network: injections plus what the fixed nodes supply."""
-        supplied = np.where(self.fixed, -balance, self.source)
+    def _throughput(self, balance, p):
+        """The flow that enters the network: injections plus what the fixed nodes and the
+        resistance outlets supply."""
+        supplied = np.where(self.fixed, -balance, self._supplied(p))
         return float(np.sum(np.maximum(supplied, 0.0)))
 
     def _to_bound(self, p, step):
@@ -703,132 +879,6 @@ class _Solver:
         return float(frac[i])
 
 
-@attrs.frozen(kw_only=True, repr=False, eq=False)
-class NetworkSolution:
-    """The steady state of a :class:`Network`.
-
-    Attributes
-    ----------
-    pressure : dict
-        node -> pressure (Pa).
-    flow_rate : dict
-        tube name -> flow rate (m^3/s), positive from the tube's ``u`` to its ``v``.
-    iterations : int
-        Newton iterations taken.
-    residual : float
-        The largest mass imbalance of a free node over the throughput.
-    """
-
-    net: Network
-    nodes: list
-    tubes: list
-    p: np.ndarray
-    q: np.ndarray
-    radius_u: np.ndarray
-    radius_v: np.ndarray
-    iterations: int
-    residual: float
-
-    @property
-    def pressure(self) -> dict:
-        return dict(zip(self.nodes, self.p.tolist()))
-
-    @property
-    def flow_rate(self) -> dict:
-        return {t.name: q for t, q in zip(self.tubes, self.q.tolist())}
-
-    @property
-    def tube_names(self) -> list:
-        return [t.name for t in self.tubes]
-
-    @property
-    def pressures(self) -> np.ndarray:
-        """Node pressures (Pa) in the order of :attr:`nodes`."""
-        return self.p.copy()
-
-    @property
-    def flow_rates(self) -> np.ndarray:
-        """Tube flow rates (m^3/s) in the order of :attr:`tube_names`."""
-        return self.q.copy()
-
-    @checked_keywords
-    def solution(self, name: Hashable) -> Solution:
-        """The full single-tube :class:`~tubefsi.Solution` of tube ``name`` (profiles included): its
-        flow rate at its outlet pressure, oriented from its higher-pressure end (``z = 0`` is ``u``
-        if the flow runs u -> v, else ``v``)."""
-        t = self.net._tubes.get(name) if _hashable(name) else None
-        if t is None:
-            raise InvalidParameterError("name", "the name of a tube of the network", name)
-        pu, pv = self.pressure[t.u], self.pressure[t.v]
-        return solve(t.rheology, t.wall, t.tube, flow_rate=abs(self.flow_rate[name]), outlet_pressure=min(pu, pv),
-                     external_pressure=t.external_pressure)
-
-    def node_table(self) -> dict:
-        """Columns ``node``, ``pressure`` (Pa), ``inflow`` (m^3/s, net flow injected; at a fixed
-        node, what the boundary supplies) and ``fixed``."""
-        n = len(self.nodes)
-        U = np.array([self.net._nodes[t.u] for t in self.tubes])
-        V = np.array([self.net._nodes[t.v] for t in self.tubes])
-        injected = np.bincount(U, self.q, n) - np.bincount(V, self.q, n)
-        return {"node": list(self.nodes), "pressure": self.p.tolist(), "inflow": injected.tolist(),
-                "fixed": [node in self.net._pressure for node in self.nodes]}
-
-    def tube_table(self) -> dict:
-        """Columns ``name``, ``u``, ``v``, ``flow_rate`` (m^3/s), ``pressure_u``, ``pressure_v``
-        (Pa), ``radius_u``, ``radius_v`` (deformed inner radii at the two ends, m) and ``length`` (m)."""
-        p = self.pressure
-        return {"name": self.tube_names, "u": [t.u for t in self.tubes], "v": [t.v for t in self.tubes],
-                "flow_rate": self.q.tolist(), "pressure_u": [p[t.u] for t in self.tubes],
-                "pressure_v": [p[t.v] for t in self.tubes], "radius_u": self.radius_u.tolist(),
-                "radius_v": self.radius_v.tolist(), "length": [t.tube.length for t in self.tubes]}
-
-    @checked_keywords
-    def to_csv(self, prefix: str | os.PathLike) -> tuple:
-        """Write ``<prefix>_nodes.csv`` and ``<prefix>_tubes.csv``; returns the two paths."""
-        paths = (f"{prefix}_nodes.csv", f"{prefix}_tubes.csv")
-        for path, table in zip(paths, (self.node_table(), self.tube_table())):
-            with open(path, "w", newline="", encoding="utf-8") as fh:
-                writer = csv.writer(fh)
-                writer.writerow(list(table))
-                for row in zip(*table.values()):
-                    writer.writerow([_text(x) if not isinstance(x, float) else repr(x) for x in row])
-        return paths
-
-    @checked_keywords
-    def to_json(self, path: str | os.PathLike | None = None) -> str:
-        """The node and tube tables as JSON (node and tube names as text); written to ``path`` if given."""
-        data = {"nodes": _records(self.node_table()), "tubes": _records(self.tube_table()),
-                "iterations": self.iterations, "residual": self.residual}
-        text = json.dumps(data, indent=1)
-        if path is not None:
-            with open(path, "w", encoding="utf-8") as fh:
-                fh.write(text)
-        return text
-
-    def plot(self, **kwargs):
-        """The network coloured by pressure, tubes as wide as their deformed radius; see
-        :func:`tubefsi.plotting.plot_network`."""
-        from .plotting import plot_network
-
-        return plot_network(self, **kwargs)
-
-    def _repr_html_(self) -> str:
-        """The notebook summary: the size and convergence, then the first rows of the node and tube
-        tables with units."""
-        units = {"pressure": "Pa", "inflow": "m^3/s", "flow_rate": "m^3/s", "pressure_u": "Pa",
-                 "pressure_v": "Pa", "radius_u": "m", "radius_v": "m", "length": "m"}
-        return "\n".join([
-            _html.table("NetworkSolution", [("nodes", len(self.nodes)), ("tubes", len(self.tubes)),
-                                            ("Newton iterations", self.iterations),
-                                            ("residual", f"{self.residual:.2e}")]),
-            _html.columns_html("nodes", self.node_table(), units),
-            _html.columns_html("tubes", self.tube_table(), units)])
-
-    def __repr__(self) -> str:
-        return (f"NetworkSolution({len(self.nodes)} nodes, {len(self.tubes)} tubes, "
-                f"{self.iterations} iterations, residual {self.residual:.2e})")
-
-
 #: Why a network can have no resolvable throughput: tubes in series whose conductances differ by
 #: more than double precision resolves (the drop over the wide one is below one rounding unit of
 #: the pressures, so its flow is either 0 or far too large).
@@ -846,18 +896,38 @@ def _share(worst, through) -> float:
     return worst / through if through > 0 else (0.0 if worst == 0 else float("inf"))
 
 
+def _initial_pressures(initial):
+    """A warm start as a dict node -> pressure (None: the rigid start)."""
+    if initial is None:
+        return None
+    if isinstance(initial, NetworkSolution):
+        return initial.pressure
+    if not hasattr(initial, "items"):
+        raise InvalidParameterError("initial", "a NetworkSolution or a mapping node -> pressure (Pa)", initial)
+    start = {}
+    for node, value in initial.items():
+        start[node] = float(as_array(f"initial[{node!r}]", value, "[0, inf) Pa", lambda a: np.isfinite(a) & (a >= 0)))
+    return start
+
+
+def _names_of(label, values) -> list:
+    """Node or tube names given as a sequence or an array, as a list of plain Python objects."""
+    if isinstance(values, np.ndarray):
+        if values.ndim != 1:
+            raise InvalidParameterError(label, "a 1-D sequence of names", values.shape)
+        return values.tolist()
+    if isinstance(values, (str, bytes)) or not hasattr(values, "__len__"):
+        raise InvalidParameterError(label, "a sequence of names (a list or a 1-D array)", values)
+    values = list(values)
+    for k, x in enumerate(values):
+        if not _hashable(x):
+            raise InvalidParameterError(f"{label}[{k}]", "a hashable name", x)
+    return values
+
+
 def _hashable(x) -> bool:
     try:
         hash(x)
     except TypeError:
         return False
     return True
-
-
-def _text(x):
-    return x if isinstance(x, (str, int, bool)) else str(x)
-
-
-def _records(table):
-    return [{k: (v if isinstance(v, (float, int, bool, str)) else str(v)) for k, v in zip(table, row)}
-            for row in zip(*table.values())]
