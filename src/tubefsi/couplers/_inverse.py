@@ -597,7 +597,11 @@ def one_batch_mapped(engine, scene, target, index, q, bound):
     with np.errstate(all="ignore"):
         y_out = (np.log(4.0 / math.pi * q) - 3.0 * np.log(pts.radius * pts.outlet_stretch)) + np.zeros(target.size)
         # the linear guess from the law at the outlet's apparent rate (a start: within a factor ~2)
-        rough = np.asarray(scene.at(index).rheology._stress(np.exp(y_out)), dtype=float) + np.zeros(target.size)
+        if flow_map.kind(scene.rheology) == "closed":      # (exact there, and cheap)
+            rough, _, _ = flow_map.flow_map(pts.rheology, y_out, y_out).wall_stress(y_out[None])
+            rough = rough[0]
+        else:
+            rough = np.asarray(pts.rheology._stress(np.exp(y_out)), dtype=float) + np.zeros(target.size)
         slope0 = np.asarray(engine._slope(pts, np.zeros(target.size)), dtype=float) + np.zeros(target.size)
         radius_out = (pts.radius * pts.outlet_stretch) + np.zeros(target.size)
         top = np.minimum(1.5 * target * 2.0 * rough / (radius_out * slope0), bound)

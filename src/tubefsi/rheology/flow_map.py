@@ -34,6 +34,7 @@ import math
 import numpy as np
 
 from ..fields import _array_fields, _replace
+from ..numerics.kernels import blocked_matmul
 from ..numerics.quadrature import unit_integral
 from ..numerics.spectral import clenshaw, lobatto_rule
 
@@ -169,11 +170,11 @@ class PanelMap:
                 g = np.exp(x)
                 tau = self._tau(r, g)
                 cube = tau * tau * tau
-                maps = rule.matrix @ (cube * g)
+                maps = blocked_matmul(rule.matrix, cube * g)       # (a point's bits independent of its batch)
                 k_nodes = K[live] + (0.5 * WIDTH) * maps[rule.cumulative]
                 gamma = (4.0 / 3.0) * (g - k_nodes / cube)
                 y = np.log(gamma)
-                c = rule.matrix[rule.coef] @ y
+                c = blocked_matmul(rule.matrix[rule.coef], y)
                 # K's error: the quadrature's, and the tail of the integrand's interpolant on each panel
                 # (a tail at the rounding of the values, 32 eps of their largest, is noise: the
                 # cumulative integral then carries a few eps of the panel's integral)
