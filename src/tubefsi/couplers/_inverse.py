@@ -31,6 +31,7 @@ from ..numerics.kernels import EPS, rows_dot
 from ..numerics.quadrature import Integral, warn_unconverged
 from ..numerics.roots import solve_increasing
 from ..numerics.spectral import CHEBYSHEV_DEGREE, solve_integral
+from ..rheology import flow_map
 
 optimize = lazy_module("scipy.optimize", globals(), "optimize")
 elementwise = lazy_module("scipy.optimize.elementwise", globals(), "elementwise")
@@ -583,7 +584,6 @@ def one_batch_mapped(engine, scene, target, index, q, bound):
     table; the identity :math:`\int_0^v sP'(s)/G\,du = T` is then solved on the Chebyshev
     interpolant in :math:`u` as for a separable fluid. A point is solved only where the map vouches
     for every node and the interpolant's tail for the integral (else left to :func:`newton`)."""
-    from ..rheology import flow_map
     target = np.asarray(target, dtype=float).ravel()
     index = np.asarray(index).ravel()
     q = np.broadcast_to(np.asarray(q, dtype=float), target.shape)
