@@ -36,7 +36,10 @@ thick neo-Hookean wall, mu = 2 kPa.
 7. ``carreau curve``: a 10^4-point Carreau-Yasuda curve (blood, Cho & Kensey constants) in the
    thick wall against the power-law baseline at the same flow rates, per point;
 8. ``carreau scalar``: one scalar Carreau-Yasuda solve with fresh fluid parameters each call
-   (absolute time: a new fluid builds its flow table);
+   (absolute time; a fresh fluid is served by its flow map, no table);
+8b. ``carreau scenes``: 10^3 random Carreau-Yasuda scenes (every fluid, wall and tube parameter and
+   q random), one broadcast call, against the baseline per scene (the power law of each fluid's
+   high-shear asymptote, same q, tube and wall);
 9. ``fit``: ``tubefsi.fit`` of 3 parameters (wall.shear_modulus, rheology.consistency,
    rheology.index) to 20 synthetic points with 1 % noise (absolute time);
 10. ``import``: ``import tubefsi`` wall time over ``import numpy`` wall time, each in a fresh
@@ -441,6 +444,67 @@ def carreau_scalar(row, sizes, rng):
                 f"the same fluid again: {seconds(warm)}")
 
 
+def carreau_scenes_draw(count, rng):
+    """``count`` Carreau-Yasuda scenes with every parameter random (the issue-26 Monte Carlo): eta0,
+    eta_inf / eta0, lambda, n, a (transition), mu, a, t, L and q; q loads the rigid tube, at the
+    fluid's zero-shear viscosity, to 5-90 % of the limit pressure times 1-20 (shear thinning carries more)."""
+    s = random_scenes(count, rng)
+    s["e0"] = np.exp(rng.uniform(math.log(0.02), math.log(0.1), count))
+    s["einf"] = s["e0"] * np.exp(rng.uniform(math.log(0.02), math.log(0.2), count))
+    s["lam"] = np.exp(rng.uniform(math.log(0.1), math.log(10.0), count))
+    s["n"] = rng.uniform(0.3, 0.8, count)
+    s["tr"] = rng.uniform(0.6, 2.5, count)
+    load = np.exp(rng.uniform(math.log(0.05), math.log(0.9), count)) * np.exp(rng.uniform(0.0, math.log(20.0), count))
+    s["q"] = math.pi * s["a"] ** 4 * load * s["mu"] * np.log1p(s["t"] / s["a"]) / (8 * s["e0"] * s["length"])
+    s["m"] = s["e0"] * s["lam"] ** (s["n"] - 1)      # the baseline's power law: the fluid's high-shear asymptote
+    return s
+
+
+def carreau_broadcast(s):
+    fluid = rheologies["carreau-yasuda"](zero_shear_viscosity=s["e0"], infinite_shear_viscosity=s["einf"],
+                                         relaxation_time=s["lam"], index=s["n"], transition=s["tr"])
+    tube = tubefsi.Tube(radius=s["a"], thickness=s["t"], length=s["length"])
+    return tubefsi.solve(fluid, thick(s["mu"]), tube, flow_rate=s["q"])
+
+
+def carreau_scenes_row(row, sizes, rng):
+    """10^3 random Carreau-Yasuda scenes in one broadcast call against the power-law baseline per scene."""
+    count_scenes = min(sizes.points, 1000)
+    sets = [carreau_scenes_draw(count_scenes, rng) for _ in range(sizes.repeats + 1)]
+    carreau_broadcast(sets[-1])                     # (warms the process, not a fluid: each pass draws new ones)
+    count = sizes.sample
+    tubes = [[_Tube(float(s["a"][i]), float(s["t"][i]), float(s["length"][i])) for i in range(count)] for s in sets]
+    got = {}
+
+    def ours(r):
+        got["tubefsi"] = carreau_broadcast(sets[r])
+
+    def theirs(r):
+        s = sets[r]
+        got["baseline"] = [chapter_thick(float(s["q"][i]), float(s["n"][i]), float(s["m"][i]), float(s["mu"][i]),
+                                         tubes[r][i]) for i in range(count)]
+
+    times = interleaved({"tubefsi": (ours, count_scenes), "baseline": (theirs, count)}, sizes.repeats)
+    fill_ratio(row, times["tubefsi"], times["baseline"])
+    s = sets[sizes.repeats - 1]
+    b = carreau_broadcast(s)
+    alone = []
+    for i in range(min(count, 20)):                 # the default answer of a scene alone (a scalar fluid)
+        fluid = rheologies["carreau-yasuda"](zero_shear_viscosity=float(s["e0"][i]),
+                                             infinite_shear_viscosity=float(s["einf"][i]),
+                                             relaxation_time=float(s["lam"][i]), index=float(s["n"][i]),
+                                             transition=float(s["tr"][i]))
+        tube = tubefsi.Tube(radius=float(s["a"][i]), thickness=float(s["t"][i]), length=float(s["length"][i]))
+        alone.append(tubefsi.solve(fluid, thick(float(s["mu"][i])), tube, flow_rate=float(s["q"][i])))
+    row.err_tubefsi = rel_diff(b.pressure_drop[:len(alone)], b.inlet_displacement[:len(alone)],
+                               [d.pressure_drop for d in alone], [d.inlet_displacement for d in alone])
+    strain = float(np.max(b.inlet_displacement / s["a"]))
+    row.note = (f"{count_scenes} scenes per tubefsi pass, {count} per baseline pass; eta0 20-100 mPa s, "
+                "eta_inf/eta0 0.02-0.2, lambda 0.1-10 s, n 0.3-0.8, a 0.6-2.5, mu 1-10 kPa, a 50-200 um, t/a 0.1-0.5, "
+                f"L 5-20 mm; strain up to ~{strain:.2g}; baseline: the power law of each fluid's high-shear "
+                "asymptote at the same q; err tfsi: the broadcast call against each scene solved alone")
+
+
 def fit_timing(row, sizes, rng):
     """``tubefsi.fit`` of 3 parameters to 20 synthetic points (1 % noise, fresh noise each fit)."""
     truth = dict(mu=MU, m=M, n=N)
@@ -491,7 +555,8 @@ ROWS = [
     ("random scenes", "{N} random scenes, one broadcast call", "ratio", "scene", 30),
     ("infeasible scenes", "{N} random scenes, 10 % beyond q_max, on_infeasible='nan'", "ratio", "scene", 30),
     ("carreau curve", "{N}-pt Carreau-Yasuda curve, thick wall", "ratio", "point", 10),
-    ("carreau scalar", "scalar Carreau-Yasuda solve, fresh fluid", "absolute", "call", 10e-3),
+    ("carreau scalar", "scalar Carreau-Yasuda solve, fresh fluid", "absolute", "call", 0.5e-3),
+    ("carreau scenes", "10^3 random Carreau-Yasuda scenes, one call", "ratio", "scene", 0.5),
     ("fit", "tubefsi.fit, 20 points, 3 parameters", "absolute", "fit", 30e-3),
     ("import", "import tubefsi / import numpy", "ratio-max", "import", 2),
 ]
@@ -515,6 +580,7 @@ def measure(sizes, only=None):
         "carreau curve": lambda row: flow_curve(row, carreau_yasuda(), wall, q_cy, chapter_thick, sizes,
                                                 baseline_fluid=fluid),
         "carreau scalar": lambda row: carreau_scalar(row, sizes, rng),
+        "carreau scenes": lambda row: carreau_scenes_row(row, sizes, rng),
         "fit": lambda row: fit_timing(row, sizes, rng),
         "import": lambda row: imports(row, sizes),
     }

@@ -40,7 +40,7 @@ def test_speed_quick_prints_every_call_shape_with_finite_values(tmp_path, capsys
     assert speed.main(["--quick", "--json", str(out)]) == 0
     text = capsys.readouterr().out
     keys = [key for key, *_ in speed.ROWS]
-    assert len(keys) == 10
+    assert len(keys) == 11
     data = json.loads(out.read_text())
     assert data["quick"] is True and [r["key"] for r in data["rows"]] == keys
     lines = text.splitlines()

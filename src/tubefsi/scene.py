@@ -22,6 +22,7 @@ from .errors import BucklingError, InvalidParameterError, NoSteadyStateError
 from .geometry import Tube
 from .registry import rheologies as _rheologies
 from .registry import walls as _walls
+from .rheology.flow_map import kind as flow_map_kind
 from .rheology.base import Rheology
 from .walls.base import WallModel
 from .walls.hyperelastic import InstalledTube
@@ -302,8 +303,8 @@ class Scene:
         grouped = []
         for model in (self.rheology, self.wall):
             broadcasts = getattr(type(model), "broadcasts", True)
-            if model is self.rheology:
-                broadcasts = broadcasts and model.separable
+            if model is self.rheology:       # (a law that a flow map serves needs no table per fluid)
+                broadcasts = broadcasts and (model.separable or flow_map_kind(model) is not None)
             if not broadcasts and _array_values(model):
                 grouped.append(model)
         return grouped

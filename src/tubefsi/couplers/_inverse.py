@@ -31,6 +31,7 @@ from ..numerics.kernels import EPS, rows_dot
 from ..numerics.quadrature import Integral, warn_unconverged
 from ..numerics.roots import solve_increasing
 from ..numerics.spectral import CHEBYSHEV_DEGREE, solve_integral
+from ..rheology import flow_map
 
 optimize = lazy_module("scipy.optimize", globals(), "optimize")
 elementwise = lazy_module("scipy.optimize.elementwise", globals(), "elementwise")
@@ -373,7 +374,8 @@ def max_flow_rate(engine, scene, index):
         return out
     ids = index[limited]
     if not scene.rheology.separable:
-        out[limited] = [_max_flow_rate_point(engine, scene, int(i)) for i in ids]   # one search per point
+        # one search per point, on that point as a scene of scalars (its fluid's parameters may vary)
+        out[limited] = [_max_flow_rate_point(engine, scene.point(int(i)), 0) for i in ids]
         return out
     j_inf = engine._J_infinity(scene, ids)
     finite = np.isfinite(j_inf.value)
@@ -565,3 +567,70 @@ def solve_flow_rate(engine, scene, v, dp, index):
                                 tolerances=dict(xrtol=4 * np.finfo(float).eps, xatol=1e-300))
     q[sel] = np.where(found, np.exp(res.x), 0.0)
     return q
+
+
+#: The degrees :func:`one_batch_mapped` tries, in turn (a short interval: three times wider instead).
+_MAPPED_DEGREES = (24, 32, 32)
+#: Its tolerance on the tail: the flow map's own values carry ~1e-15 of rounding (ln Gamma to a few
+#: eps of itself, inverted), which the tail of an interpolant of them shows as ~1e-14.
+_MAPPED_RTOL = 5e-14
+
+
+def one_batch_mapped(engine, scene, target, index, q, bound):
+    r"""``(v, solved)``: :func:`one_batch` for a non-separable fluid whose flow law a
+    :mod:`~tubefsi.rheology.flow_map` serves. At the flow rate ``q`` of a point, the node
+    :math:`u` has :math:`\ln\Gamma = \ln(4q/\pi) - 3\ln(a\lambda_{out}) - 3u`, so the map built over
+    that range per point gives :math:`\tau_w` and :math:`G = 2\tau_w/(a s)` at every node without a
+    table; the identity :math:`\int_0^v sP'(s)/G\,du = T` is then solved on the Chebyshev
+    interpolant in :math:`u` as for a separable fluid. A point is solved only where the map vouches
+    for every node and the interpolant's tail for the integral (else left to :func:`newton`)."""
+    target = np.asarray(target, dtype=float).ravel()
+    index = np.asarray(index).ravel()
+    q = np.broadcast_to(np.asarray(q, dtype=float), target.shape)
+    v = np.zeros(target.size)
+    solved = np.zeros(target.size, dtype=bool)
+    bound = np.broadcast_to(bound, target.shape)
+    live = np.flatnonzero((target > 0) & (q > 0))
+    if live.size == 0 or flow_map.kind(scene.rheology) is None:
+        return v, solved
+    pts = scene.at(index)
+    with np.errstate(all="ignore"):
+        y_out = (np.log(4.0 / math.pi * q) - 3.0 * np.log(pts.radius * pts.outlet_stretch)) + np.zeros(target.size)
+        # the linear guess from the law at the outlet's apparent rate (a start: within a factor ~2)
+        if flow_map.kind(scene.rheology) == "closed":      # (exact there, and cheap)
+            rough, _, _ = flow_map.flow_map(pts.rheology, y_out, y_out).wall_stress(y_out[None])
+            rough = rough[0]
+        else:
+            rough = np.asarray(pts.rheology._stress(np.exp(y_out)), dtype=float) + np.zeros(target.size)
+        slope0 = np.asarray(engine._slope(pts, np.zeros(target.size)), dtype=float) + np.zeros(target.size)
+        radius_out = (pts.radius * pts.outlet_stretch) + np.zeros(target.size)
+        top = np.minimum(1.5 * target * 2.0 * rough / (radius_out * slope0), bound)
+    top = np.where(np.isfinite(top) & (top > 0), top, 0.0)
+    live = live[top[live] > 0]
+    for degree in _MAPPED_DEGREES:
+        if live.size == 0:
+            break
+        ids = index[live]
+        sub = scene.at(ids)
+        fmap = flow_map.flow_map(sub.rheology, y_out[live] - 3.0 * top[live] - 1e-9, y_out[live] + 1e-9)
+        vouched = np.ones(live.size, dtype=bool)
+        y0, a = y_out[live], sub.radius * sub.outlet_stretch
+
+        def f(u, i):
+            tau, ok, _ = fmap.wall_stress(y0 - 3.0 * u)
+            vouched[:] &= np.all(ok, axis=0)
+            return engine._slope(sub, u) * (a * np.exp(u)) / (2.0 * tau)
+
+        with np.errstate(all="ignore"):
+            x, good, short = solve_integral(f, target[live], top[live], rtol=max(engine._RTOL, _MAPPED_RTOL),
+                                            degree=degree)
+        good &= vouched
+        v[live[good]] = x[good]
+        solved[live[good]] = True
+        # short: three times the interval; a tail that missed: the next degree on the same one
+        again = short & vouched
+        wider = np.minimum(3.0 * top[live[again]], bound[live[again]])
+        keep = wider > top[live[again]]
+        top[live[again]] = wider
+        live = np.sort(np.concatenate([live[again][keep], live[~good & ~short & vouched]]))
+    return v, solved

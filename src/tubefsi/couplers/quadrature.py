@@ -91,8 +91,10 @@ class Quadrature(SeparatedVariables):
         others, safeguarded Newton for the points it cannot vouch for."""
         target = np.asarray(target, dtype=float).ravel()
         index = np.asarray(index).ravel()
-        if self._coarse or not scene.rheology.separable or not np.any(target > 0):
+        if self._coarse or not np.any(target > 0):
             return super()._solve_J(scene, target, index, q, upper)
+        if not scene.rheology.separable:
+            return self._solve_mapped(scene, target, index, q, upper)
         ok = np.ones(target.size, dtype=bool)
         final = Integral.exact(target)              # (where solved: the interpolant's tail met the tolerance)
         beyond = np.zeros(0, dtype=int)
@@ -111,5 +113,23 @@ class Quadrature(SeparatedVariables):
         if rest.size:
             up = None if upper is None else np.broadcast_to(np.asarray(upper, dtype=float), target.shape)[rest]
             v[rest], ok[rest], part = super()._solve_J(scene, target[rest], index[rest], None, up)
+            final = final.replaced(rest, part)
+        return v, ok, final
+
+    def _solve_mapped(self, scene, target, index, q, upper):
+        """A non-separable fluid: one batch of integrand values per point from the flow map of its
+        law (:func:`tubefsi.couplers._inverse.one_batch_mapped`), safeguarded Newton for the points
+        it cannot vouch for."""
+        bound = 0.5 * _inverse.log_stretch_cap(scene, index)
+        if upper is not None:
+            bound = np.minimum(bound, upper)
+        v, solved = _inverse.one_batch_mapped(self, scene, target, index, q, bound)
+        ok = np.ones(target.size, dtype=bool)
+        final = Integral.exact(target)
+        rest = np.flatnonzero(~solved & (target > 0))
+        if rest.size:
+            up = None if upper is None else np.broadcast_to(np.asarray(upper, dtype=float), target.shape)[rest]
+            qq = np.broadcast_to(np.asarray(q, dtype=float), target.shape)[rest]
+            v[rest], ok[rest], part = super()._solve_J(scene, target[rest], index[rest], qq, up)
             final = final.replaced(rest, part)
         return v, ok, final

@@ -54,6 +54,8 @@ def lobatto_rule(n):
     to_antiderivative = np.polynomial.chebyshev.chebint(to_coef, lbnd=-1.0, axis=0)
     cumulative = np.polynomial.chebyshev.chebvander(t, n + 1) @ to_antiderivative
     matrix = np.vstack([to_coef, to_antiderivative, cumulative])
+    for constant in (t, nodes, matrix):     # (shared by every call: a write into one would change later answers)
+        constant.setflags(write=False)
     return _LobattoRule(n, t, nodes, matrix, slice(0, n + 1), slice(n + 1, 2 * n + 3), slice(2 * n + 3, 3 * n + 4))
 
 

@@ -37,8 +37,9 @@ import numpy as np
 from .._html import model_html
 from .._validation import as_array
 from ..errors import InvalidParameterError
-from ..fields import _array_fields, evaluate, model_at
+from ..fields import _array_fields, broadcast_model, evaluate, model_at, parameter_sets
 from ..numerics.quadrature import unit_integral
+from . import flow_map
 from .flow_law import check, flow_table, rate_natural_rate, stress_natural_rate
 
 __all__ = ["Rheology"]
@@ -243,7 +244,10 @@ class Rheology(abc.ABC):
         else:
             rate = q / rate
         rate *= 4.0 / math.pi
-        out = flow_table(self).wall_stress(self, rate)
+        if _holds_arrays(self):     # many fluids at once: each point's wall stress from the flow map
+            out = _mapped_wall_stress(self, rate)
+        else:
+            out = flow_table(self).wall_stress(self, rate)
         out *= 2.0
         out /= r
         return out
@@ -351,6 +355,28 @@ class Rheology(abc.ABC):
 
     def _radius_factor(self, radius):
         raise NotImplementedError
+
+
+def _holds_arrays(model) -> bool:
+    return any(np.ndim(getattr(model, n)) for n in _array_fields(type(model)))
+
+
+def _mapped_wall_stress(model, rate):
+    r""":math:`\tau_w` at the apparent rates ``rate`` of a fluid with array parameters (broadcast
+    against ``rate``): from :func:`~tubefsi.rheology.flow_map.wall_stress` where it vouches for a
+    point, else from the flow table of that point's parameter set (no table is shared between sets)."""
+    tau, ok = flow_map.wall_stress(model, rate) if flow_map.kind(model) is not None else (None, None)
+    shape = np.broadcast_shapes(np.shape(rate), *(np.shape(getattr(model, n)) for n in _array_fields(type(model))))
+    if tau is None:
+        tau, ok = np.full(shape, np.nan), np.zeros(shape, dtype=bool)
+    if np.all(ok):
+        return tau
+    tau, flat_rate = tau.ravel(), np.broadcast_to(rate, shape).ravel()
+    missing = np.flatnonzero(~ok.ravel())
+    sub = model_at(broadcast_model(model, shape), missing)
+    for part, scalar in parameter_sets(sub, (missing.size,)):
+        tau[missing[part]] = flow_table(scalar).wall_stress(scalar, flat_rate[missing[part]])
+    return tau.reshape(shape)
 
 
 def _masked(model, hook, mask, *args):

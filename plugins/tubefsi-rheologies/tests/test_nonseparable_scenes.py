@@ -1,0 +1,128 @@
+"""Many non-separable fluids in one call (issue 26), against independent mpmath solves.
+
+Every plugin fluid, its parameters given as arrays (several fluids broadcast in one
+``tubefsi.solve``, the Monte Carlo call shape, served by the flow maps of
+``tubefsi.rheology.flow_map`` without a table per fluid), flow-controlled in a thick
+neo-Hookean wall and in a stiff thin linear wall, each point against
+``tubefsi.testing.reference.rheology.solve_flow_controlled`` (30 digits, the separated identity
+integrated over the wall shear rate or stress, written from docs/theory.md; nothing of tubefsi).
+The contract: 1e-12 relative (these problems' condition numbers are below 1).
+"""
+
+import numpy as np
+import pytest
+from mpmath import mp, mpf
+
+import tubefsi
+from tubefsi.registry import rheologies, walls
+from tubefsi.testing.reference import rel_err
+from tubefsi.testing.reference.rheology import CarreauYasudaRef, RateLawRef, solve_flow_controlled
+from tubefsi.testing.reference.tube_laws import Linear, NeoHookean, RefWall
+
+TOL = 1e-12
+
+
+@pytest.fixture(autouse=True, scope="module")
+def _precision():
+    with mp.workdps(30):
+        yield
+
+
+class CrossRef(CarreauYasudaRef):
+    """The Cross law and its slope, written afresh: tau = x (e_inf + (e0 - e_inf) / (1 + (lam x)^m))."""
+
+    def __init__(self, eta0, eta_inf, relaxation_time, exponent, m=24):
+        super().__init__(eta0, eta_inf, relaxation_time, 1, 1, m)
+        self.exponent = mpf(exponent)
+
+    def tau(self, x):
+        return x * (self.einf + (self.e0 - self.einf) / (1 + (self.lam * x) ** self.exponent))
+
+    def dtau(self, x):
+        y = (self.lam * x) ** self.exponent
+        return self.einf + (self.e0 - self.einf) * (1 + (1 - self.exponent) * y) / (1 + y) ** 2
+
+
+def _rate_ref(name, p):
+    """The shear rate of a rate-natural law at stress t (mpmath), and its yield stress."""
+    ty = mpf(p.get("yield_stress", 0))
+    if name == "ellis":
+        e0, half, a = (mpf(p[k]) for k in ("zero_shear_viscosity", "half_stress", "exponent"))
+        return RateLawRef(lambda t: t / e0 * (1 + (t / half) ** (a - 1)))
+    if name == "bingham":
+        mu = mpf(p["plastic_viscosity"])
+        return RateLawRef(lambda t: (t - ty) / mu if t > ty else mpf(0), ty)
+    if name == "casson":
+        mu = mpf(p["plastic_viscosity"])
+        return RateLawRef(lambda t: (mp.sqrt(t) - mp.sqrt(ty)) ** 2 / mu if t > ty else mpf(0), ty)
+    if name == "herschel-bulkley":
+        k, n = mpf(p["consistency"]), mpf(p["index"])
+        return RateLawRef(lambda t: ((t - ty) / k) ** (1 / n) if t > ty else mpf(0), ty)
+    raise KeyError(name)
+
+
+def _ref_fluid(name, p):
+    if name in ("carreau-yasuda", "carreau"):
+        return CarreauYasudaRef(p["zero_shear_viscosity"], p["infinite_shear_viscosity"], p["relaxation_time"],
+                                p["index"], p.get("transition", 2))
+    if name == "cross":
+        return CrossRef(p["zero_shear_viscosity"], p["infinite_shear_viscosity"], p["relaxation_time"],
+                        p["exponent"])
+    return _rate_ref(name, p)
+
+
+# two parameter sets per fluid (yield-stress fluids well above their yield pressure drop)
+SETS = {
+    "carreau-yasuda": [dict(zero_shear_viscosity=0.056, infinite_shear_viscosity=0.00345, relaxation_time=3.313,
+                            index=0.3568, transition=2.0),
+                       dict(zero_shear_viscosity=0.022, infinite_shear_viscosity=0.0022, relaxation_time=0.110,
+                            index=0.392, transition=0.644)],
+    "carreau": [dict(zero_shear_viscosity=0.056, infinite_shear_viscosity=0.00345, relaxation_time=3.313, index=0.3568),
+                dict(zero_shear_viscosity=2.0, infinite_shear_viscosity=0.0, relaxation_time=10.0, index=0.5)],
+    "cross": [dict(zero_shear_viscosity=0.056, infinite_shear_viscosity=0.00345, relaxation_time=1.007, exponent=1.028),
+              dict(zero_shear_viscosity=1.0, infinite_shear_viscosity=0.0, relaxation_time=0.5, exponent=0.6)],
+    "ellis": [dict(zero_shear_viscosity=0.1, half_stress=1.0, exponent=2.5),
+              dict(zero_shear_viscosity=0.056, half_stress=0.05, exponent=1.7)],
+    "bingham": [dict(yield_stress=0.5, plastic_viscosity=0.01), dict(yield_stress=0.2, plastic_viscosity=0.05)],
+    "casson": [dict(yield_stress=0.5, plastic_viscosity=0.01), dict(yield_stress=0.1, plastic_viscosity=0.004)],
+    "herschel-bulkley": [dict(yield_stress=0.5, consistency=0.2, index=0.6),
+                         dict(yield_stress=0.1, consistency=0.05, index=1.3)],
+}
+RADIUS, LENGTH = 5e-4, 2e-2
+WALLS = {
+    "thick neo-Hookean": (walls["thick-neo-hookean"](shear_modulus=5e3), 0.3,
+                          RefWall("thick", NeoHookean(5e3), 0.3, closed_form=False), (1e-9, 3e-8)),
+    "stiff thin linear": (walls["thin-linear"](youngs_modulus=1e6, poisson_ratio=0.5), 0.05,
+                          RefWall("thin-linear", Linear(1e6, 0.5), 0.05), (3e-8, 1e-6)),
+}
+
+
+@pytest.mark.parametrize("wall_name", sorted(WALLS))
+@pytest.mark.parametrize("name", sorted(SETS))
+def test_fluids_as_arrays_against_mpmath(name, wall_name):
+    wall, tb, ref_wall, flow_rates = WALLS[wall_name]
+    sets = SETS[name]
+    # every parameter set at both flow rates: four scenes in one broadcast call
+    params = {k: np.array([s[k] for s in sets for _ in flow_rates], dtype=float) for k in sets[0]}
+    q = np.array([f for _ in sets for f in flow_rates])
+    tube = tubefsi.Tube(radius=RADIUS, thickness=tb * RADIUS, length=LENGTH)
+    sol = tubefsi.solve(rheologies[name](**params), wall, tube, flow_rate=q)
+    for i in range(q.size):
+        p = {k: float(v[i]) for k, v in params.items()}
+        dp, lam = solve_flow_controlled(_ref_fluid(name, p), ref_wall, RADIUS, LENGTH, q[i],
+                                        1 + sol.inlet_displacement[i] / RADIUS)
+        assert rel_err(sol.pressure_drop[i], dp) < TOL, (i, p)
+        assert rel_err(sol.inlet_displacement[i], (lam - 1) * RADIUS) < TOL * max(1.0, float(lam / (lam - 1)) * 1e-3), (i, p)
+
+
+def test_one_fluid_alone_and_in_a_batch_agree():
+    """A scene solved alone (a scalar fluid) and among others (array parameters): the same route,
+    the same answer to rounding."""
+    sets = SETS["carreau-yasuda"]
+    params = {k: np.array([s[k] for s in sets]) for k in sets[0]}
+    tube = tubefsi.Tube(radius=RADIUS, thickness=0.3 * RADIUS, length=LENGTH)
+    wall = WALLS["thick neo-Hookean"][0]
+    batch = tubefsi.solve(rheologies["carreau-yasuda"](**params), wall, tube, flow_rate=[1e-8, 2e-8])
+    for i, s in enumerate(sets):
+        alone = tubefsi.solve(rheologies["carreau-yasuda"](**s), wall, tube, flow_rate=[1e-8, 2e-8][i])
+        assert rel_err(alone.pressure_drop, batch.pressure_drop[i]) < 1e-14

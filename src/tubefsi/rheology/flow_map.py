@@ -1,0 +1,265 @@
+r"""The wall stress of a non-separable fluid at given apparent wall shear rates, for many fluids at
+once and without a table kept per fluid (``docs/theory.md``, section "Non-separable fluids without
+a table").
+
+In a tube the flow depends on the wall stress only through the apparent wall shear rate
+:math:`\Gamma = 4q/(\pi R^3)`, and the separated identity needs :math:`\tau_w` at the
+:math:`\Gamma` of each of its nodes. In the law's *natural variable* :math:`x`, :math:`\Gamma(x)`
+needs no inner inverse:
+
+* a law with a closed form of :math:`\Gamma` (``_apparent_shear_rate``; Ellis, Bingham, Casson,
+  Herschel–Bulkley): :math:`x = \ln(\tau_w - \tau_y)`, :math:`y = \ln\Gamma(x)` exact, and
+  :math:`dy/dx = (4\dot\gamma_w/\Gamma - 3)(\tau_w - \tau_y)/\tau_w`; each node is solved by
+  Newton's method on the exact :math:`y(x)` (:class:`ClosedMap`). The plug's kink never enters: the
+  excess :math:`\tau_w - \tau_y = e^x` is exact.
+* a law given by its stress (Carreau, Carreau–Yasuda, Cross; no yield stress): :math:`x = \ln\dot\gamma_w`,
+  :math:`\tau_w = \tau(e^x)` explicit and, integrating the Rabinowitsch–Mooney integral by parts,
+  :math:`\Gamma = \tfrac43\bigl(\dot\gamma_w - K(\dot\gamma_w)/\tau_w^3\bigr)` with the cumulative
+  :math:`K(\dot\gamma) = \int_0^{\dot\gamma}\tau^3\,dg`. :class:`PanelMap` takes :math:`K` at the
+  bottom of the range of each fluid once (error-controlled quadrature from 0), then *upward* on
+  unit panels in :math:`x` from Chebyshev–Lobatto values and the integration matrix (no
+  difference of nearly equal integrals), and inverts :math:`y(x)` by Newton's method on each
+  panel's interpolant; :math:`\tau_w = \tau(e^x)` is then evaluated exactly.
+
+Every answer carries its own check: a panel's Chebyshev tails (of :math:`\tau^3\dot\gamma` and of
+:math:`y`) and the quadrature's estimate, a Newton iteration's convergence. A point that misses
+its tolerance is marked (``ok`` False) and left to the caller's other route: nothing is accepted
+unchecked. Nothing is kept between calls.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..fields import _array_fields, _replace
+from ..numerics.kernels import blocked_matmul
+from ..numerics.quadrature import unit_integral
+from ..numerics.spectral import clenshaw, lobatto_rule
+
+__all__ = ["kind", "ClosedMap", "PanelMap", "flow_map", "wall_stress"]
+
+_EPS = float(np.finfo(float).eps)
+#: Degree and width (in ln of the wall shear rate) of a panel of :class:`PanelMap`.
+DEGREE, WIDTH = 24, 1.0
+#: At most this many panels per fluid (a range of e^24 in the wall shear rate).
+MAX_PANELS = 24
+#: Tolerance of a map, in ln Gamma (so in ln tau_w: the flow index, <= 1 for these fluids, times it),
+#: above the rounding of ln Gamma's own values.
+TOL = 1e-14
+#: Newton iterations of :class:`ClosedMap` (steps clipped to 3 in ln(tau_w - tau_y)).
+_NEWTON = 60
+
+
+def _overridden(cls, name) -> bool:
+    owners = [c for c in cls.__mro__ if name in vars(c)]
+    return len(owners) > 1 and owners[0] is not owners[-1]
+
+
+def kind(rheology):
+    """``"closed"`` (a closed form of the apparent wall shear rate), ``"stress"`` (a law given by its
+    stress, without a yield stress), or None (a law the maps do not serve)."""
+    cls = type(rheology)
+    if rheology.separable:
+        return None
+    if _overridden(cls, "_apparent_shear_rate"):
+        return "closed"
+    if _overridden(cls, "_stress") and not _overridden(cls, "_shear_rate") and \
+            not np.any(np.asarray(rheology.yield_stress) != 0):
+        return "stress"
+    return None
+
+
+def _at(model, index, column=False):
+    """``model`` with its array parameters (one per point, 1-D) taken at ``index`` (as columns, to
+    broadcast against ``(points, nodes)``, if ``column``)."""
+    arrays = {n: v for n in _array_fields(type(model)) if isinstance(v := getattr(model, n), np.ndarray) and v.ndim}
+    if not arrays:
+        return model
+    return _replace(model, {n: v[index][:, None] if column else v[index] for n, v in arrays.items()})
+
+
+def _points(model, count):
+    """``model`` with every array parameter broadcast to ``(count,)``."""
+    arrays = {n: v for n in _array_fields(type(model)) if isinstance(v := getattr(model, n), np.ndarray)}
+    if not arrays:
+        return model
+    return _replace(model, {n: np.broadcast_to(v, (count,)).copy() if v.size != count else v.reshape(count)
+                            for n, v in arrays.items()})
+
+
+class ClosedMap:
+    """Newton's method on the exact :math:`y(x) = \\ln\\Gamma(\\tau_y + e^x)` (module docstring)."""
+
+    def __init__(self, rheology, y_lo, y_hi):
+        self.rheology = rheology
+        self.y_lo, self.y_hi = y_lo, y_hi
+
+    def _y(self, rheo, x):
+        e = np.exp(x)
+        tau_w = rheo.yield_stress + e
+        gamma = np.asarray(rheo._apparent_shear_rate(tau_w, excess=e), dtype=float)
+        rate = np.asarray(rheo._shear_rate(tau_w), dtype=float)
+        return np.log(gamma), (4.0 * rate / gamma - 3.0) * e / tau_w, tau_w
+
+    def wall_stress(self, y, x=None):
+        """``(tau_w, ok, x)`` at ``y = ln Gamma`` (shape ``(..., P)``, points along the last axis);
+        ``x`` a start (default 0, i.e. tau_w - tau_y = 1 Pa)."""
+        y = np.asarray(y, dtype=float)
+        rheo = self.rheology
+        x = np.zeros(y.shape) if x is None else np.array(np.broadcast_to(x, y.shape), dtype=float)
+        p = y.shape[-1] if y.ndim else 1
+        flat_y, flat_x = y.reshape(-1, p), x.reshape(-1, p)
+        rows, cols = np.nonzero(np.isfinite(flat_y))
+        live = np.arange(rows.size)
+        xs = flat_x[rows, cols]
+        ys = flat_y[rows, cols]
+        out_tau = np.full(rows.size, np.nan)
+        done = np.zeros(rows.size, dtype=bool)
+        with np.errstate(all="ignore"):
+            for _ in range(_NEWTON):
+                if live.size == 0:
+                    break
+                r = _at(rheo, cols[live])
+                value, slope, tau_w = self._y(r, xs[live])
+                step = (value - ys[live]) / slope
+                bad = ~np.isfinite(step) | ~(slope > 0)
+                step = np.clip(np.where(bad, 0.0, step), -3.0, 3.0)
+                converged = ~bad & (np.abs(value - ys[live]) <= 4.0 * _EPS * np.maximum(1.0, np.abs(ys[live])))
+                out_tau[live[converged]] = tau_w[converged]
+                done[live[converged]] = True
+                xs[live] -= step
+                live = live[~converged & ~bad]
+        tau_flat = np.full(flat_y.shape, np.nan)
+        ok_flat = np.zeros(flat_y.shape, dtype=bool)
+        x_flat = np.full(flat_y.shape, np.nan)
+        tau_flat[rows, cols], ok_flat[rows, cols], x_flat[rows, cols] = out_tau, done, xs
+        tau, ok = tau_flat.reshape(y.shape), ok_flat.reshape(y.shape)
+        return tau, ok, x_flat.reshape(y.shape)
+
+
+class PanelMap:
+    r""":math:`y(x)` on unit panels in :math:`x = \ln\dot\gamma_w` covering :math:`[y_{lo}, y_{hi}]`
+    per point (module docstring); :meth:`wall_stress` inverts it."""
+
+    def __init__(self, rheology, y_lo, y_hi):
+        self.rheology = rheology
+        y_lo, y_hi = np.asarray(y_lo, dtype=float), np.asarray(y_hi, dtype=float)
+        n = y_lo.size
+        rule = lobatto_rule(DEGREE)
+        self.rule = rule
+        # gamma_w >= 3 Gamma / 4 for an increasing law (K >= 0): x(y_lo) >= y_lo + ln(3/4)
+        self.x0 = y_lo + math.log(0.75) - 0.01
+        self.coef = np.full((DEGREE + 1, MAX_PANELS, n), np.nan)     # Chebyshev coefficients of y, per panel
+        self.y_nodes = np.full((DEGREE + 1, MAX_PANELS, n), np.nan)
+        self.ok = np.isfinite(y_lo) & np.isfinite(y_hi)
+        self.panels = np.zeros(n, dtype=int)
+        with np.errstate(all="ignore"):
+            g0 = np.exp(self.x0)
+            base = unit_integral(lambda t, idx: self._tau(_at(rheology, idx, column=True), g0[idx, None] * t) ** 3, n, rtol=1e-15)
+            K = g0 * base.value
+            err_k = g0 * base.error + 4.0 * _EPS * np.abs(K)
+            self.ok &= np.isfinite(K) & (K > 0)
+            live = np.flatnonzero(self.ok)
+            for j in range(MAX_PANELS):
+                if live.size == 0:
+                    break
+                r = _at(rheology, live)
+                x = self.x0[live] + WIDTH * (j + rule.nodes[:, None])
+                g = np.exp(x)
+                tau = self._tau(r, g)
+                cube = tau * tau * tau
+                maps = blocked_matmul(rule.matrix, cube * g)       # (a point's bits independent of its batch)
+                k_nodes = K[live] + (0.5 * WIDTH) * maps[rule.cumulative]
+                gamma = (4.0 / 3.0) * (g - k_nodes / cube)
+                y = np.log(gamma)
+                c = blocked_matmul(rule.matrix[rule.coef], y)
+                # K's error: the quadrature's, and the tail of the integrand's interpolant on each panel
+                # (a tail at the rounding of the values, 32 eps of their largest, is noise: the
+                # cumulative integral then carries a few eps of the panel's integral)
+                w_tail = np.abs(maps[rule.coef][-3:]).sum(axis=0)
+                noise = w_tail <= 32.0 * _EPS * np.max(cube * g, axis=0)
+                err_k[live] += np.where(noise, 0.0, (0.5 * WIDTH) * w_tail) + 4.0 * _EPS * k_nodes[-1]
+                err_y = np.max((4.0 / 3.0) * err_k[live] / (cube * gamma), axis=0)
+                tail = np.abs(c[-3:]).sum(axis=0)
+                good = np.all(np.isfinite(y), axis=0) & np.all(np.diff(y, axis=0) > 0, axis=0) & \
+                    (err_y + tail <= TOL + 32.0 * _EPS * np.max(np.abs(y), axis=0))
+                self.coef[:, j, live], self.y_nodes[:, j, live] = c, y
+                K[live] = k_nodes[-1]
+                self.panels[live] = j + 1
+                self.ok[live[~good]] = False
+                if j == 0:
+                    self.ok[live[y[0] > y_lo[live]]] = False       # (cannot happen for an increasing law)
+                live = live[good & (y[-1] < y_hi[live])]
+            self.ok[live] = False                                   # (beyond MAX_PANELS)
+        self.derivative = np.polynomial.chebyshev.chebder(np.nan_to_num(self.coef), axis=0)
+
+    @staticmethod
+    def _tau(rheo, g):
+        return np.asarray(rheo._stress(np.maximum(g, np.finfo(float).tiny)), dtype=float)
+
+    def wall_stress(self, y, x=None):
+        """``(tau_w, ok, x)`` at ``y = ln Gamma`` (shape ``(..., P)``, points along the last axis)."""
+        y = np.asarray(y, dtype=float)
+        shape = y.shape
+        n = self.x0.size
+        y2 = y.reshape(-1, n)
+        cols = np.broadcast_to(np.arange(n), y2.shape)
+        # the panel of each target: the count of panels whose top is below it
+        tops = self.y_nodes[-1]                                     # (MAX_PANELS, P)
+        with np.errstate(invalid="ignore"):
+            j = np.minimum(np.sum(tops[:, None, :] < y2[None], axis=0), np.maximum(self.panels - 1, 0))
+            nodes = self.y_nodes[:, j, cols]                       # (DEGREE + 1, rows, P)
+            inside = (y2 >= self.y_nodes[0, 0]) & (y2 <= nodes[-1]) & self.ok
+            # the start: linear interpolation between the panel's nodes that bracket y
+            k = np.clip(np.sum(nodes < y2[None], axis=0), 1, DEGREE)
+            t_nodes = self.rule.t
+            ya = np.take_along_axis(nodes, (k - 1)[None], axis=0)[0]
+            yb = np.take_along_axis(nodes, k[None], axis=0)[0]
+            ta, tb = t_nodes[k - 1], t_nodes[k]
+            t = np.where(yb > ya, ta + (tb - ta) * (y2 - ya) / (yb - ya), ta)
+            coef = self.coef[:, j, cols]
+            der = self.derivative[:, j, cols]
+            # Newton on the interpolant, quadratic: after a step below 1e-9 the error is ~1e-18 and
+            # that point stops (its iterations do not depend on its neighbours')
+            moving = inside.copy()
+            for _ in range(10):
+                step = (clenshaw(coef, t) - y2) / clenshaw(der, t)
+                step = np.where(moving & np.isfinite(step), step, 0.0)
+                t = np.clip(t - step, -1.0, 1.0)
+                moving &= ~(np.abs(step) <= 1e-9)
+                if not np.any(moving):
+                    break
+            inside &= ~moving
+            x = self.x0[cols] + WIDTH * (j + 0.5 * (t + 1.0))
+            tau = self._tau(self.rheology, np.exp(x))            # (the law's parameters: one per point, the last axis)
+        return tau.reshape(shape), inside.reshape(shape), x.reshape(shape)
+
+
+def flow_map(rheology, y_lo, y_hi):
+    """The map of ``rheology`` (its array parameters one per point, along the last axis) over
+    ``[y_lo, y_hi]`` per point (``y = ln Gamma``), or None where :func:`kind` is None."""
+    which = kind(rheology)
+    if which is None:
+        return None
+    y_lo = np.atleast_1d(np.asarray(y_lo, dtype=float))
+    y_hi = np.atleast_1d(np.asarray(y_hi, dtype=float))
+    model = _points(rheology, y_lo.size)
+    return ClosedMap(model, y_lo, y_hi) if which == "closed" else PanelMap(model, y_lo, y_hi)
+
+
+def wall_stress(rheology, apparent_rate):
+    r""":math:`\tau_w` at each apparent wall shear rate (any shape; the fluid's array parameters
+    broadcast against it), each point on its own; ``(tau_w, ok)``."""
+    rate = np.asarray(apparent_rate, dtype=float)
+    arrays = [getattr(rheology, n) for n in _array_fields(type(rheology))]
+    shape = np.broadcast_shapes(rate.shape, *(np.shape(a) for a in arrays))
+    flat_rate = np.broadcast_to(rate, shape).ravel()
+    model = _replace(rheology, {n: np.broadcast_to(getattr(rheology, n), shape).ravel()
+                                for n in _array_fields(type(rheology)) if isinstance(getattr(rheology, n), np.ndarray)})
+    with np.errstate(divide="ignore"):
+        y = np.log(flat_rate)
+    m = flow_map(model, y, y)
+    tau, ok, _ = m.wall_stress(y[None])
+    return tau[0].reshape(shape), ok[0].reshape(shape)
