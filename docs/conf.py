@@ -8,6 +8,7 @@ import tubefsi
 
 project = "tubefsi"
 author = "the tubefsi developers"
+copyright = "2026, the tubefsi developers (BSD 3-Clause licence)"
 release = version = tubefsi.__version__
 extensions = [
     "sphinx.ext.autodoc",

@@ -21,7 +21,7 @@ TRUE = {"wall.shear_modulus": 2e3, "rheology.consistency": 0.017, "rheology.inde
 
 
 def synthetic(seed=1, noise=0.01, points=25):
-    tube = tubefsi.Tube(radius=1e-4, thickness=3e-5, length=1e-2)
+    tube = tubefsi.Tube(radius=1e-4, thickness=3e-5, length=3e-2)      # slender up to 0.9 q_max
     fluid = rheologies["power-law"](consistency=0.017, index=0.7)
     wall = walls["thick-neo-hookean"](shear_modulus=2e3)
     q = np.linspace(0.05, 0.9, points) * tubefsi.max_flow_rate(fluid, wall, tube)

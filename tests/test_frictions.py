@@ -50,3 +50,34 @@ def test_the_thick_hgo_laws_slope_jumps_where_the_fibres_engage_as_the_docs_say(
     below = (wall.pressure(1 - h, tb) - wall.pressure(1 - 2 * h, tb)) / h
     jump = 4 * media["fibre_stiffness"] * math.cos(media["fibre_angle"]) ** 4 * (1 - (1 + tb) ** -2)
     assert abs((above - below) / jump - 1) < 1e-4
+
+
+def test_a_misspelt_registry_name_suggests_the_intended_one():
+    import tubefsi
+    from tubefsi.registry import walls
+
+    with pytest.raises(KeyError, match=r"did you mean 'thick-neo-hookean'\?"):
+        walls["thick-neo-hookan"]
+    tube = tubefsi.Tube(radius=1e-4, thickness=3e-5, length=1e-2)
+    with pytest.raises(tubefsi.InvalidParameterError, match=r"did you mean 'power-law'\?"):
+        tubefsi.solve("power-lw", "rigid", tube, flow_rate=1e-9)
+
+
+def test_tubefsi_list_describes_a_class_by_its_own_docstring_only():
+    """A composed class without a docstring was described by its base's ("Thick-walled theory")."""
+    import attrs
+
+    from tubefsi.cli import _summary
+    from tubefsi.walls import ThickWall
+    from tubefsi.walls.neo_hookean import NeoHookean
+
+    @attrs.frozen(kw_only=True)
+    class Mine(ThickWall, NeoHookean):
+        pass
+
+    @attrs.frozen(kw_only=True)
+    class Described(ThickWall, NeoHookean):
+        """My wall, thick."""
+
+    assert "no docstring" in _summary(Mine) and "Thick-walled" not in _summary(Mine)
+    assert _summary(Described) == "My wall, thick"

@@ -153,8 +153,12 @@ def _load_values(option: str, text: str):
 
 # ---------------------------------------------------------------------------- list
 def _summary(cls) -> str:
-    """First phrase of a class docstring, without reST math."""
-    doc = " ".join((inspect.getdoc(cls) or "").split())
+    """First phrase of a class's own docstring, without reST math (a class without one is said to
+    have none: a base class's description, "Thick-walled theory ...", would misdescribe it)."""
+    own = cls.__dict__.get("__doc__")
+    if not own:
+        return f"{cls.__name__} (no description: its class has no docstring)"
+    doc = " ".join(inspect.cleandoc(own).split())
     depth, cut = 0, len(doc)
     for i, ch in enumerate(doc):
         if ch == "(":

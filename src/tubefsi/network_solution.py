@@ -43,7 +43,7 @@ def _frozen(a) -> np.ndarray:
 
 @attrs.frozen(kw_only=True, repr=False, eq=False)
 class NetworkSolution:
-    """The steady state of a :class:`~tubefsi.Network`.
+    r"""The steady state of a :class:`~tubefsi.Network`.
 
     Arrays (read-only, handed out without a copy, so a read is O(1)) follow the order of
     :attr:`nodes` (node arrays) or of :attr:`tube_names` (tube arrays):

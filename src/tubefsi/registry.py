@@ -33,6 +33,7 @@ nothing: the next access finds every name resolved. The same distribution seen t
 
 from __future__ import annotations
 
+import difflib
 import importlib
 import re
 import sys
@@ -176,9 +177,16 @@ class Registry(Mapping):
     def __getitem__(self, name: str) -> type:
         obj = self._get(name)
         if obj is None:
-            raise KeyError(f"{name!r} is not a registered {_KINDS.get(self.group, self.group)}; "
+            close = self.closest(name)
+            hint = f" (did you mean {close!r}?)" if close else ""
+            raise KeyError(f"{name!r} is not a registered {_KINDS.get(self.group, self.group)}{hint}; "
                            f"known: {', '.join(sorted(self._load()))}")
         return obj
+
+    def closest(self, name) -> str | None:
+        """The registered name closest to a misspelt ``name`` (difflib's ratio at least 0.6), or None."""
+        close = difflib.get_close_matches(str(name), sorted(self._load()), n=1, cutoff=0.6)
+        return close[0] if close else None
 
     def __contains__(self, name) -> bool:
         return isinstance(name, str) and self._get(name) is not None

@@ -431,7 +431,9 @@ def _resolve(kind, value, base, registry):
         try:
             value = registry[value]
         except KeyError as exc:
-            raise InvalidParameterError(kind, "{" + ", ".join(registry) + "}", value) from exc
+            close = registry.closest(value)
+            raise InvalidParameterError(kind, "{" + ", ".join(registry) + "}", value,
+                                        f"did you mean {close!r}?" if close else "") from exc
     if isinstance(value, type) and issubclass(value, base):
         try:
             value = value()
