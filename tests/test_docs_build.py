@@ -106,3 +106,11 @@ def test_the_checks_catch_a_misread_paragraph():
     names = [name for _, name in parser.names if not PARAMETER_NAMES.fullmatch(name)]
     assert roles == ["inlet): a callable, a :class:`~tubefsi.Profile` or a"]
     assert names == ["inlet): a callable, a :class:`~tubefsi.Profile` or a"]
+
+
+def test_no_page_shows_the_build_machines_paths():
+    """The site is the same wherever it is built: no page (the gallery's captured output included)
+    shows the absolute path of the clone it was built from."""
+    root = str(Path(__file__).resolve().parents[1])
+    found = [str(page.relative_to(SITE)) for page in _pages() if root in page.read_text(encoding="utf-8")]
+    assert not found, f"pages showing {root}: {found}"
