@@ -168,7 +168,7 @@ def test_a_scalar_argument_with_array_parameters_in_the_generic_wall_paths():
     a scalar stretch or pressure with array parameters (they used to index one point only)."""
     from tubefsi.registry import walls
     moduli = np.array([1.0e3, 1.5e3, 2.0e3])
-    for name, extra in (("thick-fung", {"stiffening": 20.0}), ("thin-fung", {"stiffening": 2.0})):
+    for name, extra in (("thick-demiray", {"stiffening": 20.0}), ("thin-demiray", {"stiffening": 2.0})):
         wall = walls[name](shear_modulus=moduli, **extra)
         got = wall.pressure(1.05, 0.3)
         strain = wall.strain(50.0, 0.3)

@@ -139,7 +139,7 @@ def test_list_starts_without_scipy():
             "loaded = sorted(m for m in sys.modules if m == 'scipy' or m.startswith('scipy.'))\n"
             "print('SCIPY', loaded, 'matplotlib' in sys.modules, file=sys.stderr)\n")
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    for name in ("thick-neo-hookean", "thin-fung", "ode", "quadrature", "newtonian", "bingham"):
+    for name in ("thick-neo-hookean", "thin-demiray", "ode", "quadrature", "newtonian", "bingham"):
         assert f"  {name} " in run.stdout, name
     assert run.stderr.strip().splitlines()[-1] == "SCIPY [] False"
 

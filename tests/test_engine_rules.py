@@ -453,7 +453,7 @@ import tubefsi
 
 barrier = threading.Barrier(8)
 fluids = ["carreau", "cross", "bingham", "power-law", "ellis", "casson", "herschel-bulkley", "carreau-yasuda"]
-wall_names = ["thick-fung", "thin-gent", "thick-neo-hookean", "thin-yeoh"]
+wall_names = ["thick-demiray", "thin-gent", "thick-neo-hookean", "thin-yeoh"]
 
 def first_use(i):
     barrier.wait()
@@ -502,8 +502,8 @@ F = {"pl7": R["power-law"](consistency=0.017, index=0.7), "pl5": R["power-law"](
                          index=0.3568),
      "bing": R["bingham"](yield_stress=0.005, plastic_viscosity=0.0035)}
 WL = {"thick": W["thick-neo-hookean"](shear_modulus=2e3), "thin": W["thin-neo-hookean"](shear_modulus=2e3,
-      thickness_convention="current"), "fung": W["thick-fung"](shear_modulus=2e3, stiffening=2.0),
-      "tfung": W["thin-fung"](shear_modulus=1e3, stiffening=20.0), "ref": W["thin-neo-hookean"](shear_modulus=1e3)}
+      thickness_convention="current"), "demiray": W["thick-demiray"](shear_modulus=2e3, stiffening=2.0),
+      "tfung": W["thin-demiray"](shear_modulus=1e3, stiffening=20.0), "ref": W["thin-neo-hookean"](shear_modulus=1e3)}
 CURVE = np.geomspace(1e-11, 2e-9, 100)
 
 
@@ -520,7 +520,7 @@ def sol(**kw):
 
 CALLS = {}
 for f in F:
-    for w in ("thick", "thin", "fung"):
+    for w in ("thick", "thin", "demiray"):
         CALLS[f"{f}/{w}/q"] = (sol(flow_rate=7e-10), f, w)
         CALLS[f"{f}/{w}/curve"] = (sol(flow_rate=CURVE, on_infeasible="nan"), f, w)
     CALLS[f"{f}/thick/dp"] = (sol(pressure_drop=np.array([50.0, 150.0, 250.0])), f, "thick")
@@ -560,7 +560,7 @@ for k, name in enumerate(names):
 
 def test_answers_do_not_depend_on_the_process_history(tmp_path):
     """A fixed list of 40 mixed calls (power law, Carreau and Bingham; thick and thin neo-Hookean,
-    thick and thin Fung walls; scalars, 100-point curves, pressure-controlled, an outlet pressure,
+    thick and thin Demiray walls; scalars, 100-point curves, pressure-controlled, an outlet pressure,
     another tube, max_flow_rate, a profile) run in two fresh processes: in order, and in a
     shuffled reverse order with ~120 unrelated solves interleaved (other fluids, walls and tubes,
     enough to evict from the cache). Every call prints the same bits in both. (The old engine's

@@ -71,7 +71,7 @@ def test_stiffness_beyond_the_doubles_is_a_typed_error():
 def test_axial_stretch_outside_its_range_names_it(name, value):
     """axial_stretch lies in [1e-100, 1e100] (AXIAL_STRETCH_RANGE: the invariants of the installed
     rest state, ~lz^2 and ~2/lz^2, stay doubles there); beyond, an InvalidParameterError naming it
-    and its range (Fung, Gent, Yeoh and Ogden raised OverflowError or ZeroDivisionError)."""
+    and its range (Demiray, Gent, Yeoh and Ogden raised OverflowError or ZeroDivisionError)."""
     example = dict(W[name]._examples[0])
     with pytest.raises(InvalidParameterError, match=r"axial_stretch.*1e-100, 1e\+100"):
         W[name](**{**example, "axial_stretch": value})

@@ -42,15 +42,15 @@ def test_a_broadcast_of_thick_walls_meets_mpmath():
 
 
 def test_a_stiff_batch_is_handed_to_the_adaptive_path():
-    """Fung b = 20 at large strain: the interpolant's tail refuses, the adaptive path answers,
+    """Demiray b = 20 at large strain: the interpolant's tail refuses, the adaptive path answers,
     and each entry equals its scalar solve (which runs the adaptive path alone)."""
     size = 70
     fluid = rheologies["power-law"](consistency=0.01, index=0.8)
     tube = tubefsi.Tube(radius=1e-4, thickness=3e-5, length=1e-2)
     q = np.geomspace(1e-7, 1e-5, size)
-    wall = walls["thick-fung"](shear_modulus=np.linspace(1e3, 1.2e3, size), stiffening=20.0)  # no shared table
+    wall = walls["thick-demiray"](shear_modulus=np.linspace(1e3, 1.2e3, size), stiffening=20.0)  # no shared table
     sol = tubefsi.solve(fluid, wall, tube, flow_rate=q)
     for i in (0, size // 2, size - 1):
-        one = tubefsi.solve(fluid, walls["thick-fung"](shear_modulus=float(wall.shear_modulus[i]), stiffening=20.0),
+        one = tubefsi.solve(fluid, walls["thick-demiray"](shear_modulus=float(wall.shear_modulus[i]), stiffening=20.0),
                             tube, flow_rate=float(q[i]))
         assert abs(sol.pressure_drop[i] / one.pressure_drop - 1) < 1e-13

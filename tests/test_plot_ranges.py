@@ -1,6 +1,6 @@
 """Default plot ranges come from the physics, never from a numerical guard (issue 27, item 1).
 
-A stiffening wall (HGO, Fung, a user's exponential law) has a "limit pressure" only where double
+A stiffening wall (HGO, Demiray, a user's exponential law) has a "limit pressure" only where double
 precision ends (~1e260 Pa); drawn, it flattened every curve onto the axis. References: the
 pressures the plotted walls give at the plotted stretches (the axis must hold them, and no more
 than a few times them), and the small-strain modulus that bounds the default stretch range.
@@ -39,7 +39,7 @@ class Exponential(WallModel):
 def stiffening_walls():
     out = [("thick-hgo rabbit media", walls["thick-hgo"](**PRESETS["rabbit-carotid-media"])),
            ("user exponential", Exponential())]
-    for name in ("thick-fung", "thin-fung", "thin-hgo"):
+    for name in ("thick-demiray", "thin-demiray", "thin-hgo"):
         if name in walls:
             out.append((name, walls[name](**walls[name]._examples[0])))
     return out

@@ -19,8 +19,8 @@ PLUGINS = {
     "tubefsi-rheologies": ("tubefsi_rheologies", "tubefsi.rheologies",
                            ["bingham", "carreau", "carreau-yasuda", "casson", "cross", "ellis", "herschel-bulkley"]),
     "tubefsi-hyperelastic": ("tubefsi_hyperelastic", "tubefsi.walls",
-                             ["thick-fung", "thick-gent", "thick-ogden", "thick-yeoh",
-                              "thin-fung", "thin-gent", "thin-ogden", "thin-yeoh"]),
+                             ["thick-demiray", "thick-gent", "thick-ogden", "thick-yeoh",
+                              "thin-demiray", "thin-gent", "thin-ogden", "thin-yeoh"]),
 }
 
 

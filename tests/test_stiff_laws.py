@@ -5,11 +5,11 @@ Until the default path's quadrature was error-controlled, stiff tube laws came o
 suites passed on them, since they compare a model's paths with each other. Here:
 
 * the three reproducers (tube ``a = 1e-4``, ``t = 3e-5``, ``L = 1e-2`` m; power law
-  ``m = 0.01 Pa s^n``, ``n = 0.8``): ``thin-fung`` and ``thick-fung`` with ``mu = 1e3``,
+  ``m = 0.01 Pa s^n``, ``n = 0.8``): ``thin-demiray`` and ``thick-demiray`` with ``mu = 1e3``,
   ``b = 20``, and a user's thick fibre law (a ``HyperelasticWall`` subclass composed with
   ``ThickWall``, written here as a user would), each at its flow rate, against a 40-digit
   reference computed here from ``tubefsi.testing.reference`` (``tube_laws.RefWall`` of the
-  materials ``Fung`` and ``HoopFibre``, written from their strain energies; ``power_law``:
+  materials ``Demiray`` and ``HoopFibre``, written from their strain energies; ``power_law``:
   the separated integral ``Jhat(lam) = int_1^lam P'(s) s^k ds``, ``docs/theory.md``, section
   "Coupling without an ODE"): the flow-controlled pressure drop and inlet displacement, the
   profiles at mid-length, and the pressure-controlled flow rate and inlet displacement at the
@@ -18,7 +18,7 @@ suites passed on them, since they compare a model's paths with each other. Here:
 * the brute force of ``tubefsi.testing.brute_force`` against the same reference (1e-12): the
   independent check the accuracy suite relies on is itself accurate on these laws;
 * the stiff laws given at the suite level: the fibre law (with the overflow guard a published
-  law needs) through ``HyperelasticWallContract``, and it and the Fung walls with ``b = 20``
+  law needs) through ``HyperelasticWallContract``, and it and the Demiray walls with ``b = 20``
   through ``AccuracyContract`` (the default answers against the brute force);
 * the accuracy suite fails on a deliberately wrong default answer: a wall whose stiffness is
   off by 1e-6 (and by 1e-9, which ``WallContract``'s slope test, at 1e-7, cannot see), and a
@@ -49,7 +49,7 @@ from tubefsi import fields, registry
 from tubefsi.testing import AccuracyContract, HyperelasticWallContract, accuracy_cases, brute_force, contracts
 from tubefsi.testing.reference import rel_err
 from tubefsi.testing.reference.power_law import ref_J, ref_J_direct, ref_phi, ref_phi_inverse
-from tubefsi.testing.reference.tube_laws import Fung, HoopFibre, RefWall
+from tubefsi.testing.reference.tube_laws import Demiray, HoopFibre, RefWall
 from tubefsi.walls import HyperelasticWall, ThickNeoHookean, ThickWall, ThinWall
 
 DPS = 40
@@ -82,7 +82,7 @@ class ThickFibre(ThickWall, Fibre):
 
 @attrs.frozen(kw_only=True)
 class GuardedFibre(Fibre):
-    """The law as a package would publish it, like the Fung walls: the stretch where ``exp``
+    """The law as a package would publish it, like the Demiray walls: the stretch where ``exp``
     would overflow (``k2 (s^2 - 1)^2 = 600``) is its maximum stretch and the pressure there its
     limit pressure (so that the suites' large strains raise typed errors, not ``inf``), and the
     second derivative and the thick-wall integrand are given in closed form (their numerical
@@ -124,9 +124,9 @@ FUNG = dict(shear_modulus=1e3, stiffening=20.0)
 
 #: (wall, reference kind, reference material, flow rate): the three reproducers
 REPRODUCERS = {
-    "thin-fung-b20": (registry.walls["thin-fung"](**FUNG), "thin-reference", Fung(1e3, 20.0),
+    "thin-demiray-b20": (registry.walls["thin-demiray"](**FUNG), "thin-reference", Demiray(1e3, 20.0),
                       2.0077062102538603e-4),
-    "thick-fung-b20": (registry.walls["thick-fung"](**FUNG), "thick", Fung(1e3, 20.0), 9.830164143636886e-6),
+    "thick-demiray-b20": (registry.walls["thick-demiray"](**FUNG), "thick", Demiray(1e3, 20.0), 9.830164143636886e-6),
     "thick-fibre": (ThickFibre(**FIBRE), "thick", HoopFibre(1e3, 1e4, 20.0), 4.5517606198809837e-6),
 }
 CASES = list(REPRODUCERS)
@@ -284,7 +284,7 @@ def test_reference_fibre_derivative_matches_its_strain_energy():
 # ---------------------------------------------------------------------------- the suites
 STIFF_WALLS = [ThickGuardedFibre(**FIBRE), ThinGuardedFibre(**FIBRE),
                ThinGuardedFibre(**FIBRE, thickness_convention="current"),
-               registry.walls["thin-fung"](**FUNG), registry.walls["thick-fung"](**FUNG)]
+               registry.walls["thin-demiray"](**FUNG), registry.walls["thick-demiray"](**FUNG)]
 
 
 class TestStiffWalls(HyperelasticWallContract):
@@ -294,7 +294,7 @@ class TestStiffWalls(HyperelasticWallContract):
 
     def test_thick_tends_to_thin_current(self, wall):
         """A stiff law's O(t/a) coefficient is large (about 43 t/a for the fibre law, 18 t/a for
-        Fung with b = 20, at stretch 1.5), which is why the suite asks only for a difference below
+        Demiray with b = 20, at stretch 1.5), which is why the suite asks only for a difference below
         1 at t/a = 0.01 and a fivefold fall per decade; here the first-order rate is pinned
         tighter: the difference falls 7–13-fold per decade of t/a."""
         if not isinstance(wall, ThickWall):

@@ -26,8 +26,8 @@ WALLS = [
     walls["thick-neo-hookean"](shear_modulus=2e3),
     walls["thin-neo-hookean"](shear_modulus=2e3),
     walls["thick-mooney-rivlin"](c1=1.5e3, c2=-0.5e3),
-    walls["thick-fung"](shear_modulus=2e3, stiffening=2.0),
-    walls["thin-fung"](shear_modulus=1e3, stiffening=20.0),
+    walls["thick-demiray"](shear_modulus=2e3, stiffening=2.0),
+    walls["thin-demiray"](shear_modulus=1e3, stiffening=20.0),
     walls["thick-gent"](shear_modulus=2e3, locking_parameter=3.0),
     walls["thick-yeoh"](c1=1e3, c2=50.0, c3=2.0),
 ]

@@ -493,7 +493,7 @@ def axial_dW_of(name, params, lz):
         dW, energy = hgo_axial(**params, lz=lz)
     else:
         mat = {"gent": lambda: ref.Gent(params["shear_modulus"], params["locking_parameter"]),
-               "fung": lambda: ref.Fung(params["shear_modulus"], params["stiffening"]),
+               "demiray": lambda: ref.Demiray(params["shear_modulus"], params["stiffening"]),
                "yeoh": lambda: ref.Yeoh(params["c1"], params["c2"], params["c3"]),
                "ogden": lambda: ref.Ogden(params["moduli"], params["exponents"])}[name]()
         L = mp.mpf(lz)
@@ -545,14 +545,14 @@ def s_integral(dW, lz, tb):
     return law, slope
 
 
-ISOTROPIC = {"gent": dict(shear_modulus=2e3, locking_parameter=3.0), "fung": dict(shear_modulus=2e3, stiffening=0.7),
+ISOTROPIC = {"gent": dict(shear_modulus=2e3, locking_parameter=3.0), "demiray": dict(shear_modulus=2e3, stiffening=0.7),
              "yeoh": dict(c1=1e3, c2=-120.0, c3=8.0), "ogden": dict(moduli=(2008.5, 14.75, 49.05), exponents=(1.3, 5.0, -2.0))}
 
 
 @pytest.mark.parametrize("name", sorted(ISOTROPIC))
 @pytest.mark.parametrize("lz", [0.8, 1.6])
 def test_axial_stretch_of_plugin_materials_matches_mpmath(name, lz):
-    """Gent, Fung, Yeoh, Ogden installed at lz: the thick law against the s-integral of the 3-D
+    """Gent, Demiray, Yeoh, Ogden installed at lz: the thick law against the s-integral of the 3-D
     energy (mpmath), including a collapsing stretch; the thin laws against the membrane forms
     tb W'(s_i)/sqrt(lz) and tb W'(s_i)/(lz s_i), s_i = lam/sqrt(lz) (the installed rest lumen
     a/sqrt(lz), as for every isotropic material)."""
@@ -573,7 +573,7 @@ def test_axial_stretch_of_plugin_materials_matches_mpmath(name, lz):
 
 
 def test_axial_stretch_of_plugin_materials_validates_and_locks():
-    """Gent's lock and Fung's maximum stretch in the installed variables (where I1 - 3 = J_m and
+    """Gent's lock and Demiray's maximum stretch in the installed variables (where I1 - 3 = J_m and
     b (I1 - 3) = 600, solved in mpmath from the stretches); typed errors where the installed tube
     at rest is beyond them, or has no positive small-strain modulus (Yeoh, Ogden)."""
     pytest.importorskip("tubefsi_hyperelastic")
@@ -585,10 +585,10 @@ def test_axial_stretch_of_plugin_materials_validates_and_locks():
 
     gent = walls["thick-gent"](shear_modulus=1.0, locking_parameter=3.0, axial_stretch=1.5)
     assert gent.max_stretch(0.3) == pytest.approx(float(mp.findroot(lambda x: installed_i1(x) - 3, 2)), rel=1e-14)
-    fung = walls["thin-fung"](shear_modulus=1.0, stiffening=20.0, axial_stretch=1.5)
+    fung = walls["thin-demiray"](shear_modulus=1.0, stiffening=20.0, axial_stretch=1.5)
     assert fung.max_stretch(0.3) == pytest.approx(float(mp.findroot(lambda x: 20 * installed_i1(x) - 600, 2)), rel=1e-14)
     for name, kw in [("thick-gent", dict(shear_modulus=1.0, locking_parameter=0.5, axial_stretch=2.0)),
-                     ("thin-fung", dict(shear_modulus=1.0, stiffening=300.0, axial_stretch=2.5)),
+                     ("thin-demiray", dict(shear_modulus=1.0, stiffening=300.0, axial_stretch=2.5)),
                      ("thick-yeoh", dict(c1=1.0, c2=-2.0, c3=0.0, axial_stretch=2.0)),
                      ("thick-ogden", dict(moduli=(1.0, -0.9), exponents=(8.0, -2.0), axial_stretch=2.0)),
                      ("thick-gent", dict(shear_modulus=1.0, locking_parameter=3.0, axial_stretch=0.0))]:
@@ -599,7 +599,7 @@ def test_axial_stretch_of_plugin_materials_validates_and_locks():
 
 
 @settings(deadline=None, max_examples=scaled(6))
-@given(delta=st.floats(-1e-6, 1e-6), name=st.sampled_from(["thick-gent", "thin-fung", "thick-ogden", "thin-yeoh",
+@given(delta=st.floats(-1e-6, 1e-6), name=st.sampled_from(["thick-gent", "thin-demiray", "thick-ogden", "thin-yeoh",
                                                            "thick-hgo", "thin-hgo"]),
        lam=st.floats(1.001, 1.5))
 @example(delta=-1e-6, name="thick-hgo", lam=1.001)    # the fibre walls at the low end of lam, on the side
@@ -637,7 +637,7 @@ def test_axial_stretch_near_one_gives_todays_walls(delta, name, lam):
 
 @settings(deadline=None, max_examples=scaled(4))
 @given(lz=st.lists(st.floats(0.85, 1.8), min_size=2, max_size=3), name=st.sampled_from(["thick-hgo", "thin-hgo",
-                                                                                        "thick-fung", "thin-gent"]))
+                                                                                        "thick-demiray", "thin-gent"]))
 def test_axial_stretch_broadcasts_like_a_loop(lz, name):
     """An array of axial stretches gives the scalar walls' values, entry by entry."""
     pytest.importorskip("tubefsi_hyperelastic")
@@ -783,13 +783,13 @@ def test_hgo_in_situ_validates():
 
 class TestStiffHGOInSitu(tubefsi.testing.AccuracyContract):
     """A stiff thin fibre law (k2 = 20) at lz = 1.3, whose fibres are slack at rest and engage at
-    the stretch 1.10, inside the flow (the quadratures split there), and a stiff thick Fung
+    the stretch 1.10, inside the flow (the quadratures split there), and a stiff thick Demiray
     (b = 20) at lz = 1.3, against the brute force."""
 
     @pytest.fixture(params=tubefsi.testing.accuracy_cases(
         [walls["thin-hgo"](shear_modulus=1e3, fibre_stiffness=1e4, fibre_exponent=20.0, fibre_angle=0.3,
                            thickness_convention="current", axial_stretch=1.3)]
-        + ([walls["thick-fung"](shear_modulus=1e3, stiffening=20.0, axial_stretch=1.3)] if "thick-fung" in walls else []),
+        + ([walls["thick-demiray"](shear_modulus=1e3, stiffening=20.0, axial_stretch=1.3)] if "thick-demiray" in walls else []),
         [POWER_LAW]))
     def case(self, request):
         return request.param

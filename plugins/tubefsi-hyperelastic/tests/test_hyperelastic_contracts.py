@@ -13,7 +13,7 @@ from tubefsi.testing import (AccuracyContract, CouplerContract, HyperelasticWall
                              coupler_cases, examples)
 from tubefsi.testing.fuzz import FuzzContract
 
-NAMES = ["thin-gent", "thick-gent", "thin-fung", "thick-fung", "thin-ogden", "thick-ogden", "thin-yeoh", "thick-yeoh"]
+NAMES = ["thin-gent", "thick-gent", "thin-demiray", "thick-demiray", "thin-ogden", "thick-ogden", "thin-yeoh", "thick-yeoh"]
 WALLS = [wall for name in NAMES for wall in examples("walls", name)]
 
 

@@ -21,7 +21,7 @@ the fibres at :math:`\pm\beta` to the circumferential direction, bearing load on
 
 :math:`\hat W''` jumps at :math:`s = 1` (the fibres engage): the small-strain modulus of
 inflation is :math:`\mu + 2k_1\cos^4\beta`, that of collapse :math:`\mu` (which sets the buckling
-bound). Like the Fung walls, :math:`k_2x^2 = 600` is the maximum stretch (beyond it
+bound). Like the Demiray walls, :math:`k_2x^2 = 600` is the maximum stretch (beyond it
 :math:`e^{k_2x^2}` overflows) and the pressure there the limit pressure. Presets:
 :data:`PRESETS` (``docs/walls_beyond.md``, section "Arterial walls").
 

@@ -201,7 +201,7 @@ def _secant_slope(wall, h, reach):
 #: The admissible axial pre-stretch: there the invariants of the installed rest state,
 #: :math:`I_1 - 3 \sim \lambda_z^2` and :math:`I_2 - 3 \sim 2/\lambda_z^2`, and the installed
 #: cross-section (:math:`1/\sqrt{\lambda_z}`) are doubles with room to spare (each material checks
-#: what its own law makes of them: Fung's and Gent's rest state, a finite installed modulus).
+#: what its own law makes of them: Demiray's and Gent's rest state, a finite installed modulus).
 AXIAL_STRETCH_RANGE = (1e-100, 1e100)
 
 

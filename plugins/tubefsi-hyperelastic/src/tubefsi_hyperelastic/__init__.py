@@ -4,7 +4,7 @@
 registered names                             parameters
 ===========================================  ==================================================
 ``thin-gent``, ``thick-gent``                shear_modulus, locking_parameter (J_m)
-``thin-fung``, ``thick-fung``                shear_modulus, stiffening (b)
+``thin-demiray``, ``thick-demiray``                shear_modulus, stiffening (b)
 ``thin-ogden``, ``thick-ogden``              moduli, exponents (any number of terms)
 ``thin-yeoh``, ``thick-yeoh``                c1, c2, c3
 ===========================================  ==================================================
@@ -13,11 +13,11 @@ Thin variants also take ``thickness_convention`` ("reference" or "current"), lik
 tubefsi finds them through the entry points of this distribution and never imports it.
 """
 
-from .fung import Fung, ThickFung, ThinFung
+from .demiray import Demiray, ThickDemiray, ThinDemiray
 from .gent import Gent, ThickGent, ThinGent
 from .ogden import Ogden, ThickOgden, ThinOgden
 from .yeoh import ThickYeoh, ThinYeoh, Yeoh
 
-__all__ = ["Gent", "ThinGent", "ThickGent", "Fung", "ThinFung", "ThickFung",
+__all__ = ["Gent", "ThinGent", "ThickGent", "Demiray", "ThinDemiray", "ThickDemiray",
            "Ogden", "ThinOgden", "ThickOgden", "Yeoh", "ThinYeoh", "ThickYeoh"]
 __version__ = "0.1.0"

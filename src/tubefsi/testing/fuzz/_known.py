@@ -117,11 +117,11 @@ def _known_probes():
         fluid = R["carreau"](**R["carreau"]._examples[0])
         out.append(Probe("solve", "known: carreau thick-gent q=1e-300", lambda f=fluid: solve(
             f, W["thick-gent"](**W["thick-gent"]._examples[0]), tube, flow_rate=1e-300)))
-    if have("carreau-yasuda", "thick-fung"):
+    if have("carreau-yasuda", "thick-demiray"):
         fluid = R["carreau-yasuda"](**R["carreau-yasuda"]._examples[0])
-        fung = W["thick-fung"](shear_modulus=1082.1, stiffening=3.1333)
+        fung = W["thick-demiray"](shear_modulus=1082.1, stiffening=3.1333)
         long = Tube(radius=3.2235e-3, thickness=3.54e-4, length=1.4378)
-        out.append(Probe("solve", "known: carreau-yasuda thick Fung q=1.734e-11",
+        out.append(Probe("solve", "known: carreau-yasuda thick Demiray q=1.734e-11",
                          lambda f=fluid, w=fung, t=long: solve(f, w, t, flow_rate=1.734e-11)))
     return out
 

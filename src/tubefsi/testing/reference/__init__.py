@@ -18,7 +18,7 @@ tubefsi.testing`` does not need mpmath. Import the modules directly:
   (thick Lamé, thin with the reference or the current thickness, thin and thick linear): the
   closed-form laws of the built-in neo-Hookean and Mooney–Rivlin walls with hand-derived
   slopes, and the laws of any material given by its three-dimensional strain energy
-  (neo-Hookean, Mooney–Rivlin, Gent, Fung, Yeoh, Ogden, Arruda–Boyce) by quadrature and Leibniz's rule; the
+  (neo-Hookean, Mooney–Rivlin, Gent, Demiray, Yeoh, Ogden, Arruda–Boyce) by quadrature and Leibniz's rule; the
   table :data:`~.tube_laws.WALLS` of the built-in walls the accuracy tests use; the stretch at a
   given pressure; :class:`~.tube_laws.HoopFibre`, a strain-stiffening user law (a neo-Hookean
   matrix with circumferential exponential fibres) written as the wall-law tutorial teaches.

@@ -8,7 +8,7 @@ walls"), at the caller's ``mp.dps``; ``P(lam)`` is the transmural pressure at th
 Materials
 ---------
 A hyperelastic material is its three-dimensional strain energy :math:`W(\lambda_1, \lambda_2,
-\lambda_3)` (:class:`NeoHookean`, :class:`MooneyRivlin`, :class:`Gent`, :class:`Fung`,
+\lambda_3)` (:class:`NeoHookean`, :class:`MooneyRivlin`, :class:`Gent`, :class:`Demiray`,
 :class:`Yeoh`, :class:`Ogden`, :class:`ArrudaBoyce` (the wall-law tutorial's); :class:`HoopFibre`, an
 anisotropic one: a neo-Hookean matrix with exponential fibres along the hoop direction). In the clamped (plane-strain) tube a point at the hoop stretch
 :math:`s` has principal stretches :math:`(1/s, s, 1)`, so :math:`\hat W(s) = W(1/s, s, 1)`
@@ -54,7 +54,7 @@ from collections.abc import Mapping
 from mpmath import mp, mpf
 
 __all__ = [
-    "Material", "NeoHookean", "MooneyRivlin", "Gent", "Fung", "HoopFibre", "Yeoh", "Ogden", "ArrudaBoyce", "Linear",
+    "Material", "NeoHookean", "MooneyRivlin", "Gent", "Demiray", "HoopFibre", "Yeoh", "Ogden", "ArrudaBoyce", "Linear",
     "Installed",
     "material_from_params", "RefWall", "KINDS", "LIMIT_KINDS", "WALLS", "stretch_at_pressure",
 ]
@@ -169,12 +169,12 @@ class Gent(Material):
         return mp.sqrt((B + mp.sqrt(B * B - 4)) / 2)
 
 
-class Fung(Material):
+class Demiray(Material):
     """W = (mu / 2b)(exp(b (I1 - 3)) - 1)."""
 
     def __init__(self, shear_modulus, stiffening):
         self.mu, self.b = mpf(shear_modulus), mpf(stiffening)
-        self._repr = f"Fung({shear_modulus!r}, {stiffening!r})"
+        self._repr = f"Demiray({shear_modulus!r}, {stiffening!r})"
 
     def W(self, l1, l2, l3):
         return self.mu / (2 * self.b) * (mp.exp(self.b * (l1**2 + l2**2 + l3**2 - 3)) - 1)

@@ -1,4 +1,8 @@
-r"""Fung walls: exponential strain stiffening, as in arteries.
+r"""Demiray walls: exponential strain stiffening, as in arteries.
+
+The isotropic exponential law of Demiray (1972), sometimes called "Fung-type"; it is not Fung's
+anisotropic arterial law (an exponential of a quadratic form in the circumferential and axial
+Green strains), whose anisotropy :mod:`tubefsi.walls.hgo` models with fibres.
 
 :math:`W = \frac{\mu}{2b}\left(e^{b(I_1 - 3)} - 1\right)`, a 3-D isotropic energy of :math:`I_1`
 alone (:math:`W_1 = \tfrac{\mu}{2}e^{b(I_1-3)}`, the natural hook ``_W1`` of
@@ -25,12 +29,12 @@ from tubefsi.walls.hyperelastic import axial_stretch
 
 from ._forms import quartic
 
-__all__ = ["Fung", "ThinFung", "ThickFung"]
+__all__ = ["Demiray", "ThinDemiray", "ThickDemiray"]
 
 
 @attrs.frozen(kw_only=True)
-class Fung(HyperelasticWall):
-    """Fung material (abstract: pick a theory, :class:`ThinFung` or :class:`ThickFung`)."""
+class Demiray(HyperelasticWall):
+    """Demiray material (abstract: pick a theory, :class:`ThinDemiray` or :class:`ThickDemiray`)."""
 
     shear_modulus: float = positive(unit="Pa", doc="small-strain shear modulus mu")
     stiffening: float = positive(doc="stiffening exponent b")
@@ -92,8 +96,8 @@ class Fung(HyperelasticWall):
 
 
 @attrs.frozen(kw_only=True)
-class ThinFung(ThinWall, Fung):
-    r"""Thin-walled Fung tube: :math:`P = \bar t\,\hat W'(\lambda)` (reference) or :math:`/\lambda` (current)."""
+class ThinDemiray(ThinWall, Demiray):
+    r"""Thin-walled Demiray tube: :math:`P = \bar t\,\hat W'(\lambda)` (reference) or :math:`/\lambda` (current)."""
 
     _examples = ({"shear_modulus": 2e3, "stiffening": 0.5},
                  {"shear_modulus": 1e4, "stiffening": 2.0, "thickness_convention": "current"},
@@ -101,7 +105,7 @@ class ThinFung(ThinWall, Fung):
 
 
 @attrs.frozen(kw_only=True)
-class ThickFung(ThickWall, Fung):
-    """Thick-walled Fung tube (exact plane-strain Lamé solution)."""
+class ThickDemiray(ThickWall, Demiray):
+    """Thick-walled Demiray tube (exact plane-strain Lamé solution)."""
 
     _examples = ({"shear_modulus": 2e3, "stiffening": 0.5}, {"shear_modulus": 3e4, "stiffening": 3.0})
