@@ -282,6 +282,9 @@ class NeoHookean(HyperelasticWall):
     axial_stretch: float = axial_stretch()
 
     def __attrs_post_init__(self):
+        mu, lz = self.shear_modulus, self.axial_stretch
+        if type(mu) is float and type(lz) is float and math.isfinite(mu / lz):
+            return                 # (the commonest wall, made in a Monte Carlo loop: no array work)
         if varies(self):           # a graded wall: its modulus is evaluated along z
             return
         with np.errstate(over="ignore"):
