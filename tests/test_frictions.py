@@ -81,3 +81,4 @@ def test_tubefsi_list_describes_a_class_by_its_own_docstring_only():
 
     assert "no docstring" in _summary(Mine) and "Thick-walled" not in _summary(Mine)
     assert _summary(Described) == "My wall, thick"
+

@@ -113,7 +113,7 @@ class ODE(Coupler):
         def rhs(z, y):
             calls[0] += 1
             if calls[0] > _MAX_EVALUATIONS:
-                raise ConvergenceError(f"{self.method} needed more than {_MAX_EVALUATIONS} steps at q = {q!r} "
+                raise ConvergenceError(f"{self.method} needed more than {_MAX_EVALUATIONS} steps at q = {float(q):.6g} "
                                        "(a stiff or nearly unbounded inflation)")
             lam = 1.0 + y[0] * strain0
             lam = min(max(lam, 1.0), lam_max * (1 - 1e-15)) if math.isfinite(lam_max) else max(lam, 1.0)
@@ -121,7 +121,7 @@ class ODE(Coupler):
                 g = float(rheo._pressure_gradient(np.asarray([q]), np.asarray([a * lam]))[0])
                 stiff = float(wall._stiffness(np.asarray(lam), tb))
             if not (math.isfinite(g) and stiff > 0):
-                raise ConvergenceError(f"the ODE left the tube law's range (stretch {lam:.3g}) at q = {q!r}")
+                raise ConvergenceError(f"the ODE left the tube law's range (stretch {lam:.3g}) at q = {float(q):.6g}")
             return [-g / stiff / strain0, -g / drop0]
 
         y0 = [scene.outlet_strain / strain0, 0.0]
@@ -130,20 +130,20 @@ class ODE(Coupler):
                 y, info = integrate.odeint(rhs, y0, [L, 0.0], tfirst=True, full_output=True,
                                            rtol=rtol, atol=atol)
                 if info["message"] != "Integration successful.":
-                    raise ConvergenceError(f"odeint failed at q = {q!r}: {info['message']}")
+                    raise ConvergenceError(f"odeint failed at q = {float(q):.6g}: {info['message']}")
                 strain, rise = y[-1]
             else:
                 sol = integrate.solve_ivp(rhs, (L, 0.0), y0, method=self.method, rtol=rtol, atol=atol)
                 if not sol.success:
-                    raise ConvergenceError(f"solve_ivp({self.method}) failed at q = {q!r}: {sol.message}")
+                    raise ConvergenceError(f"solve_ivp({self.method}) failed at q = {float(q):.6g}: {sol.message}")
                 strain, rise = sol.y[:, -1]
         except (ArithmeticError, FloatingPointError) as exc:
             if isinstance(exc, ConvergenceError):
                 raise
-            raise ConvergenceError(f"{self.method} failed at q = {q!r}: {type(exc).__name__}: {exc}") from exc
+            raise ConvergenceError(f"{self.method} failed at q = {float(q):.6g}: {type(exc).__name__}: {exc}") from exc
         strain, rise = strain * strain0, rise * drop0
         if not (np.isfinite(strain) and np.isfinite(rise)):
-            raise ConvergenceError(f"the ODE solution is not finite at q = {q!r}")
+            raise ConvergenceError(f"the ODE solution is not finite at q = {float(q):.6g}")
         return strain, rise
 
     def _shoot(self, scene, drop, lo, hi):
@@ -164,7 +164,7 @@ class ODE(Coupler):
                 hi = hi * 1.001 if not math.isfinite(q_max) else 0.5 * (hi + q_max)
                 f_hi = miss(hi)
         else:
-            raise ConvergenceError(f"{self.method}: shooting could not bracket the flow rate for Δp = {drop!r}")
+            raise ConvergenceError(f"{self.method}: shooting could not bracket the flow rate for Δp = {float(drop):.6g}")
         return optimize.brentq(miss, lo, hi, xtol=1e-300, rtol=8 * np.finfo(float).eps)
 
     def flow_controlled(self, scene, flow_rate) -> State:

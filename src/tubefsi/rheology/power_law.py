@@ -91,7 +91,7 @@ class _PowerLawForms(Rheology):
             low = float(np.min(np.where(np.asarray(factor) > 0, factor, math.inf)))
             raise FactorRangeError("pressure_drop", f"drops whose flow factor J/L = 2 m [(3n+1) q / (pi n)]^n "
                                    f"is a normal double (>= {_TINY:.3g})", None,
-                                   f"J/L = {low:.3g} underflows (n = {n!r}): the flow rate would lose its digits")
+                                   f"J/L = {low:.3g} underflows (n = {_text(n)}): the flow rate would lose its digits")
         return math.pi * n / (3.0 * n + 1.0) * (factor / (2.0 * self.consistency)) ** (1.0 / n)
 
     def _radius_factor(self, radius):
@@ -162,3 +162,8 @@ class PowerLaw(_PowerLawForms):
 
     consistency: float = positive(unit="Pa s^n", doc="consistency m")
     index: float = positive(doc="power-law index n")
+
+
+def _text(value) -> str:
+    """A number or an array in a message, as plain numbers (``0.7``, not ``np.float64(0.7)``)."""
+    return f"{float(value):.6g}" if np.ndim(value) == 0 else np.array2string(np.asarray(value, dtype=float), precision=6)
