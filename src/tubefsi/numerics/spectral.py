@@ -177,8 +177,14 @@ def solve_integral(f, target, upper, *, rtol=1e-14, values=None, degree=CHEBYSHE
     # Newton on the interpolant: quadratic, so a step below 1e-9 leaves an error of order
     # (f'/f) 1e-18 after it, and is the last one
     moving = np.ones(live.size, dtype=bool)
+    # the integral and the integrand in one Clenshaw pass (half the array operations, which a small
+    # batch pays per operation); the integrand's top coefficient is zero, so its values are the same
+    pair = np.zeros((anti.shape[0], 2, live.size))
+    pair[:, 0] = anti
+    pair[:-1, 1] = coef
     for _ in range(8):
-        step = (clenshaw(anti, t) - t_goal) / (clenshaw(coef, t) * h)
+        integral, integrand = clenshaw(pair, np.broadcast_to(t, (2, live.size)))
+        step = (integral - t_goal) / (integrand * h)
         step[~moving] = 0.0                  # a point's iterations do not depend on its neighbours'
         t = np.clip(t - step, t0, t1)
         moving &= ~(np.abs(step) <= 1e-9)

@@ -193,7 +193,10 @@ class PanelMap:
                     self.ok[live[y[0] > y_lo[live]]] = False       # (cannot happen for an increasing law)
                 live = live[good & (y[-1] < y_hi[live])]
             self.ok[live] = False                                   # (beyond MAX_PANELS)
-        self.derivative = np.polynomial.chebyshev.chebder(np.nan_to_num(self.coef), axis=0)
+        # y's coefficients and its derivative's (the top one zero), stacked for one Clenshaw pass of both
+        self.pair = np.zeros((DEGREE + 1, 2, MAX_PANELS, n))
+        self.pair[:, 0] = self.coef
+        self.pair[:-1, 1] = np.polynomial.chebyshev.chebder(np.nan_to_num(self.coef), axis=0)
 
     @staticmethod
     def _tau(rheo, g):
@@ -219,13 +222,13 @@ class PanelMap:
             yb = np.take_along_axis(nodes, k[None], axis=0)[0]
             ta, tb = t_nodes[k - 1], t_nodes[k]
             t = np.where(yb > ya, ta + (tb - ta) * (y2 - ya) / (yb - ya), ta)
-            coef = self.coef[:, j, cols]
-            der = self.derivative[:, j, cols]
+            pair = self.pair[:, :, j, cols]                          # (DEGREE + 1, 2, rows, P)
             # Newton on the interpolant, quadratic: after a step below 1e-9 the error is ~1e-18 and
             # that point stops (its iterations do not depend on its neighbours')
             moving = inside.copy()
             for _ in range(10):
-                step = (clenshaw(coef, t) - y2) / clenshaw(der, t)
+                value, slope = clenshaw(pair, np.broadcast_to(t, pair.shape[1:]))
+                step = (value - y2) / slope
                 step = np.where(moving & np.isfinite(step), step, 0.0)
                 t = np.clip(t - step, -1.0, 1.0)
                 moving &= ~(np.abs(step) <= 1e-9)
