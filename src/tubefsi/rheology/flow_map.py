@@ -29,6 +29,7 @@ unchecked. Nothing is kept between calls.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -50,6 +51,17 @@ MAX_PANELS = 24
 TOL = 1e-14
 #: Newton iterations of :class:`ClosedMap` (steps clipped to 3 in ln(tau_w - tau_y)).
 _NEWTON = 60
+
+
+@functools.lru_cache(maxsize=2)
+def _y_maps(degree):
+    """Values at the Chebyshev-Lobatto nodes -> the Chebyshev coefficients of their interpolant (rows
+    ``0..degree``) and of its derivative (the rest), in one matrix: one product per panel gives both
+    (constants of the degree, read-only)."""
+    to_coef = lobatto_rule(degree).matrix[lobatto_rule(degree).coef]
+    maps = np.vstack([to_coef, np.polynomial.chebyshev.chebder(to_coef, axis=0)])
+    maps.setflags(write=False)
+    return maps
 
 
 def _overridden(cls, name) -> bool:
@@ -151,7 +163,11 @@ class PanelMap:
         self.rule = rule
         # gamma_w >= 3 Gamma / 4 for an increasing law (K >= 0): x(y_lo) >= y_lo + ln(3/4)
         self.x0 = y_lo + math.log(0.75) - 0.01
-        self.coef = np.full((DEGREE + 1, MAX_PANELS, n), np.nan)     # Chebyshev coefficients of y, per panel
+        # Chebyshev coefficients of y per panel ([:, 0]) and of its derivative ([:, 1], the top one zero),
+        # stacked for one Clenshaw pass of both
+        self.pair = np.full((DEGREE + 1, 2, MAX_PANELS, n), np.nan)
+        self.pair[-1, 1] = 0.0
+        y_maps = _y_maps(DEGREE)
         self.y_nodes = np.full((DEGREE + 1, MAX_PANELS, n), np.nan)
         self.ok = np.isfinite(y_lo) & np.isfinite(y_hi)
         self.panels = np.zeros(n, dtype=int)
@@ -174,7 +190,8 @@ class PanelMap:
                 k_nodes = K[live] + (0.5 * WIDTH) * maps[rule.cumulative]
                 gamma = (4.0 / 3.0) * (g - k_nodes / cube)
                 y = np.log(gamma)
-                c = blocked_matmul(rule.matrix[rule.coef], y)
+                c_and_slope = blocked_matmul(y_maps, y)
+                c = c_and_slope[:DEGREE + 1]
                 # K's error: the quadrature's, and the tail of the integrand's interpolant on each panel
                 # (a tail at the rounding of the values, 32 eps of their largest, is noise: the
                 # cumulative integral then carries a few eps of the panel's integral)
@@ -185,7 +202,8 @@ class PanelMap:
                 tail = np.abs(c[-3:]).sum(axis=0)
                 good = np.all(np.isfinite(y), axis=0) & np.all(np.diff(y, axis=0) > 0, axis=0) & \
                     (err_y + tail <= TOL + 32.0 * _EPS * np.max(np.abs(y), axis=0))
-                self.coef[:, j, live], self.y_nodes[:, j, live] = c, y
+                self.pair[:, 0, j, live], self.pair[:-1, 1, j, live] = c, c_and_slope[DEGREE + 1:]
+                self.y_nodes[:, j, live] = y
                 K[live] = k_nodes[-1]
                 self.panels[live] = j + 1
                 self.ok[live[~good]] = False
@@ -193,10 +211,6 @@ class PanelMap:
                     self.ok[live[y[0] > y_lo[live]]] = False       # (cannot happen for an increasing law)
                 live = live[good & (y[-1] < y_hi[live])]
             self.ok[live] = False                                   # (beyond MAX_PANELS)
-        # y's coefficients and its derivative's (the top one zero), stacked for one Clenshaw pass of both
-        self.pair = np.zeros((DEGREE + 1, 2, MAX_PANELS, n))
-        self.pair[:, 0] = self.coef
-        self.pair[:-1, 1] = np.polynomial.chebyshev.chebder(np.nan_to_num(self.coef), axis=0)
 
     @staticmethod
     def _tau(rheo, g):
