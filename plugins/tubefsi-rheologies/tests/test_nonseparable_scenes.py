@@ -126,3 +126,27 @@ def test_one_fluid_alone_and_in_a_batch_agree():
     for i, s in enumerate(sets):
         alone = tubefsi.solve(rheologies["carreau-yasuda"](**s), wall, tube, flow_rate=[1e-8, 2e-8][i])
         assert rel_err(alone.pressure_drop, batch.pressure_drop[i]) < 1e-14
+
+
+def test_flow_map_vouches_on_the_newtonian_plateau():
+    """A Carreau-Yasuda fluid far below its transition (lambda Gamma ~ 0.1-3: the law's Newtonian
+    plateau, where the integrand of K grows e^4-fold over a panel of the map) is served by its
+    flow map: the map vouches for the wall stress (it charged the rounding of a panel's top to its
+    bottom node, refused such fluids, and left them to the much slower Newton route of the
+    coupler), and the wall stress it gives has the apparent wall shear rate Gamma =
+    (4/3)(g - K(g)/tau^3), K = int_0^g tau^3, by mpmath quadrature (30 digits) at the wall shear
+    rate g where the reference law gives that stress."""
+    from tubefsi.rheology import flow_map
+
+    p = dict(zero_shear_viscosity=0.0930, infinite_shear_viscosity=0.00509, relaxation_time=0.104,
+             index=0.556, transition=1.68)
+    ref = CarreauYasudaRef(p["zero_shear_viscosity"], p["infinite_shear_viscosity"], p["relaxation_time"],
+                           p["index"], p["transition"])
+    rates = np.array([0.5, 1.0, 3.0, 10.0, 30.0])
+    tau, ok = flow_map.wall_stress(rheologies["carreau-yasuda"](**p), rates)
+    assert ok.all()
+    for rate, t in zip(rates, tau):
+        g = mp.findroot(lambda x: ref.tau(x) - mpf(float(t)), mpf(float(rate)))
+        k = mp.quad(lambda s: ref.tau(s) ** 3, [0, g / 8, g / 2, g])
+        gamma = mpf(4) / 3 * (g - k / ref.tau(g) ** 3)
+        assert rel_err(rate, gamma) < 1e-14, (rate, float(gamma))

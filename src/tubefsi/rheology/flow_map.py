@@ -64,6 +64,18 @@ def _y_maps(degree):
     return maps
 
 
+@functools.lru_cache(maxsize=2)
+def _k_maps(degree):
+    """The maps of :func:`~tubefsi.numerics.spectral.lobatto_rule` (values -> coefficients,
+    antiderivative, cumulative integrals at the nodes), then the cumulative rows' absolute values:
+    applied to positive values, those give the sums of the terms each cumulative integral adds up,
+    the scale of its rounding (constants of the degree, read-only)."""
+    rule = lobatto_rule(degree)
+    maps = np.vstack([rule.matrix, np.abs(rule.matrix[rule.cumulative])])
+    maps.setflags(write=False)
+    return maps
+
+
 def _overridden(cls, name) -> bool:
     owners = [c for c in cls.__mro__ if name in vars(c)]
     return len(owners) > 1 and owners[0] is not owners[-1]
@@ -167,7 +179,8 @@ class PanelMap:
         # stacked for one Clenshaw pass of both
         self.pair = np.full((DEGREE + 1, 2, MAX_PANELS, n), np.nan)
         self.pair[-1, 1] = 0.0
-        y_maps = _y_maps(DEGREE)
+        y_maps, k_maps = _y_maps(DEGREE), _k_maps(DEGREE)
+        terms = slice(rule.matrix.shape[0], None)                 # the rows of k_maps beyond rule.matrix
         self.y_nodes = np.full((DEGREE + 1, MAX_PANELS, n), np.nan)
         self.ok = np.isfinite(y_lo) & np.isfinite(y_hi)
         self.panels = np.zeros(n, dtype=int)
@@ -186,21 +199,26 @@ class PanelMap:
                 g = np.exp(x)
                 tau = self._tau(r, g)
                 cube = tau * tau * tau
-                maps = blocked_matmul(rule.matrix, cube * g)       # (a point's bits independent of its batch)
+                maps = blocked_matmul(k_maps, cube * g)            # (a point's bits independent of its batch)
                 k_nodes = K[live] + (0.5 * WIDTH) * maps[rule.cumulative]
                 gamma = (4.0 / 3.0) * (g - k_nodes / cube)
                 y = np.log(gamma)
                 c_and_slope = blocked_matmul(y_maps, y)
                 c = c_and_slope[:DEGREE + 1]
-                # K's error: the quadrature's, and the tail of the integrand's interpolant on each panel
-                # (a tail at the rounding of the values, 32 eps of their largest, is noise: the
-                # cumulative integral then carries a few eps of the panel's integral)
+                # K's error at each node: the panel's start's, the tail of the integrand's interpolant
+                # (a tail at the rounding of the values, 32 eps of their largest, is noise), and the
+                # rounding of the node's own sum, a few eps of the terms it adds up (at the panel's
+                # low nodes far below its top: a Newtonian plateau's integrand grows e^4-fold over a
+                # panel, and the top's rounding charged to the bottom node failed such fluids)
                 w_tail = np.abs(maps[rule.coef][-3:]).sum(axis=0)
                 noise = w_tail <= 32.0 * _EPS * np.max(cube * g, axis=0)
-                err_k[live] += np.where(noise, 0.0, (0.5 * WIDTH) * w_tail) + 4.0 * _EPS * k_nodes[-1]
-                err_y = np.max((4.0 / 3.0) * err_k[live] / (cube * gamma), axis=0)
+                err_nodes = err_k[live] + np.where(noise, 0.0, (0.5 * WIDTH) * w_tail) + \
+                    2.0 * _EPS * (k_nodes + (0.5 * WIDTH) * maps[terms])
+                err_k[live] = err_nodes[-1]
+                err_y = np.max((4.0 / 3.0) * err_nodes / (cube * gamma), axis=0)
                 tail = np.abs(c[-3:]).sum(axis=0)
                 good = np.all(np.isfinite(y), axis=0) & np.all(np.diff(y, axis=0) > 0, axis=0) & \
+                    np.all(cube > 0, axis=0) & \
                     (err_y + tail <= TOL + 32.0 * _EPS * np.max(np.abs(y), axis=0))
                 self.pair[:, 0, j, live], self.pair[:-1, 1, j, live] = c, c_and_slope[DEGREE + 1:]
                 self.y_nodes[:, j, live] = y
