@@ -70,6 +70,19 @@ def no_solve(monkeypatch):
     (json.dumps({**NETWORK, "positions": {"a": [1]}}), ["positions['a']", "[x, y]"]),
     (json.dumps({**NETWORK, "positions": {"a": {"x": 1}}}), ["positions['a']", "[x, y]"]),
     ('{"tubes": [' + "9" * 5000 + "]}", ["is not JSON"]),                     # beyond Python's int digits
+    (json.dumps({**NETWORK, "resistances": 5}), ["resistances:", "expected an object"]),
+    (json.dumps({**NETWORK, "resistances": {"c": "x"}}), ["resistances['c']", "resistance:", "number"]),
+    (json.dumps({**NETWORK, "resistances": {"b": 0}}), ["resistances['b']", "resistance", "(0, inf)"]),
+    (json.dumps({**NETWORK, "resistances": {"b": -1e9}}), ["resistances['b']", "resistance", "(0, inf)"]),
+    (json.dumps({**NETWORK, "resistances": {"c": 1e9}}), ["resistances['c']", "one boundary condition"]),
+    (json.dumps({**NETWORK, "resistances": {"b": [1e9, 0]}}), ["resistances['b']", "resistance:", "number"]),
+    (json.dumps({**NETWORK, "resistances": {"b": {"distal_pressure": 5}}}), ["resistances['b']", "\"resistance\""]),
+    (json.dumps({**NETWORK, "resistances": {"b": {"resistance": 1e9, "distal": 5}}}),
+     ["resistances['b']", "distal_pressure"]),
+    (json.dumps({**NETWORK, "resistances": {"b": {"resistance": 1e9, "distal_pressure": "x"}}}),
+     ["resistances['b']", "distal_pressure:", "number"]),
+    (json.dumps({**NETWORK, "resistances": {"x": 1e9}}), ["resistances['x']", "no node of any tube"]),
+    (json.dumps({**NETWORK, "inflows": {"x": 1e-9}}), ["inflows['x']", "no node of any tube"]),
 ])
 def test_a_malformed_network_file_is_one_error_naming_the_place(content, words, tmp_path, capsys):
     path = tmp_path / "net.json"
@@ -107,6 +120,32 @@ def test_what_the_file_format_accepts_still_solves(tmp_path, capsys):
     net = tubefsi.Network(rheology=fluid).add_tube("a", "b", "rigid", tube, name=7).add_tube("b", "c", "rigid", tube)
     ref = net.set_pressure("a", 300.0).set_pressure("c", 0.0).solve()
     assert {t["name"]: t["flow_rate"] for t in data["tubes"]}[7] == ref.flow_rate[7]
+
+
+def test_resistance_outlets_in_the_file_are_the_librarys(tmp_path, capsys):
+    """A file's resistance outlets (a number R, or an object with a distal pressure) give the
+    network of :meth:`Network.set_resistance` to the last digit; and, as an independent check, the
+    rigid Newtonian chain a -> b -> c with c an outlet R to p_d is the series circuit: the flow
+    (p_a - p_d) / (2 R_tube + R), R_tube = 8 mu L / (pi a^4) (Poiseuille)."""
+    import math
+
+    import tubefsi
+
+    r_out, p_d = 5e11, 40.0
+    for given, distal in ((r_out, 0.0), ({"resistance": r_out, "distal_pressure": p_d}, p_d)):
+        spec = {**NETWORK, "pressures": {"a": 300}, "resistances": {"c": given}}
+        path = tmp_path / "net.json"
+        path.write_text(json.dumps(spec))
+        assert cli.main(["network", str(path)]) == 0
+        data = json.loads(capsys.readouterr().out)
+        flows = {t["name"]: t["flow_rate"] for t in data["tubes"]}
+        fluid = tubefsi.registry.rheologies["newtonian"](viscosity=1e-3)
+        tube = tubefsi.Tube(radius=1e-4, thickness=3e-5, length=1e-2)
+        net = tubefsi.Network(rheology=fluid).add_tube("a", "b", "rigid", tube, name="ab")
+        net.add_tube("b", "c", "rigid", tube).set_pressure("a", 300.0).set_resistance("c", r_out, distal)
+        assert flows["ab"] == net.solve().flow_rate["ab"]
+        r_tube = 8 * 1e-3 * 1e-2 / (math.pi * 1e-4**4)
+        assert flows["ab"] == pytest.approx((300.0 - distal) / (2 * r_tube + r_out), rel=1e-10)
 
 
 # ---------------------------------------------------------------------------- output paths

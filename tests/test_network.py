@@ -438,3 +438,36 @@ def test_the_package_pickles_by_name():
     import pickle
 
     assert pickle.loads(pickle.dumps(tubefsi)) is tubefsi
+
+
+def _carreau_yasuda_diamond(scale):
+    """A diamond with a cross edge (thick neo-Hookean walls, the plugin's Carreau–Yasuda blood
+    model) fed at 'in' and 'b'. Tube in-a's limit pressure (931.2 Pa) bounds p_in and p_a. At
+    ``scale`` = 1 no steady state exists, by hand: below it, tube a-out carries at most
+    5.46e-9 m^3/s and b-out (at p_b <= 931.2 Pa) 1.22e-9 (single-tube solves). If p_b <= p_in,
+    that is all the network can take out, short of the 1.73e-8 fed; if p_b > p_in, all that 'in'
+    receives (>= 8.72e-9) must leave through in-a and then a-out."""
+    fluid = rheologies["carreau-yasuda"](**rheologies["carreau-yasuda"]._examples[1])
+    net = Network(rheology=fluid)
+    for u, v, mu, a, t, length in [("in", "a", 4595.0, 1.923e-4, 4.32e-5, 1.135e-2),
+                                   ("in", "b", 16899.0, 1.114e-4, 3.56e-5, 5.41e-3),
+                                   ("a", "b", 15563.0, 1.307e-4, 3.03e-5, 1.683e-2),
+                                   ("a", "out", 7458.0, 1.180e-4, 1.81e-5, 1.105e-2),
+                                   ("b", "out", 5662.0, 8.93e-5, 3.58e-5, 9.21e-3)]:
+        net.add_tube(u, v, walls["thick-neo-hookean"](shear_modulus=mu), Tube(radius=a, thickness=t, length=length))
+    return net.set_inflow("in", scale * 8.72e-9).set_inflow("b", scale * 8.56e-9).set_pressure("out", 0.0)
+
+
+def test_a_non_separable_network_beyond_its_capacity_says_so_at_once():
+    """Issue 28: a Carreau–Yasuda network fed beyond what it carries crept toward the limit
+    pressure for 100 Newton iterations (~10 s) and raised ConvergenceError. Now the node pushed into
+    its bound is held there and the rest solved: the excess it keeps proves that no steady state
+    exists (contract: NoSteadyStateError naming the tube, with its finite limit pressure
+    mu ln(1 + t/a), the thick neo-Hookean limit), within 30 iterations (about 1 s)."""
+    with pytest.raises(NoSteadyStateError, match=r"tube \('in', 'a'\) reaches its limit pressure") as info:
+        _carreau_yasuda_diamond(1.0).solve(max_iterations=30)
+    assert info.value.quantity == "pressure"
+    assert info.value.limit == pytest.approx(4595.0 * math.log1p(4.32e-5 / 1.923e-4), rel=1e-12)
+    # below the capacity: a steady state whose mass balances at every free node (from the flows)
+    result = _carreau_yasuda_diamond(0.2).solve()
+    assert _worst_balance(result) < 1e-12

@@ -360,7 +360,8 @@ def _parser() -> argparse.ArgumentParser:
                        description="Solve a network (Kirchhoff over its tubes) described in FILE: "
                                    '{"rheology": "NAME:k=v,...", "tubes": [{"u": "a", "v": "b", "name": "ab", '
                                    '"wall": "NAME:k=v,...", "tube": {"radius": 1e-4, "thickness": 3e-5, '
-                                   '"length": 1e-2}}, ...], "pressures": {"a": 500, "c": 0}, "inflows": {}}. '
+                                   '"length": 1e-2}}, ...], "pressures": {"a": 500}, "inflows": {}, '
+                                   '"resistances": {"c": {"resistance": 1e11, "distal_pressure": 0}}}. '
                                    + _SCENE_HELP)
     p.add_argument("file", metavar="FILE", help="the network description (JSON)")
     p.add_argument("--format", choices=("json", "csv"), default=None,
@@ -524,7 +525,8 @@ def _cmd_curve(args, out) -> int:
 
 
 #: The keys of a network file, and of each of its tubes: required, then optional (``docs/cli.md``).
-_NETWORK_KEYS = ("rheology", "tubes", "pressures", "inflows", "positions")
+_NETWORK_KEYS = ("rheology", "tubes", "pressures", "inflows", "resistances", "positions")
+_RESISTANCE_KEYS = ("resistance", "distal_pressure")
 _TUBE_KEYS = ("u", "v", "wall", "tube")
 _TUBE_OPTIONAL = ("name", "rheology", "external_pressure")
 
@@ -558,16 +560,22 @@ def _network_from_file(path):
             net.add_tube(_node_at("u", item["u"]), _node_at("v", item["v"]), wall, _tube_at(item["tube"]), name=name,
                          rheology=rheology,
                          external_pressure=_number_at("external_pressure", item.get("external_pressure", 0.0), "Pa"))
-    for key, unit in (("pressures", "Pa"), ("inflows", "m^3/s"), ("positions", "[x, y]")):
+    for key, unit in (("pressures", "Pa"), ("inflows", "m^3/s"), ("resistances", "Pa s/m^3"),
+                      ("positions", "[x, y]")):
         entries = spec.get(key, {})
         if not isinstance(entries, dict):
             raise UsageError(f"{path!r}, {key}: expected an object {{node: {unit}}}, got {reprlib.repr(entries)}")
+        nodes = set(net.nodes)
         for node, value in entries.items():
             with _located(path, f"{key}[{node!r}]"):
+                if key != "positions" and node not in nodes:    # (else refused only by the solve, placeless)
+                    raise UsageError(f"node {node!r} is no node of any tube")
                 if key == "pressures":
                     net.set_pressure(node, _number_at("pressure", value, unit))
                 elif key == "inflows":
                     net.set_inflow(node, _number_at("inflow", value, unit))
+                elif key == "resistances":
+                    net.set_resistance(node, *_resistance_at(value))
                 elif isinstance(value, list) and len(value) == 2:
                     net.set_position(node, [_number_at("x", value[0], "plot units"),
                                             _number_at("y", value[1], "plot units")])
@@ -619,7 +627,7 @@ def _model_at(kind, models, spec):
 
 
 def _node_at(key, node):
-    # a string: the keys of 'pressures', 'inflows' and 'positions', which name nodes, are strings in JSON
+    # a string: the keys of 'pressures', 'inflows', 'resistances' and 'positions', which name nodes, are strings in JSON
     if not isinstance(node, str):
         raise UsageError(f"{key}: a node name is a string, got {reprlib.repr(node)}")
     return node
@@ -633,6 +641,19 @@ def _number_at(key, value, unit):
         return float(value)
     except OverflowError:          # an integer written out with hundreds of digits
         raise UsageError(f"{key}: {reprlib.repr(value)} is beyond the floating-point numbers ({unit})") from None
+
+
+def _resistance_at(value):
+    """``(resistance, distal_pressure)`` of a resistance outlet from a file: a number R (Pa s/m^3,
+    to a distal pressure of 0) or an object ``{"resistance": R, "distal_pressure": P}`` (P optional)."""
+    if isinstance(value, dict):
+        unknown = sorted(set(value) - set(_RESISTANCE_KEYS))
+        if unknown or "resistance" not in value:
+            raise UsageError(f"expected a resistance R (Pa s/m^3) or an object {{\"resistance\": R, "
+                             f"\"distal_pressure\": P}} (P in Pa, optional), got {reprlib.repr(value)}")
+        return (_number_at("resistance", value["resistance"], "Pa s/m^3"),
+                _number_at("distal_pressure", value.get("distal_pressure", 0.0), "Pa"))
+    return _number_at("resistance", value, "Pa s/m^3"), 0.0
 
 
 def _tube_at(geometry):

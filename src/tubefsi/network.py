@@ -77,6 +77,9 @@ _STILL = 1e-8
 _TINY = 1e-30
 #: a node this close (relative) to its bound with the step still pushing outward is at the bound
 _AT_BOUND = 1e-12
+#: a node within this (relative) of its bound whose step into it the line search must cut is held
+#: at the bound (an active set: ``_Solver._pinned_done``); farther away such a cut is a one-off
+_NEAR_BOUND = 1e-2
 
 
 @attrs.define(eq=False)
@@ -777,19 +780,35 @@ class _Solver:
         else:
             q, gu, gv, r_u, r_v = self._edges(p)
         balance = self._balance(q, p)
+        # nodes held at their bound (an active set): where Newton pushes a node into its limit
+        # pressure and the line search must cut the step, the node is held there and the rest
+        # solved; see _pinned_done
+        pinned = np.zeros(len(self.nodes), dtype=bool)
+        released = pinned.copy()          # (a node released once is not held again: no ping-pong)
+        held_from = p.copy()              # a pinned node's pressure before it was held
         for iteration in range(max_iterations + 1):
+            free = self.free
             F = balance[free]
             through = self._throughput(balance, p)
             worst = float(np.max(np.abs(F), initial=0.0))
             if worst <= rtol * through or through == 0.0 and worst == 0.0:
-                return self._result(p, q, r_u, r_v, iteration, worst / through if through else 0.0)
+                if not np.any(pinned) or self._pinned_done(pinned, balance, p, rtol * through):
+                    return self._result(p, q, r_u, r_v, iteration, worst / through if through else 0.0)
+                # a pinned node takes flow out: its pressure goes down
+                p, q, gu, gv, r_u, r_v, balance = self._release(p, pinned, released, held_from)
+                continue
             if iteration == max_iterations:
                 break
             ju = np.maximum(np.nan_to_num(gu, nan=c, posinf=c / _CLIP), _CLIP * c)
             jv = -np.maximum(np.nan_to_num(-gv, nan=c, posinf=c / _CLIP), _CLIP * c)
             step = self._linear_solve(self._jacobian(ju, jv), -F)
-            alpha = self._to_bound(p, step)
+            alpha, bounded = self._to_bound(p, step)
+            first = alpha
+            # the node a cut step would hold at its bound: within _NEAR_BOUND of it, never released
+            pin = bounded if (bounded is not None and not released[bounded]
+                              and self.p_limit[bounded] - p[bounded] <= _NEAR_BOUND * self.p_limit[bounded]) else None
             norm = float(np.linalg.norm(F))
+            release = False
             while True:
                 trial = p.copy()
                 trial[free] = np.clip(p[free] + alpha * step, 0.0, None)
@@ -802,6 +821,14 @@ class _Solver:
                 if t_balance is not None and np.linalg.norm(t_balance[free]) <= (1 - 1e-4 * alpha) * norm:
                     break
                 alpha *= 0.5
+                if alpha < 1e-10 and pin is not None:
+                    break                        # pushed into its bound without a better point: hold it there
+                if alpha < 1e-10 and np.any(pinned):
+                    # the rest stalls near its own bounds (rounding): the pinned nodes' excess
+                    # still decides where it dwarfs the rest's imbalance
+                    if not self._pinned_done(pinned, balance, p, max(rtol * through, 10 * float(np.sum(np.abs(F))))):
+                        release = True
+                        break
                 if alpha < 1e-10 and np.all(np.abs(F) <= 10 * self._noise(p, q, gu, gv)) \
                         and _share(worst, through) <= _WORST_ROUNDED:
                     warn_user(f"network: mass balance to {_share(worst, through):.1e} of the throughput, not rtol = "
@@ -812,6 +839,19 @@ class _Solver:
                     raise ConvergenceError(f"network: the line search stalled after {iteration} Newton iterations; "
                                            f"largest mass imbalance {worst:.3e} m^3/s = {_share(worst, through):.3e} of "
                                            f"the throughput (rtol {rtol:g}){_UNRESOLVED if through == 0 else ''}")
+            if release:                 # a pinned node takes flow out: its pressure goes down
+                p, q, gu, gv, r_u, r_v, balance = self._release(p, pinned, released, held_from)
+                continue
+            if pin is not None and alpha < first:
+                # the step into the bound was cut: hold the node at its bound (to _AT_BOUND)
+                if alpha < 1e-10:
+                    trial = p.copy()
+                pinned[pin] = True
+                held_from[pin] = trial[pin]
+                trial[pin] = (1.0 - _AT_BOUND) * self.p_limit[pin]
+                self._unknowns(self.unknown & ~pinned)
+                t_q, t_gu, t_gv, t_ru, t_rv = self._edges(trial)
+                t_balance = self._balance(t_q, trial)
             p, q, gu, gv, r_u, r_v, balance = trial, t_q, t_gu, t_gv, t_ru, t_rv, t_balance
             if shown is not None:
                 shown.update()
@@ -853,9 +893,44 @@ class _Solver:
         supplied = np.where(self.fixed, -balance, self._supplied(p))
         return float(np.sum(np.maximum(supplied, 0.0)))
 
+    def _release(self, p, pinned, released, held_from):
+        """Let the pinned nodes go, back to their pressures before they were held (Newton's
+        iterate from the bound itself would start among enormous conductances); the new state."""
+        p = p.copy()
+        p[pinned] = held_from[pinned]
+        released |= pinned
+        pinned[:] = False
+        self._unknowns(~self.fixed & ~self.feeds)
+        q, gu, gv, r_u, r_v = self._edges(p)
+        return p, q, gu, gv, r_u, r_v, self._balance(q, p)
+
+    def _pinned_done(self, pinned, balance, p, tolerance):
+        """At a solution of the other nodes with the ``pinned`` ones at their limit pressures:
+        False where a pinned node takes flow out (a negative excess: its pressure goes down, so
+        it is released); True where they balance (a steady state at the bound); raises where they
+        keep an excess. Why that excess means no steady state: a tube's flow rises with its inlet
+        pressure and falls with its outlet one, so raising some nodes' pressures to their limits
+        raises every other free node's pressure, and with them what the fixed nodes and the
+        resistance outlets take out; the free nodes' total excess can then only fall. A steady
+        state below the limits would thus leave the pinned nodes' total excess <= 0."""
+        excess = balance[pinned]
+        if np.any(excess < -tolerance):
+            return False
+        if float(np.sum(excess)) <= tolerance:
+            return True
+        nodes = np.flatnonzero(pinned)
+        i = int(nodes[np.argmax(excess)])
+        tube = self._limiting_tube(i)
+        raise NoSteadyStateError("pressure", float(self.p_limit[i]), float(p[i]),
+                                 f"tube {tube!r} reaches its limit pressure at node {self.nodes[i]!r} (to "
+                                 f"{_AT_BOUND:g} relative): held there, the network still leaves "
+                                 f"{float(np.sum(excess)):.6g} m^3/s it cannot carry, so no steady state "
+                                 f"below it carries these inflows")
+
     def _to_bound(self, p, step):
-        """The largest step fraction (<= 1) that goes at most 90 % of the way to a bound; raises
-        when a node sits at a bound and the step still pushes outward."""
+        """The largest step fraction (<= 1) that goes at most 90 % of the way to a bound, and the
+        node whose limit pressure sets it (None where none does); raises when a node sits at a
+        bound and the step still pushes outward."""
         pf, lim = p[self.free], self.p_limit[self.free]
         up = step > 0
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -865,7 +940,7 @@ class _Solver:
         frac = np.where(step == 0, np.inf, frac)
         i = int(np.argmin(frac))
         if frac[i] >= 1:
-            return 1.0
+            return 1.0, None
         node = int(self.free[i])
         if up[i] and gap_up[i] <= _AT_BOUND * lim[i]:
             tube = self._limiting_tube(node)
@@ -876,7 +951,7 @@ class _Solver:
             raise InvalidParameterError("inflow", "inflows that keep every pressure >= 0 (tubefsi models "
                                         "inflation, not collapse)", self.nodes[node],
                                         f"node {self.nodes[node]!r} would need a negative transmural pressure")
-        return float(frac[i])
+        return float(frac[i]), (node if up[i] else None)
 
 
 #: Why a network can have no resolvable throughput: tubes in series whose conductances differ by
