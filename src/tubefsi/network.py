@@ -58,7 +58,7 @@ from . import validity
 from .errors import (AccuracyWarning, ConvergenceError, InvalidParameterError, NoSteadyStateError, warn_user)
 from .fields import broadcast_model, varies, _array_fields, parameter_shape
 from .geometry import Tube
-from .network_solution import NetworkSolution
+from .network_solution import NetworkSolution, _hashable
 from .rheology.base import Rheology
 from .scene import make_scene, resolve
 from .solve import max_flow_rate as tubefsi_max_flow
@@ -999,10 +999,3 @@ def _names_of(label, values) -> list:
             raise InvalidParameterError(f"{label}[{k}]", "a hashable name", x)
     return values
 
-
-def _hashable(x) -> bool:
-    try:
-        hash(x)
-    except TypeError:
-        return False
-    return True
