@@ -81,6 +81,11 @@ def clenshaw(coef, t):
     return b1
 
 
+#: Batches of at most this many points evaluate an interpolant and its derivative in one pass
+#: (the same bits either way; only the time differs).
+_PAIRED_BELOW = 2048
+
+
 def solve_integral(f, target, upper, *, rtol=1e-14, values=None, degree=CHEBYSHEV_DEGREE):
     r"""Solve :math:`\int_0^{x} f(u)\,du = T` for :math:`x \in (0, X]`, per point, from one
     batch of integrand values: a Chebyshev interpolant on ``[0, X]``, integrated exactly.
@@ -177,13 +182,19 @@ def solve_integral(f, target, upper, *, rtol=1e-14, values=None, degree=CHEBYSHE
     # Newton on the interpolant: quadratic, so a step below 1e-9 leaves an error of order
     # (f'/f) 1e-18 after it, and is the last one
     moving = np.ones(live.size, dtype=bool)
-    # the integral and the integrand in one Clenshaw pass (half the array operations, which a small
-    # batch pays per operation); the integrand's top coefficient is zero, so its values are the same
-    pair = np.zeros((anti.shape[0], 2, live.size))
-    pair[:, 0] = anti
-    pair[:-1, 1] = coef
+    # a small batch pays per array operation: the integral and the integrand in one Clenshaw pass
+    # halve them (the integrand's top coefficient is zero, so its values are the same bits); a
+    # large batch is faster in two passes over contiguous rows
+    paired = live.size <= _PAIRED_BELOW
+    if paired:
+        pair = np.zeros((anti.shape[0], 2, live.size))
+        pair[:, 0] = anti
+        pair[:-1, 1] = coef
     for _ in range(8):
-        integral, integrand = clenshaw(pair, np.broadcast_to(t, (2, live.size)))
+        if paired:
+            integral, integrand = clenshaw(pair, np.broadcast_to(t, (2, live.size)))
+        else:
+            integral, integrand = clenshaw(anti, t), clenshaw(coef, t)
         step = (integral - t_goal) / (integrand * h)
         step[~moving] = 0.0                  # a point's iterations do not depend on its neighbours'
         t = np.clip(t - step, t0, t1)
