@@ -165,12 +165,7 @@ class Network:
         if name in self._tubes:
             raise InvalidParameterError("name", "a name no other tube has", name,
                                         "tubes between the same two nodes need distinct names")
-        wall = resolve("wall", wall)
-        fluid = self.rheology if rheology is None else resolve("rheology", rheology)
-        if fluid is None:
-            raise InvalidParameterError("rheology", "a fluid, here or in Network(rheology=...)", None)
-        if not isinstance(tube, Tube):
-            raise InvalidParameterError("tube", "a tubefsi.Tube", tube)
+        wall, tube, fluid = self._models(wall, tube, rheology)
         for label, model in (("wall", wall), ("rheology", fluid), ("tube", tube)):
             if parameter_shape(model) != ():
                 raise InvalidParameterError(label, "scalar parameters (one tube per add_tube)", model)
@@ -184,6 +179,17 @@ class Network:
             self._nodes.setdefault(node, len(self._nodes))
         self._tubes[name] = _Tube(name, u, v, wall, tube, fluid, float(p_e))
         return self
+
+    def _models(self, wall, tube, rheology):
+        """``(wall, tube, fluid)`` of a tube to add: the models resolved (the network's fluid
+        by default), the tube a :class:`~tubefsi.Tube`."""
+        wall = resolve("wall", wall)
+        fluid = self.rheology if rheology is None else resolve("rheology", rheology)
+        if fluid is None:
+            raise InvalidParameterError("rheology", "a fluid, here or in Network(rheology=...)", None)
+        if not isinstance(tube, Tube):
+            raise InvalidParameterError("tube", "a tubefsi.Tube", tube)
+        return wall, tube, fluid
 
     @checked_keywords
     def add_tubes(self, u, v, wall, tube, *, names=None, rheology=None, external_pressure=0.0):
@@ -214,12 +220,7 @@ class Network:
                 raise InvalidParameterError(f"names[{k}]", "a name no other tube has", name,
                                             "tubes between the same two nodes need distinct names")
             seen.add(name)
-        wall = resolve("wall", wall)
-        fluid = self.rheology if rheology is None else resolve("rheology", rheology)
-        if fluid is None:
-            raise InvalidParameterError("rheology", "a fluid, here or in Network(rheology=...)", None)
-        if not isinstance(tube, Tube):
-            raise InvalidParameterError("tube", "a tubefsi.Tube", tube)
+        wall, tube, fluid = self._models(wall, tube, rheology)
         models = []
         for label, model in (("wall", wall), ("tube", tube), ("rheology", fluid)):
             if parameter_shape(model) not in ((), (n,)):
