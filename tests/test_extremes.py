@@ -14,6 +14,7 @@ from tubefsi import InvalidParameterError, Tube, registry, solve
 from tubefsi.rheology import Rheology
 from tubefsi.testing.fuzz import bad_input_probes, run_probe
 from tubefsi.walls.hyperelastic import AXIAL_STRETCH_RANGE
+from tubefsi.testing.reference import rel_err as rel
 
 W, R = registry.walls, registry.rheologies
 MAX = float(np.finfo(float).max)
@@ -24,9 +25,6 @@ def _digits():
     with mp.workdps(40):
         yield
 
-
-def rel(value, reference):
-    return abs(mpf(value) - reference) / abs(reference)
 
 
 # ------------------------------------------------------------------ walls: stiffness at stretch 1e300

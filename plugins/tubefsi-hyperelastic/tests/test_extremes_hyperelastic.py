@@ -12,6 +12,7 @@ from tubefsi import InvalidParameterError, Tube, solve
 from tubefsi.registry import walls
 from tubefsi.rheology import Rheology
 from tubefsi.testing.fuzz import bad_input_probes, run_probe
+from tubefsi.testing.reference import rel_err as rel
 
 MAX = float(np.finfo(float).max)
 PLUGIN_WALLS = [n for n in walls if walls[n].__module__.startswith("tubefsi_hyperelastic")]
@@ -22,9 +23,6 @@ def _digits():
     with mp.workdps(40):
         yield
 
-
-def rel(value, reference):
-    return abs(mpf(value) - reference) / abs(reference)
 
 
 def ogden_term_slope(c, a, s):

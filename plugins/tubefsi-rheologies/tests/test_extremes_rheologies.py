@@ -10,6 +10,7 @@ from mpmath import mp, mpf, sqrt
 from tubefsi import InvalidParameterError, Tube, solve
 from tubefsi.registry import rheologies, walls
 from tubefsi.testing.fuzz import bad_input_probes, run_probe
+from tubefsi.testing.reference import rel_err as rel
 
 MAX = float(np.finfo(float).max)
 PLUGIN_FLUIDS = [n for n in rheologies if rheologies[n].__module__.startswith("tubefsi_rheologies")]
@@ -20,9 +21,6 @@ def _digits():
     with mp.workdps(40):
         yield
 
-
-def rel(value, reference):
-    return abs(mpf(value) - reference) / abs(reference)
 
 
 def casson_velocity(r, radius, g, ty, mu):
