@@ -33,6 +33,7 @@ __all__ = [
     "advise", "Advice", "Diagnostics", "ModelValidityWarning", "fit", "FitResult", "Network", "NetworkSolution",
     "TubefsiError", "InvalidParameterError", "KeywordError", "NoSteadyStateError", "ConvergenceError", "AccuracyWarning",
     "StretchRangeError", "BucklingError", "FitWarning", "Profile", "sampled", "Problem", "cache_clear", "cache_info",
+    "read_network_table", "write_network_table", "datasets",
 ]
 
 __version__ = "0.1.0"
@@ -46,6 +47,7 @@ _LAZY = {
     "advise": "advise", "Advice": "advise", "Diagnostics": "advise",
     "fit": "fit", "FitResult": "fit",
     "Network": "network", "NetworkSolution": "network",
+    "read_network_table": "network_io", "write_network_table": "network_io", "datasets": None,
 }
 
 
@@ -56,6 +58,8 @@ if _typing.TYPE_CHECKING:      # never run: tells type checkers what the lazy na
     from .fit import FitResult, fit
     from .geometry import Tube
     from .network import Network, NetworkSolution
+    from .network_io import read_network_table, write_network_table
+    from . import datasets
     from .profiles import Profile, sampled
     from .solution import Solution
     from .solve import Problem, max_flow_rate, select_coupler, solve

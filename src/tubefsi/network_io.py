@@ -1,0 +1,728 @@
+r"""Networks from and to files (``docs/network.md``, "Files").
+
+* **The vascular table form** of the one-dimensional blood-flow community (openBF's model
+  tables): one row per vessel, ``Name, sn, tn, wkn, l(m), M, Rp(m), Rd(m), E(Pa), Pext, R1, R2,
+  C``. :func:`read_network_table` makes a :class:`~tubefsi.Network` of it,
+  :func:`write_network_table` writes one back.
+* **VTK polylines** (``.vtp``, VTK's XML PolyData): the nodes are points, every tube a line
+  cell with its radius, thickness, length and (given a solution) its results as cell data;
+  :func:`write_vtp` and :func:`read_vtp`, for ParaView and other tools.
+* :func:`tree_layout`: node positions for drawing and for the points of a ``.vtp`` when the
+  network has none (:meth:`~tubefsi.Network.set_position`).
+
+A row's wall is made by a factory ``wall(E, h, R)`` of its elastic modulus, its wall thickness
+and its radius (default: :func:`openbf_wall`, the thin linear elastic wall of openBF's tube law);
+a table without a thickness column takes openBF's empirical thickness :func:`empirical_thickness`.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+import re
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse import csgraph
+
+from ._keywords import checked_keywords
+from .errors import InvalidParameterError
+from .geometry import Tube
+from .network import Network
+from .network_solution import NetworkSolution
+from .profiles import Profile, sampled
+from .registry import walls as _walls
+from .scene import resolve
+from .walls.base import WallModel
+
+__all__ = ["read_network_table", "write_network_table", "network_table", "empirical_thickness", "openbf_wall",
+           "write_vtp", "read_vtp", "tree_layout"]
+
+#: openBF's empirical wall thickness, h = R (a exp(b R) + c exp(d R)) with R in m: a, b (1/m), c, d (1/m)
+#: (Avolio 1980; as used by Blanco et al. 2015 for ADAN)
+THICKNESS_COEFFICIENTS = (0.2802, -505.3, 0.1324, -11.14)
+
+#: column -> (unit it may be given in, required, default); units are SI only
+_COLUMNS = {
+    "name": (None, True, None), "sn": (None, True, None), "tn": (None, True, None),
+    "wkn": (None, False, None), "m": (None, False, None), "c": ("m^3/pa", False, None),
+    "l": ("m", True, None), "rp": ("m", True, None), "rd": ("m", False, None), "e": ("pa", False, None),
+    "h": ("m", False, None), "pext": ("pa", False, 0.0), "r1": ("pas/m^3", False, 0.0),
+    "r2": ("pas/m^3", False, 0.0),
+}
+#: the spellings of a unit that are read as the SI unit above
+_UNIT_SPELLINGS = {"pas/m3": "pas/m^3", "pa.s/m^3": "pas/m^3", "pa*s/m^3": "pas/m^3", "m3/pa": "m^3/pa"}
+#: the header the writer writes (openBF's, with an optional thickness column h(m) after E(Pa))
+_HEADER = ["Name", "sn", "tn", "wkn", "l(m)", "M", "Rp(m)", "Rd(m)", "E(Pa)", "Pext", "R1", "R2", "C"]
+
+
+# ---------------------------------------------------------------------------- the wall
+def empirical_thickness(radius):
+    r"""openBF's empirical wall thickness of an artery of radius ``radius`` (m, array-like):
+
+    .. math::  h = R\,\bigl(a\,e^{bR} + c\,e^{dR}\bigr),\quad a = 0.2802,\ b = -5.053\ \mathrm{cm}^{-1},
+               \ c = 0.1324,\ d = -0.1114\ \mathrm{cm}^{-1}
+
+    (Avolio, *Med. Biol. Eng. Comput.* 18:709–718, 1980; used by Blanco et al., *IEEE Trans.
+    Biomed. Eng.* 62:736–753, 2015, for ADAN). It gives h/R of about 0.41 at 0.1 mm and 0.11 at
+    16 mm (the aortic root)."""
+    a, b, c, d = THICKNESS_COEFFICIENTS
+    r = np.asarray(radius, dtype=float)
+    return r * (a * np.exp(b * r) + c * np.exp(d * r))
+
+
+def openbf_wall(youngs_modulus, thickness=None, radius=None):
+    r"""The default wall of a table row: openBF's tube law, the thin linear elastic wall
+    :math:`p = \frac{E h}{(1-\nu^2) R_0}\,(R/R_0 - 1)` with :math:`\nu = 1/2`, i.e.
+    ``walls["thin-linear"](youngs_modulus=E, poisson_ratio=0.5)`` (closed and clamped ends agree
+    at :math:`\nu = 1/2`). ``thickness`` and ``radius`` are not needed (the tube carries them).
+    Arrays give one wall per vessel."""
+    return _walls["thin-linear"](youngs_modulus=youngs_modulus, poisson_ratio=0.5)
+
+
+def _wall_maker(wall):
+    """``wall`` as a factory ``(E, h, R) -> WallModel``, and whether it needs the column E."""
+    if wall is None:
+        return openbf_wall, True
+    if isinstance(wall, (str, WallModel)) or (isinstance(wall, type) and issubclass(wall, WallModel)):
+        model = resolve("wall", wall)
+        return (lambda E, h, R: model), False
+    if callable(wall):
+        return wall, True
+    raise InvalidParameterError("wall", "a wall model (instance, class or registered name) or a callable "
+                                "wall(E, h, R) returning one", wall)
+
+
+# ---------------------------------------------------------------------------- reading the table
+class _Table:
+    """The raw cells of a table: ``columns`` (normalized name -> list of cells), ``where[k]``
+    (how row ``k`` is called in a message: a line of a file, a row of a DataFrame), ``source``."""
+
+    def __init__(self, source, header, rows, where):
+        self.source, self.where = source, where
+        self.columns = {}
+        self.spelled = {}
+        for j, raw in enumerate(header):
+            key, unit = _column_key(raw)
+            if key not in _COLUMNS:
+                raise InvalidParameterError(f"{source}, column {raw!r}", f"one of the table's columns "
+                                            f"({', '.join(_HEADER)}, h(m))", raw)
+            expected = _COLUMNS[key][0]
+            if unit is not None and _UNIT_SPELLINGS.get(unit, unit) != expected:
+                raise InvalidParameterError(f"{source}, column {raw!r}", f"SI units ({expected or 'none'})", raw)
+            if key in self.columns:
+                raise InvalidParameterError(f"{source}, column {raw!r}", "a column named once", raw)
+            self.columns[key] = [row[j] for row in rows]
+            self.spelled[key] = raw
+        for key, (_, required, _) in _COLUMNS.items():
+            if required and key not in self.columns:
+                raise InvalidParameterError(f"{source}", f"a table with a column {key!r}", list(header))
+
+    def error(self, key, k, admissible, value):
+        return InvalidParameterError(f"{self.source}, {self.where[k]}, column {self.spelled[key]!r}", admissible,
+                                     value)
+
+    def numbers(self, key, admissible, predicate, default=None):
+        """Column ``key`` as floats (a missing or empty cell takes ``default``); the first cell
+        that is no number or fails ``predicate`` is an error naming its row and column."""
+        cells = self.columns.get(key)
+        n = len(self.where)
+        if cells is None:
+            if default is None:
+                return None
+            return np.full(n, float(default))
+        values = np.empty(n)
+        for k, cell in enumerate(cells):            # a cell is text (a file) or a number (a DataFrame)
+            text = cell.strip() if isinstance(cell, str) else cell
+            if text == "" or text is None or (isinstance(text, float) and math.isnan(text)):
+                if default is None:
+                    raise self.error(key, k, admissible, "an empty cell")
+                values[k] = default
+                continue
+            try:
+                values[k] = float(text)
+            except (TypeError, ValueError):
+                raise self.error(key, k, admissible, text) from None
+        with np.errstate(invalid="ignore"):
+            bad = ~(np.isfinite(values) & predicate(values))
+        if np.any(bad):
+            k = int(np.flatnonzero(bad)[0])
+            raise self.error(key, k, admissible, cells[k])
+        return values
+
+    def names(self, key):
+        """Column ``key`` as node or vessel names: integers where a cell is one, else its text."""
+        out = []
+        for k, cell in enumerate(self.columns[key]):
+            if isinstance(cell, (int, np.integer)) and not isinstance(cell, bool):
+                out.append(int(cell))
+                continue
+            text = str(cell).strip() if cell is not None else ""
+            if text == "" or text == "nan":
+                raise self.error(key, k, "a name (not empty)", "an empty cell")
+            out.append(int(text) if re.fullmatch(r"[+-]?\d+", text) else text)
+        return out
+
+
+def _column_key(raw):
+    """``"Rp(m)"`` -> ``("rp", "m")``; ``" sn"`` -> ``("sn", None)``."""
+    text = str(raw).strip()
+    match = re.fullmatch(r"([^()]*?)\s*(?:\(([^()]*)\))?", text)
+    name, unit = (match.group(1), match.group(2)) if match else (text, None)
+    return name.strip().lower(), (None if unit is None else unit.replace(" ", "").lower())
+
+
+def _read_csv(path):
+    """The header, the rows and their line numbers of a CSV file; ``#`` starts a comment line;
+    a trailing empty column (openBF's rows end with a comma) is dropped."""
+    with open(path, newline="", encoding="utf-8") as fh:
+        lines = [(i + 1, line) for i, line in enumerate(fh) if line.strip() and not line.lstrip().startswith("#")]
+    label = Path(path).name
+    if not lines:
+        raise InvalidParameterError(label, "a table with a header and at least one row", "an empty file")
+    parsed = [(i, row) for i, row in zip((i for i, _ in lines), csv.reader(line for _, line in lines))]
+    header = parsed[0][1]
+    while header and header[-1].strip() == "":
+        header = header[:-1]
+    rows, where = [], []
+    for i, row in parsed[1:]:
+        extra = row[len(header):]
+        if any(cell.strip() for cell in extra):
+            raise InvalidParameterError(f"{label}, line {i}", f"{len(header)} cells, one per column of the header",
+                                        len(row))
+        if len(row) < len(header):
+            raise InvalidParameterError(f"{label}, line {i}", f"{len(header)} cells, one per column of the header",
+                                        len(row))
+        rows.append(row[:len(header)])
+        where.append(f"line {i}")
+    if not rows:
+        raise InvalidParameterError(label, "a table with a header and at least one row", "a header only")
+    return _Table(label, header, rows, where)
+
+
+def _read_frame(frame):
+    header = [str(c) for c in frame.columns]
+    rows = [list(r) for r in frame.itertuples(index=False, name=None)]
+    if not rows:
+        raise InvalidParameterError("DataFrame", "a table with at least one row", "no rows")
+    return _Table("DataFrame", header, rows, [f"row {k}" for k in range(len(rows))])
+
+
+@checked_keywords
+def read_network_table(source, *, rheology=None, wall=None, thickness=None, distal_pressure=0.0, taper="linear"):
+    r"""A :class:`~tubefsi.Network` from a table of vessels (the openBF model table form).
+
+    Parameters
+    ----------
+    source : str, path or pandas.DataFrame
+        A CSV file (lines starting with ``#`` are comments) or a DataFrame with the same columns.
+        One row per vessel; the columns (case and spaces do not matter, a unit in parentheses
+        must be the SI one given here):
+
+        ============  ==============================================================
+        ``Name``      the vessel's (tube's) name
+        ``sn, tn``    source and target node (integers stay integers)
+        ``l(m)``      length
+        ``Rp(m)``     proximal (inlet) radius
+        ``Rd(m)``     distal radius (optional: ``Rp``)
+        ``E(Pa)``     elastic modulus (needed by the default wall)
+        ``h(m)``      wall thickness (optional: :func:`empirical_thickness`, or ``thickness``)
+        ``Pext``      external pressure (Pa, optional: 0)
+        ``R1, R2``    terminal resistances (Pa s/m^3, optional: 0); ``R1 + R2 > 0`` makes
+                      ``tn`` a resistance outlet, :meth:`~tubefsi.Network.set_resistance`
+        ``C``         terminal compliance (m^3/Pa): ignored, it carries no flow at steady state
+        ``wkn, M``    openBF's Windkessel label and mesh points: ignored
+        ============  ==============================================================
+
+    rheology : model, class or registered name, optional
+        The fluid (``Network(rheology=...)``).
+    wall : callable, model, class or registered name, optional
+        A wall model shared by every vessel, or a factory ``wall(E, h, R)`` of the vessel's
+        modulus, thickness and proximal radius returning its wall (called with arrays, one
+        entry per vessel, for runs of uniform vessels). Default :func:`openbf_wall`.
+    thickness : callable, optional
+        Without an ``h(m)`` column: the thickness as a function of the radius (arrays in,
+        arrays out); default :func:`empirical_thickness`.
+    distal_pressure : float
+        The distal pressure (Pa) of every resistance outlet (the venous pressure; default 0).
+    taper : {"linear", "mean"}
+        A vessel with ``Rp != Rd``: ``"linear"`` makes a tapered :class:`~tubefsi.Tube` whose
+        radius runs linearly from ``Rp`` to ``Rd`` (a :func:`~tubefsi.sampled` linear profile,
+        the thickness following the radius); ``"mean"`` a uniform tube of the mean radius.
+
+    Returns
+    -------
+    Network
+        Its tubes in the order of the rows, named by ``Name``; the inlet (an inflow or a
+        pressure) is yours to set, e.g. ``net.set_inflow(1, 8.3e-5)``.
+
+    Raises
+    ------
+    InvalidParameterError
+        A malformed table: the message names the file, the line (or the DataFrame's row) and
+        the column.
+    """
+    if taper not in ("linear", "mean"):
+        raise InvalidParameterError("taper", "'linear' or 'mean'", taper)
+    if isinstance(source, (str, os.PathLike)):
+        table = _read_csv(source)
+    elif hasattr(source, "columns") and hasattr(source, "itertuples"):
+        table = _read_frame(source)
+    else:
+        raise InvalidParameterError("source", "a path to a CSV file or a pandas.DataFrame", source)
+    make_wall, needs_e = _wall_maker(wall)
+    if thickness is not None and not callable(thickness):
+        raise InvalidParameterError("thickness", "a function of the radius (m -> m)", thickness)
+    p_d = float(np.asarray(distal_pressure, dtype=float)) if np.ndim(distal_pressure) == 0 else math.nan
+    if not math.isfinite(p_d):
+        raise InvalidParameterError("distal_pressure", "a finite number (Pa)", distal_pressure)
+
+    names = table.names("name")
+    sn, tn = table.names("sn"), table.names("tn")
+    length = table.numbers("l", "(0, inf) m", lambda a: a > 0)
+    rp = table.numbers("rp", "(0, inf) m", lambda a: a > 0)
+    rd = table.numbers("rd", "(0, inf) m", lambda a: a > 0) if "rd" in table.columns else rp.copy()
+    if needs_e and "e" not in table.columns:
+        raise InvalidParameterError(table.source, "a column E(Pa) (the default wall needs the elastic modulus; "
+                                    "or give wall=)", list(table.spelled.values()))
+    modulus = table.numbers("e", "(0, inf) Pa", lambda a: a > 0) if "e" in table.columns else \
+        np.full(len(names), math.nan)
+    h = table.numbers("h", "(0, inf) m", lambda a: a > 0) if "h" in table.columns else None
+    p_ext = table.numbers("pext", "finite numbers (Pa)", lambda a: a == a, default=0.0)
+    r1 = table.numbers("r1", "[0, inf) Pa s/m^3", lambda a: a >= 0, default=0.0)
+    r2 = table.numbers("r2", "[0, inf) Pa s/m^3", lambda a: a >= 0, default=0.0)
+    seen = {}
+    for k, (name, a, b) in enumerate(zip(names, sn, tn)):
+        if a == b:
+            raise table.error("tn", k, "a node other than sn (a vessel joins two nodes)", b)
+        if name in seen:
+            raise table.error("name", k, f"a name no other vessel has ({table.where[seen[name]]} has it)", name)
+        seen[name] = k
+    rule = empirical_thickness if thickness is None else thickness
+    if taper == "mean":
+        rp = rd = 0.5 * (rp + rd)
+    tapered = rp != rd
+    h0 = np.asarray(rule(rp), dtype=float) if h is None else h
+    if h is None and not np.all(np.isfinite(h0) & (h0 > 0)):
+        k = int(np.flatnonzero(~(np.isfinite(h0) & (h0 > 0)))[0])
+        raise table.error("rp", k, "a radius whose thickness(radius) is a positive number", rp[k])
+
+    net = Network(rheology=rheology)
+    # runs of consecutive rows, uniform or tapered: the uniform ones in one add_tubes each (the
+    # order of the rows is kept)
+    cuts = np.flatnonzero(np.diff(tapered.astype(np.int8))) + 1
+    for run in np.split(np.arange(len(names)), cuts):
+        if not tapered[run[0]]:
+            net.add_tubes([sn[k] for k in run], [tn[k] for k in run], make_wall(modulus[run], h0[run], rp[run]),
+                          Tube(radius=rp[run], thickness=h0[run], length=length[run]),
+                          names=[names[k] for k in run], external_pressure=p_ext[run])
+            continue
+        for k in run:
+            radius = sampled([0.0, length[k]], [rp[k], rd[k]], kind="linear")
+            wall_thickness = float(h[k]) if h is not None else Profile(_ThicknessOf(rule, rp[k], rd[k], length[k]))
+            net.add_tube(sn[k], tn[k], make_wall(float(modulus[k]), float(h0[k]), float(rp[k])),
+                         Tube(radius=radius, thickness=wall_thickness, length=float(length[k])), name=names[k],
+                         external_pressure=float(p_ext[k]))
+    terminal = np.flatnonzero(r1 + r2 > 0)
+    outlets = {}
+    for k in terminal:
+        if tn[k] in outlets:
+            raise table.error("r1", k, f"one terminal resistance per node ({table.where[outlets[tn[k]]]} gives "
+                              f"node {tn[k]!r} one)", r1[k])
+        outlets[tn[k]] = k
+        net.set_resistance(tn[k], float(r1[k] + r2[k]), distal_pressure=p_d)
+    return net
+
+
+class _ThicknessOf:
+    """The thickness of a linearly tapered vessel, ``rule(a(z))`` with ``a`` linear from ``rp``
+    at 0 to ``rd`` at ``length`` (a callable for :class:`~tubefsi.Profile`)."""
+
+    def __init__(self, rule, rp, rd, length):
+        self.rule, self.rp, self.rd, self.length = rule, float(rp), float(rd), float(length)
+        self.__name__ = "thickness(radius(z))"
+
+    def __call__(self, z):
+        a = self.rp + (self.rd - self.rp) * np.asarray(z, dtype=float) / self.length
+        return np.asarray(self.rule(a), dtype=float)
+
+
+# ---------------------------------------------------------------------------- writing the table
+def _ends(tube):
+    """``(a(0), a(L), t(0), t(L), L)`` of a tube (uniform or graded)."""
+    length = float(tube.length)
+    a, t = tube.at(np.array([0.0, length]))
+    a, t = np.broadcast_to(np.asarray(a, dtype=float), (2,)), np.broadcast_to(np.asarray(t, dtype=float), (2,))
+    return float(a[0]), float(a[1]), float(t[0]), float(t[1]), length
+
+
+def _tubes(network):
+    """``(name, u, v, wall, tube, external pressure)`` per tube, in the network's order."""
+    if not isinstance(network, Network):
+        raise InvalidParameterError("network", "a tubefsi.Network", network)
+    return [(t.name, t.u, t.v, *t.models()[:2], t.external_pressure) for t in network._tubes.values()]
+
+
+@checked_keywords
+def network_table(network, *, thickness="auto") -> dict:
+    """The table form of ``network`` as columns (header -> list), the columns of
+    :func:`write_network_table` (``pandas.DataFrame(network_table(net))`` takes them).
+
+    ``E(Pa)`` is each wall's ``youngs_modulus`` (a wall without one is an error: the table form
+    holds linear elastic walls); ``R1`` the terminal resistance of a resistance outlet at the
+    vessel's target node, ``R2 = C = 0`` (the table keeps only the steady state); ``M`` one mesh
+    point per millimetre (openBF's usual, at least 5). ``thickness``: ``"auto"`` writes an
+    ``h(m)`` column unless every thickness is :func:`empirical_thickness` of its radius, which
+    the reader recomputes; ``True`` always writes it (tapered vessels then need a constant
+    thickness), ``False`` never.
+    """
+    if thickness not in ("auto", True, False):
+        raise InvalidParameterError("thickness", "'auto', True or False", thickness)
+    rows = _tubes(network)
+    resistance = network._resistance
+    columns = {key: [] for key in _HEADER}
+    h_p, h_d, r_p, r_d = [], [], [], []
+    written = set()
+    for name, u, v, wall, tube, p_ext in rows:
+        a0, a1, t0, t1, length = _ends(tube)
+        modulus = getattr(wall, "youngs_modulus", None)
+        if modulus is None:
+            raise InvalidParameterError(f"tube {name!r}", "a wall with a youngs_modulus (the table form holds "
+                                        "linear elastic walls)", type(wall).__name__)
+        terminal = resistance.get(v, (0.0, 0.0))[0] if v not in written else 0.0
+        written.add(v)
+        for key, value in zip(_HEADER, (name, u, v, 0, length, max(5, round(length * 1e3)), a0, a1, float(modulus),
+                                        p_ext, terminal, 0.0, 0.0)):
+            columns[key].append(value)
+        h_p.append(t0), h_d.append(t1), r_p.append(a0), r_d.append(a1)
+    lost = [node for node in resistance if node not in written]
+    if lost:
+        raise InvalidParameterError("network", "resistance outlets at the target node of a tube (the table puts "
+                                    "R1 on the vessel that ends there)", lost[0])
+    distal = {p_d for _, p_d in resistance.values()}
+    if len(distal) > 1:
+        raise InvalidParameterError("network", "one distal pressure for every resistance outlet (the table has "
+                                    "none; read_network_table(distal_pressure=...) sets it)", sorted(distal))
+    h_p, h_d, r_p, r_d = map(np.asarray, (h_p, h_d, r_p, r_d))
+    rule = bool(np.allclose(h_p, empirical_thickness(r_p), rtol=1e-12, atol=0)
+                and np.allclose(h_d, empirical_thickness(r_d), rtol=1e-12, atol=0))
+    if thickness is True or (thickness == "auto" and not rule):
+        if not np.array_equal(h_p, h_d):
+            k = int(np.flatnonzero(h_p != h_d)[0])
+            raise InvalidParameterError(f"tube {rows[k][0]!r}", "a constant wall thickness (the table's h(m) column "
+                                        "holds one number per vessel)", (float(h_p[k]), float(h_d[k])))
+        columns = {**{k: columns[k] for k in _HEADER[:9]}, "h(m)": h_p.tolist(),
+                   **{k: columns[k] for k in _HEADER[9:]}}
+    return columns
+
+
+@checked_keywords
+def write_network_table(network, path, *, thickness="auto", comment=None):
+    """Write ``network`` as a table of vessels (CSV, the columns of :func:`network_table`;
+    numbers with all their digits, so that :func:`read_network_table` gives the same network
+    back). ``comment`` (text) goes first, each line after ``#``. Returns the path."""
+    columns = network_table(network, thickness=thickness)
+    with open(path, "w", newline="", encoding="utf-8") as fh:
+        for line in ([] if comment is None else str(comment).splitlines()):
+            fh.write(f"# {line}\n")
+        writer = csv.writer(fh, lineterminator="\n")
+        writer.writerow(list(columns))
+        for row in zip(*columns.values()):
+            writer.writerow([repr(x) if isinstance(x, float) else str(x) for x in row])
+    return path
+
+
+# ---------------------------------------------------------------------------- layout
+@checked_keywords
+def tree_layout(network, *, root=None) -> dict:
+    r"""Node positions ``node -> (x, y)`` (m) that draw a network as a tree: ``x`` the distance
+    from ``root`` along the tubes (their lengths), ``y`` the leaves one apart in depth-first
+    order and every other node midway between its first and last child. The tree is a
+    depth-first spanning tree (a graph with loops draws its other tubes across it); each
+    component of the graph starts at its first node (``root``: default the first node with an
+    inflow, else the first node). Vectorized per level of the tree."""
+    if not isinstance(network, Network):
+        raise InvalidParameterError("network", "a tubefsi.Network", network)
+    nodes = network.nodes
+    index = {node: i for i, node in enumerate(nodes)}
+    n = len(nodes)
+    if n == 0:
+        return {}
+    tubes = list(network._tubes.values())
+    u = np.array([index[t.u] for t in tubes])
+    v = np.array([index[t.v] for t in tubes])
+    length = np.array([float(t.models()[1].length) for t in tubes])
+    graph = sp.coo_matrix((np.ones(len(tubes)), (u, v)), shape=(n, n)).tocsr()
+    if root is None:
+        root = next((node for node in nodes if node in network._inflow), nodes[0])
+    elif root not in index:
+        raise InvalidParameterError("root", "a node of the network", root)
+    count, label = csgraph.connected_components(graph, directed=False)
+    starts = [index[root]] + [int(np.flatnonzero(label == c)[0]) for c in range(count) if c != label[index[root]]]
+    x, y = np.zeros(n), np.zeros(n)
+    row = 0.0
+    # the length of the tube between two nodes (either way; the first tube of parallel ones),
+    # looked up by the key a * n + b
+    keys = np.concatenate([u * n + v, v * n + u])
+    order_keys = np.argsort(keys, kind="stable")
+    keys, key_length = keys[order_keys], np.concatenate([length, length])[order_keys]
+    for start in starts:
+        order, pred = csgraph.depth_first_order(graph, start, directed=False, return_predecessors=True)
+        children = order[1:]
+        parents = pred[children]
+        depth = np.zeros(n, dtype=int)
+        ahead = pred.copy()
+        while np.any(ahead[children] >= 0):       # hops to the root, one vectorized step per level
+            moving = children[ahead[children] >= 0]
+            depth[moving] += 1
+            ahead[moving] = pred[ahead[moving]]
+        step = np.zeros(n)
+        step[children] = key_length[np.searchsorted(keys, parents * n + children)]
+        height = int(depth[order].max(initial=0))
+        for level in range(1, height + 1):        # x: the distance from the root along the tree
+            at = order[depth[order] == level]
+            x[at] = x[pred[at]] + step[at]
+        has_child = np.zeros(n, dtype=bool)
+        has_child[parents] = True
+        leaves = order[~has_child[order]]
+        y[leaves] = row + np.arange(leaves.size)
+        for level in range(height, 0, -1):        # y: midway between the first and last child
+            at = order[depth[order] == level]
+            low, high = np.full(n, np.inf), np.full(n, -np.inf)
+            np.minimum.at(low, pred[at], y[at])
+            np.maximum.at(high, pred[at], y[at])
+            done = np.unique(pred[at])
+            y[done] = 0.5 * (low[done] + high[done])
+        row += leaves.size + 1
+    scale = float(np.max(x) - np.min(x)) / max(row, 1.0) if np.ptp(x) > 0 else 1.0
+    return {node: (float(x[i]), float(-y[i] * scale)) for i, node in enumerate(nodes)}
+
+
+# ---------------------------------------------------------------------------- VTK polylines
+#: cell arrays of the geometry (per tube) and of a solution (NetworkSolution attribute names)
+_GEOMETRY = ("radius", "radius_proximal", "radius_distal", "thickness_proximal", "thickness_distal", "length",
+             "youngs_modulus", "external_pressure")
+_RESULTS = ("flow_rate", "pressure_drops", "radius_u", "radius_v", "strain_u", "strain_v", "wall_shear_stress_u",
+            "wall_shear_stress_v")
+_NODE_DATA = ("fixed_pressure", "inflow", "resistance", "distal_pressure")
+
+
+def _positions(network, positions):
+    pos = dict(network.positions if positions is None else positions)
+    if any(node not in pos for node in network.nodes):
+        pos = {**tree_layout(network), **pos}
+    xyz = np.zeros((len(network.nodes), 3))
+    for i, node in enumerate(network.nodes):
+        p = np.asarray(pos[node], dtype=float).ravel()
+        if p.size not in (2, 3) or not np.all(np.isfinite(p)):
+            raise InvalidParameterError(f"positions[{node!r}]", "two or three finite coordinates (m)", pos[node])
+        xyz[i, :p.size] = p
+    return xyz
+
+
+def _data_array(parent, name, values, components=1):
+    values = np.asarray(values)
+    kind = "Int64" if values.dtype.kind in "iu" else "Float64"
+    element = ET.SubElement(parent, "DataArray", type=kind, Name=name, format="ascii")
+    if components != 1:
+        element.set("NumberOfComponents", str(components))
+    element.text = " ".join(repr(float(x)) if kind == "Float64" else str(int(x)) for x in values.ravel())
+    return element
+
+
+@checked_keywords
+def write_vtp(network_or_solution, path, *, positions=None):
+    """Write a network (or a solved one: a :class:`~tubefsi.NetworkSolution`, results included)
+    as VTK polylines, a ``.vtp`` file (VTK XML PolyData, ASCII) for ParaView and other tools.
+
+    Points are the nodes, at ``positions`` (node -> (x, y) or (x, y, z), m), else at those of
+    :meth:`~tubefsi.Network.set_position`, else at :func:`tree_layout`'s. Every tube is a line
+    cell from its ``u`` to its ``v``. Cell data: ``radius`` (the mean of the two ends, for
+    ParaView's Tube filter), ``radius_proximal``, ``radius_distal``, ``thickness_proximal``,
+    ``thickness_distal``, ``length`` (m), ``youngs_modulus`` (Pa, NaN for a wall without one),
+    ``external_pressure`` (Pa); given a solution also ``flow_rate`` (m^3/s), ``pressure_drop``
+    (Pa), ``radius_u``, ``radius_v`` (deformed, m), ``strain_u``, ``strain_v``,
+    ``wall_shear_stress_u``, ``wall_shear_stress_v`` (Pa). Point data: the boundary conditions
+    ``fixed_pressure``, ``inflow``, ``resistance``, ``distal_pressure`` (NaN where a node has
+    none), ``node`` (the node names, where they are all integers) and, given a solution,
+    ``pressure`` (Pa). Returns the path."""
+    if isinstance(network_or_solution, NetworkSolution):
+        solution, network = network_or_solution, network_or_solution.net
+    elif isinstance(network_or_solution, Network):
+        solution, network = None, network_or_solution
+    else:
+        raise InvalidParameterError("network_or_solution", "a tubefsi.Network or a NetworkSolution",
+                                    network_or_solution)
+    nodes = network.nodes
+    index = {node: i for i, node in enumerate(nodes)}
+    rows = _tubes(network)
+    if not rows:
+        raise InvalidParameterError("network_or_solution", "a network with at least one tube", network_or_solution)
+    xyz = _positions(network, positions)
+    cells = {key: [] for key in _GEOMETRY}
+    connectivity = []
+    for name, u, v, wall, tube, p_ext in rows:
+        a0, a1, t0, t1, length = _ends(tube)
+        for key, value in zip(_GEOMETRY, (0.5 * (a0 + a1), a0, a1, t0, t1, length,
+                                          float(getattr(wall, "youngs_modulus", math.nan)), p_ext)):
+            cells[key].append(value)
+        connectivity.append((index[u], index[v]))
+    if solution is not None:
+        for key in _RESULTS:
+            cells["pressure_drop" if key == "pressure_drops" else key] = getattr(solution, key)
+    points = {"fixed_pressure": [network._pressure.get(n, math.nan) for n in nodes],
+              "inflow": [network._inflow.get(n, math.nan) for n in nodes],
+              "resistance": [network._resistance.get(n, (math.nan, math.nan))[0] for n in nodes],
+              "distal_pressure": [network._resistance.get(n, (math.nan, math.nan))[1] for n in nodes]}
+    if all(isinstance(n, int) and not isinstance(n, bool) for n in nodes):
+        points["node"] = np.array(nodes, dtype=np.int64)
+    if solution is not None:
+        points["pressure"] = solution.pressures
+    root = ET.Element("VTKFile", type="PolyData", version="1.0", byte_order="LittleEndian")
+    piece = ET.SubElement(ET.SubElement(root, "PolyData"), "Piece", NumberOfPoints=str(len(nodes)),
+                          NumberOfVerts="0", NumberOfLines=str(len(rows)), NumberOfStrips="0", NumberOfPolys="0")
+    _data_array(ET.SubElement(piece, "Points"), "Points", xyz, components=3)
+    lines = ET.SubElement(piece, "Lines")
+    _data_array(lines, "connectivity", np.array(connectivity, dtype=np.int64))
+    _data_array(lines, "offsets", 2 * np.arange(1, len(rows) + 1, dtype=np.int64))
+    point_data = ET.SubElement(piece, "PointData")
+    for key, values in points.items():
+        _data_array(point_data, key, np.asarray(values))
+    cell_data = ET.SubElement(piece, "CellData", Scalars="radius")
+    for key, values in cells.items():
+        _data_array(cell_data, key, np.asarray(values, dtype=float))
+    ET.indent(root)
+    ET.ElementTree(root).write(path, encoding="utf-8", xml_declaration=True)
+    return path
+
+
+def _vtp_arrays(path):
+    """``(points, lines, point data, cell data)`` of a ``.vtp`` file of ASCII line cells."""
+    label = Path(path).name
+    try:
+        root = ET.parse(path).getroot()
+    except (ET.ParseError, OSError) as err:
+        raise InvalidParameterError("path", "a readable VTK XML PolyData file (.vtp)", label, str(err)) from None
+    piece = root.find("PolyData/Piece") if root.tag == "VTKFile" and root.get("type") == "PolyData" else None
+    if piece is None:
+        raise InvalidParameterError(label, "a VTKFile of type PolyData with a Piece", root.tag)
+
+    def values(element, what):
+        if element.get("format", "ascii") != "ascii":
+            raise InvalidParameterError(f"{label}, {what}", "ASCII data arrays (format='ascii')", element.get("format"))
+        try:
+            return np.array((element.text or "").split(), dtype=float)
+        except ValueError:
+            raise InvalidParameterError(f"{label}, {what}", "numbers", (element.text or "")[:40]) from None
+
+    points = piece.find("Points/DataArray")
+    if points is None:
+        raise InvalidParameterError(label, "a Points data array", None)
+    xyz = values(points, "Points").reshape(-1, int(points.get("NumberOfComponents", "3")))
+    arrays = {a.get("Name"): a for a in piece.findall("Lines/DataArray")}
+    if "connectivity" not in arrays or "offsets" not in arrays:
+        raise InvalidParameterError(label, "line cells (Lines with connectivity and offsets)", sorted(arrays))
+    conn = values(arrays["connectivity"], "Lines connectivity").astype(np.int64)
+    offsets = values(arrays["offsets"], "Lines offsets").astype(np.int64)
+    if not np.array_equal(offsets, 2 * np.arange(1, offsets.size + 1)) or conn.size != 2 * offsets.size:
+        raise InvalidParameterError(f"{label}, Lines", "line cells of two points each (one per tube)", offsets[:5])
+    lines = conn.reshape(-1, 2)
+    if lines.size and (lines.min() < 0 or lines.max() >= len(xyz)):
+        raise InvalidParameterError(f"{label}, Lines connectivity", f"point indices in [0, {len(xyz)})",
+                                    int(lines.max()))
+    point_data = {a.get("Name"): values(a, f"PointData {a.get('Name')!r}") for a in piece.findall("PointData/DataArray")}
+    cell_data = {a.get("Name"): values(a, f"CellData {a.get('Name')!r}") for a in piece.findall("CellData/DataArray")}
+    for kind, data, n in (("PointData", point_data, len(xyz)), ("CellData", cell_data, len(lines))):
+        for key, a in data.items():
+            if a.size != n:
+                raise InvalidParameterError(f"{label}, {kind} {key!r}", f"{n} values", a.size)
+    return xyz, lines, point_data, cell_data
+
+
+@checked_keywords
+def read_vtp(path, *, rheology=None, wall=None):
+    """A :class:`~tubefsi.Network` from a ``.vtp`` file of line cells (as :func:`write_vtp`
+    writes them; ASCII data arrays).
+
+    Each line cell is a tube from its first point to its second. Its radius is the cell data
+    ``radius_proximal`` and ``radius_distal`` (a linear taper where they differ), else
+    ``radius``; its thickness ``thickness_proximal``/``thickness_distal``, else ``thickness``,
+    else :func:`empirical_thickness` of the radius; its length ``length``, else the distance
+    between its points. ``wall`` is a model or a factory ``wall(E, h, R)`` as in
+    :func:`read_network_table` (the cell data ``youngs_modulus`` gives ``E``). Nodes are named by
+    the point data ``node`` if present, else by their index; they take the positions of the
+    points and the boundary conditions of the point data ``fixed_pressure``, ``inflow``,
+    ``resistance`` with ``distal_pressure`` (NaN: none). Results in the file are not read.
+    """
+    label = Path(path).name
+    xyz, lines, point_data, cell_data = _vtp_arrays(path)
+    n_tubes = len(lines)
+    if n_tubes == 0:
+        raise InvalidParameterError(label, "at least one line cell", 0)
+    names = point_data["node"].astype(np.int64).tolist() if "node" in point_data else list(range(len(xyz)))
+
+    def cell(key, fallback=None):
+        return cell_data.get(key, fallback)
+
+    rp = cell("radius_proximal", cell("radius"))
+    if rp is None:
+        raise InvalidParameterError(label, "cell data radius or radius_proximal (m)", sorted(cell_data))
+    rd = cell("radius_distal", rp)
+    length = cell("length", np.linalg.norm(xyz[lines[:, 1]] - xyz[lines[:, 0]], axis=1))
+    hp = cell("thickness_proximal", cell("thickness", empirical_thickness(rp)))
+    hd = cell("thickness_distal", hp if "thickness_proximal" in cell_data or "thickness" in cell_data
+              else empirical_thickness(rd))
+    modulus = cell("youngs_modulus", np.full(n_tubes, math.nan))
+    p_ext = cell("external_pressure", np.zeros(n_tubes))
+    for key, a, ok in (("radius", rp, rp > 0), ("radius_distal", rd, rd > 0), ("length", length, length > 0),
+                       ("thickness", hp, hp > 0), ("thickness_distal", hd, hd > 0),
+                       ("external_pressure", p_ext, np.isfinite(p_ext))):
+        with np.errstate(invalid="ignore"):
+            bad = ~(np.isfinite(a) & ok)
+        if np.any(bad):
+            k = int(np.flatnonzero(bad)[0])
+            raise InvalidParameterError(f"{label}, cell {k}, cell data {key!r}", "finite numbers > 0 (m)"
+                                        if key != "external_pressure" else "finite numbers (Pa)", float(a[k]))
+    make_wall, needs_e = _wall_maker(wall)
+    if needs_e and not np.all(np.isfinite(modulus) & (modulus > 0)):
+        k = int(np.flatnonzero(~(np.isfinite(modulus) & (modulus > 0)))[0])
+        raise InvalidParameterError(f"{label}, cell {k}, cell data 'youngs_modulus'", "(0, inf) Pa (the default wall "
+                                    "needs it; or give wall=)", float(modulus[k]) if k < modulus.size else None)
+    u = [names[i] for i in lines[:, 0]]
+    v = [names[i] for i in lines[:, 1]]
+    # tubes are named (u, v); one of several between the same nodes (u, v, its cell index)
+    pairs = lines[:, 0] * len(xyz) + lines[:, 1]
+    _, first, counts = np.unique(pairs, return_index=True, return_counts=True)
+    shared = np.isin(pairs, pairs[first[counts > 1]])
+    names_of = [(u[k], v[k], k) if shared[k] else (u[k], v[k]) for k in range(n_tubes)]
+    graded = (rp != rd) | (hp != hd)
+    net = Network(rheology=rheology)
+    cuts = np.flatnonzero(np.diff(graded.astype(np.int8))) + 1
+    for run in np.split(np.arange(n_tubes), cuts):
+        if not graded[run[0]]:
+            net.add_tubes([u[k] for k in run], [v[k] for k in run], make_wall(modulus[run], hp[run], rp[run]),
+                          Tube(radius=rp[run], thickness=hp[run], length=length[run]), external_pressure=p_ext[run],
+                          names=[names_of[k] for k in run])
+            continue
+        for k in run:
+            ends = [0.0, float(length[k])]
+            net.add_tube(u[k], v[k], make_wall(float(modulus[k]), float(hp[k]), float(rp[k])),
+                         Tube(radius=sampled(ends, [rp[k], rd[k]], kind="linear"),
+                              thickness=sampled(ends, [hp[k], hd[k]], kind="linear"), length=float(length[k])),
+                         name=names_of[k], external_pressure=float(p_ext[k]))
+    for i, node in enumerate(names):
+        if node not in net._nodes:
+            continue
+        net.set_position(node, (float(xyz[i, 0]), float(xyz[i, 1])))
+        bc = {key: float(point_data[key][i]) for key in _NODE_DATA if key in point_data}
+        if math.isfinite(bc.get("fixed_pressure", math.nan)):
+            net.set_pressure(node, bc["fixed_pressure"])
+        if math.isfinite(bc.get("inflow", math.nan)):
+            net.set_inflow(node, bc["inflow"])
+        if math.isfinite(bc.get("resistance", math.nan)):
+            p_d = bc.get("distal_pressure", 0.0)
+            net.set_resistance(node, bc["resistance"], distal_pressure=p_d if math.isfinite(p_d) else 0.0)
+    return net
