@@ -91,7 +91,7 @@ def _wall_maker(wall):
         model = resolve("wall", wall)
         return (lambda E, h, R: model), False
     if callable(wall):
-        return wall, True
+        return wall, False
     raise InvalidParameterError("wall", "a wall model (instance, class or registered name) or a callable "
                                 "wall(E, h, R) returning one", wall)
 
@@ -107,6 +107,7 @@ class _Table:
         self.spelled = {}
         for j, raw in enumerate(header):
             key, unit = _column_key(raw)
+            raw = str(raw).strip()
             if key not in _COLUMNS:
                 raise InvalidParameterError(f"{source}, column {raw!r}", f"one of the table's columns "
                                             f"({', '.join(_HEADER)}, h(m))", raw)
@@ -116,7 +117,7 @@ class _Table:
             if key in self.columns:
                 raise InvalidParameterError(f"{source}, column {raw!r}", "a column named once", raw)
             self.columns[key] = [row[j] for row in rows]
-            self.spelled[key] = raw
+            self.spelled[key] = str(raw).strip()
         for key, (_, required, _) in _COLUMNS.items():
             if required and key not in self.columns:
                 raise InvalidParameterError(f"{source}", f"a table with a column {key!r}", list(header))
@@ -150,7 +151,7 @@ class _Table:
             bad = ~(np.isfinite(values) & predicate(values))
         if np.any(bad):
             k = int(np.flatnonzero(bad)[0])
-            raise self.error(key, k, admissible, cells[k])
+            raise self.error(key, k, admissible, cells[k].strip() if isinstance(cells[k], str) else cells[k])
         return values
 
     def names(self, key):
@@ -242,7 +243,8 @@ def read_network_table(source, *, rheology=None, wall=None, thickness=None, dist
     wall : callable, model, class or registered name, optional
         A wall model shared by every vessel, or a factory ``wall(E, h, R)`` of the vessel's
         modulus, thickness and proximal radius returning its wall (called with arrays, one
-        entry per vessel, for runs of uniform vessels). Default :func:`openbf_wall`.
+        entry per vessel, for runs of uniform vessels; ``E`` is NaN without an ``E(Pa)``
+        column). Default :func:`openbf_wall`, which needs the column ``E(Pa)``.
     thickness : callable, optional
         Without an ``h(m)`` column: the thickness as a function of the radius (arrays in,
         arrays out); default :func:`empirical_thickness`.
@@ -505,8 +507,9 @@ def tree_layout(network, *, root=None) -> dict:
 #: cell arrays of the geometry (per tube) and of a solution (NetworkSolution attribute names)
 _GEOMETRY = ("radius", "radius_proximal", "radius_distal", "thickness_proximal", "thickness_distal", "length",
              "youngs_modulus", "external_pressure")
-_RESULTS = ("flow_rate", "pressure_drops", "radius_u", "radius_v", "strain_u", "strain_v", "wall_shear_stress_u",
-            "wall_shear_stress_v")
+_RESULTS = {"flow_rate": "flow_rates", "pressure_drop": "pressure_drops", "radius_u": "radius_u",
+            "radius_v": "radius_v", "strain_u": "strain_u", "strain_v": "strain_v",
+            "wall_shear_stress_u": "wall_shear_stress_u", "wall_shear_stress_v": "wall_shear_stress_v"}
 _NODE_DATA = ("fixed_pressure", "inflow", "resistance", "distal_pressure")
 
 
@@ -571,8 +574,8 @@ def write_vtp(network_or_solution, path, *, positions=None):
             cells[key].append(value)
         connectivity.append((index[u], index[v]))
     if solution is not None:
-        for key in _RESULTS:
-            cells["pressure_drop" if key == "pressure_drops" else key] = getattr(solution, key)
+        for key, attribute in _RESULTS.items():
+            cells[key] = getattr(solution, attribute)
     points = {"fixed_pressure": [network._pressure.get(n, math.nan) for n in nodes],
               "inflow": [network._inflow.get(n, math.nan) for n in nodes],
               "resistance": [network._resistance.get(n, (math.nan, math.nan))[0] for n in nodes],

@@ -1,5 +1,5 @@
 r"""The steady state of a :class:`~tubefsi.Network`: its results as arrays aligned with the tubes
-and the nodes, tables (dict columns, pandas, CSV, JSON) and each tube's full single-tube solution
+and the nodes, tables (dict columns, pandas, xarray, CSV, JSON) and each tube's full single-tube solution
 (``docs/network.md``, "Results").
 
 Everything here is read from the arrays the solver hands over; the mappings by name are built
@@ -241,6 +241,26 @@ class NetworkSolution:
         return frame
 
     @checked_keywords
+    def to_xarray(self, *, density=None):
+        """The results as an :class:`xarray.Dataset` with the dimensions ``tube`` (coordinates: the
+        tube names, their nodes ``u`` and ``v``) and ``node`` (the node names): the columns of
+        :meth:`tube_table` (with the undeformed ``radius``) and of :meth:`node_table` as data
+        variables, each with its ``units`` attribute; names that are neither text nor integers
+        become text. Needs xarray (``pip install 'tubefsi[xarray]'``)."""
+        xr = _require("xarray", "xarray")
+        tubes, nodes = self.tube_table(density=density), self.node_table()
+        tube_vars = {key: ("tube", np.asarray(values), {"units": UNITS[key]})
+                     for key, values in tubes.items() if key in UNITS}
+        tube_vars["radius"] = ("tube", np.asarray(self.radius0), {"units": "m"})
+        node_vars = {"pressure": ("node", np.asarray(nodes["pressure"]), {"units": "Pa"}),
+                     "inflow": ("node", np.asarray(nodes["inflow"]), {"units": "m^3/s"}),
+                     "fixed": ("node", np.asarray(nodes["fixed"], dtype=bool), {})}
+        coords = {"tube": _labels(tubes["name"]), "u": ("tube", _labels(tubes["u"])),
+                  "v": ("tube", _labels(tubes["v"])), "node": _labels(nodes["node"])}
+        return xr.Dataset({**tube_vars, **node_vars}, coords=coords,
+                          attrs={"iterations": self.iterations, "residual": self.residual})
+
+    @checked_keywords
     def to_csv(self, prefix: str | os.PathLike) -> tuple:
         """Write ``<prefix>_nodes.csv`` and ``<prefix>_tubes.csv``; returns the two paths."""
         paths = (f"{prefix}_nodes.csv", f"{prefix}_tubes.csv")
@@ -298,6 +318,14 @@ def _hashable(x) -> bool:
     except TypeError:
         return False
     return True
+
+
+def _labels(names) -> np.ndarray:
+    """Names as a 1-D array of coordinate labels: as they are if all are text or all integers,
+    else as text."""
+    if all(isinstance(x, str) for x in names) or all(isinstance(x, int) and not isinstance(x, bool) for x in names):
+        return np.array(names)
+    return np.array([str(x) for x in names])
 
 
 def _text(x):

@@ -14,8 +14,8 @@ is called.
 * :func:`plot_deformed_tube` — the inflated tube in :math:`(z, r)`, lumen coloured by
   pressure (Axes);
 * :func:`plot_velocity_profiles` — axial velocity :math:`v(r)` at a few sections (Axes);
-* :func:`plot_network` — a solved :class:`~tubefsi.Network`, coloured by pressure, tubes as
-  wide as their deformed radius (Axes).
+* :func:`plot_network` — a solved :class:`~tubefsi.Network`, tubes coloured by pressure, flow
+  rate, strain or wall shear stress and as wide as their deformed radius (Axes).
 
 ``WallModel.plot`` and ``Solution.plot`` are shortcuts for :func:`plot_tube_law`
 and :func:`plot_profiles`. Arguments are SI; each axis shows its quantity in the unit that
@@ -44,6 +44,7 @@ import numpy as np
 
 from . import registry
 from .errors import InvalidParameterError, NoSteadyStateError, StretchRangeError, TubefsiError
+from .network_io import tree_layout
 from .solve import max_flow_rate, solve, solve_unchecked
 from .validity import SLENDERNESS
 from .walls.hyperelastic import HyperelasticWall
@@ -783,18 +784,38 @@ def plot_velocity_profiles(solution, z_sections=None, *, ax=None, n=101):
 
 
 # ---------------------------------------------------------------------------- networks
-def plot_network(result, *, positions=None, ax=None, cmap="viridis", max_width=8.0, layout_seed=0):
-    r"""Draw a solved network: nodes coloured by pressure, each tube a segment coloured by its
-    mean pressure and as wide as its mean deformed inner radius.
+#: what plot_network can colour the tubes by: (label, display unit kind or None, the value per tube)
+_NETWORK_COLOURS = {
+    "pressure": ("mean pressure $p$", "pressure",
+                 lambda r: 0.5 * (r.pressures[r.U] + r.pressures[r.V])),
+    "flow_rate": ("flow rate $|q|$", "flow_rate", lambda r: np.abs(r.flow_rates)),
+    "strain": ("largest hoop strain $R/a - 1$", None, lambda r: np.maximum(r.strain_u, r.strain_v)),
+    "wall_shear_stress": (r"largest wall shear stress $\tau_w$", "pressure",
+                          lambda r: np.maximum(r.wall_shear_stress_u, r.wall_shear_stress_v)),
+}
+
+
+def plot_network(result, *, color="pressure", positions=None, layout="tree", ax=None, cmap="viridis",
+                 max_width=8.0, layout_seed=0):
+    r"""Draw a solved network: each tube a segment coloured by ``color`` and as wide as its mean
+    deformed inner radius; the nodes coloured by their pressure when ``color="pressure"``.
 
     Parameters
     ----------
     result : NetworkSolution
         What :meth:`tubefsi.Network.solve` returns.
+    color : {"pressure", "flow_rate", "strain", "wall_shear_stress"}
+        What colours the tubes: the mean of their two end pressures, the magnitude of their
+        flow rate, the larger hoop strain :math:`R/a - 1` of their two ends, or the larger wall
+        shear stress of their two ends. The colour bar shows it in a display unit (kPa, mL/min,
+        ...).
     positions : mapping node -> (x, y), optional
         Node coordinates; by default those of :meth:`~tubefsi.Network.set_position` (or the
-        ``pos`` node attribute of a networkx graph), else a networkx spring layout (seeded by
-        ``layout_seed``; needs networkx).
+        ``pos`` node attribute of a networkx graph), else the ``layout``.
+    layout : {"tree", "spring"}
+        Where nodes have no position: ``"tree"``, :func:`tubefsi.network_io.tree_layout`
+        (x the distance from the inlet along the tubes); ``"spring"``, a networkx spring layout
+        seeded by ``layout_seed`` (needs networkx).
     ax : matplotlib Axes, optional
     cmap : str or Colormap
     max_width : float
@@ -807,35 +828,52 @@ def plot_network(result, *, positions=None, ax=None, cmap="viridis", max_width=8
     from matplotlib.collections import LineCollection
     from matplotlib.colors import Normalize
 
+    if color not in _NETWORK_COLOURS:
+        raise InvalidParameterError("color", f"one of {sorted(_NETWORK_COLOURS)}", color)
+    if layout not in ("tree", "spring"):
+        raise InvalidParameterError("layout", "'tree' or 'spring'", layout)
     nodes = result.nodes
     pos = dict(result.net.positions if positions is None else positions)
     if any(node not in pos for node in nodes):
-        try:
-            import networkx as nx
-        except ImportError:
-            raise InvalidParameterError("positions", "(x, y) for every node", None,
-                                        "give positions= or set_position(), or install networkx for a layout") from None
-        pos = {**nx.spring_layout(result.net.to_networkx().to_undirected(as_view=True), seed=layout_seed), **pos}
-    table = result.tube_table()
-    p = result.pressure
-    xy = np.array([[pos[u], pos[v]] for u, v in zip(table["u"], table["v"])], dtype=float)
-    radius = 0.5 * (np.asarray(table["radius_u"]) + np.asarray(table["radius_v"]))
+        if layout == "tree":
+            pos = {**tree_layout(result.net), **pos}
+        else:
+            try:
+                import networkx as nx
+            except ImportError:
+                raise InvalidParameterError("layout", "'tree', or 'spring' with networkx installed", layout,
+                                            "give positions= or set_position(), or install networkx") from None
+            pos = {**nx.spring_layout(result.net.to_networkx().to_undirected(as_view=True), seed=layout_seed), **pos}
+    pts = np.array([pos[n] for n in nodes], dtype=float)
+    xy = np.stack([pts[result.U], pts[result.V]], axis=1)
+    radius = 0.5 * (result.radius_u + result.radius_v)
     widths = max_width * radius / radius.max()
-    mean_p = 0.5 * (np.asarray(table["pressure_u"]) + np.asarray(table["pressure_v"]))
-    values = np.array([p[n] for n in nodes])
-    norm = Normalize(vmin=float(values.min()), vmax=float(values.max()) if values.max() > values.min() else
-                     float(values.min()) + 1.0)
+    label, kind, value_of = _NETWORK_COLOURS[color]
+    values = np.asarray(value_of(result), dtype=float)
+    node_values = result.pressures
+    shown = np.concatenate([values, node_values]) if color == "pressure" else values
+    low, high = float(shown.min()), float(shown.max())
+    norm = Normalize(vmin=low, vmax=high if high > low else low + (abs(low) if low else 1.0))
     ax = _new_axes(ax, (7.0, 5.0))
     lines = LineCollection(xy, linewidths=np.maximum(widths, 0.4), cmap=cmap, norm=norm, capstyle="round", zorder=1)
-    lines.set_array(mean_p)
+    lines.set_array(values)
     ax.add_collection(lines)
-    pts = np.array([pos[n] for n in nodes], dtype=float)
-    ax.scatter(pts[:, 0], pts[:, 1], c=values, cmap=cmap, norm=norm, s=14, edgecolors="k", linewidths=0.4, zorder=2)
+    if color == "pressure":
+        ax.scatter(pts[:, 0], pts[:, 1], c=node_values, cmap=cmap, norm=norm, s=14, edgecolors="k", linewidths=0.4,
+                   zorder=2)
+    else:
+        ax.scatter(pts[:, 0], pts[:, 1], c="0.3", s=4, zorder=2)
     ax.autoscale_view()
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_axis_off()
-    ax.figure.colorbar(lines, ax=ax, label="pressure $p$ (Pa)", shrink=0.8)
+    if kind is None:
+        bar = ax.figure.colorbar(lines, ax=ax, label=label, shrink=0.8)
+    else:
+        symbol, size = _unit(kind, max(abs(low), abs(high)))
+        bar = ax.figure.colorbar(lines, ax=ax, label=f"{label} ({symbol})", shrink=0.8)
+        bar.formatter = _scaled_formatter(size)
+        bar.update_ticks()
     if not ax.get_title():
-        ax.set_title(f"{len(nodes)} nodes, {len(table['name'])} tubes; width ~ deformed radius "
+        ax.set_title(f"{len(nodes)} nodes, {len(result.tube_names)} tubes; width ~ deformed radius "
                      f"(widest {_fmt_len(float(radius.max()))})", fontsize=10)
     return ax
