@@ -281,3 +281,18 @@ def test_pictures_and_tables(tmp_path):
     np.testing.assert_array_equal(ds["pressure"].values, result.pressures)
     assert ds["pressure"].attrs["units"] == "Pa" and list(ds["u"].values) == ["('in', 'j')".split("'")[1]] + ["j", "j"]
     assert list(ds["tube"].values) == [str(n) for n in result.tube_names]
+
+
+@pytest.mark.parametrize("mode", ["ascii", "binary"])
+def test_vtp_files_written_by_vtk_read_the_same(mode):
+    """tests/data/y_written_by_vtk_*.vtp: write_vtp's file of _solved_y, read by VTK 9.7.2's
+    vtkXMLPolyDataReader and written again by its vtkXMLPolyDataWriter (ASCII, and binary without
+    a compressor): VTK reads write_vtp's file, and read_vtp reads VTK's."""
+    from pathlib import Path
+
+    net, result = _solved_y()
+    path = Path(__file__).parent / "data" / f"y_written_by_vtk_{mode}.vtp"
+    again = network_io.read_vtp(path, rheology=NEWTONIAN)
+    assert network_io.network_table(again)["Rp(m)"] == network_io.network_table(net)["Rp(m)"]
+    assert again._resistance == {3: (1e9, 20.0)} and again._pressure == {2: 100.0} and again._inflow == {0: 1e-6}
+    np.testing.assert_allclose(again.solve().pressures, result.pressures, rtol=1e-13)

@@ -17,6 +17,7 @@ a table without a thickness column takes openBF's empirical thickness :func:`emp
 
 from __future__ import annotations
 
+import base64
 import csv
 import math
 import os
@@ -527,19 +528,24 @@ def _positions(network, positions):
 
 
 def _data_array(parent, name, values, components=1):
+    """A ``DataArray`` in VTK's inline binary form: base64 of a UInt64 byte count followed by
+    the little-endian values (exact, NaN included)."""
     values = np.asarray(values)
-    kind = "Int64" if values.dtype.kind in "iu" else "Float64"
-    element = ET.SubElement(parent, "DataArray", type=kind, Name=name, format="ascii")
+    dtype = np.dtype("<i8") if values.dtype.kind in "iub" else np.dtype("<f8")
+    raw = np.ascontiguousarray(values, dtype=dtype).tobytes()
+    element = ET.SubElement(parent, "DataArray", type="Int64" if dtype.kind == "i" else "Float64", Name=name,
+                            format="binary")
     if components != 1:
         element.set("NumberOfComponents", str(components))
-    element.text = " ".join(repr(float(x)) if kind == "Float64" else str(int(x)) for x in values.ravel())
+    element.text = base64.b64encode(np.uint64(len(raw)).astype("<u8").tobytes() + raw).decode("ascii")
     return element
 
 
 @checked_keywords
 def write_vtp(network_or_solution, path, *, positions=None):
     """Write a network (or a solved one: a :class:`~tubefsi.NetworkSolution`, results included)
-    as VTK polylines, a ``.vtp`` file (VTK XML PolyData, ASCII) for ParaView and other tools.
+    as VTK polylines, a ``.vtp`` file (VTK XML PolyData, inline binary data arrays: exact, and
+    NaN where a value is missing) for ParaView and other tools.
 
     Points are the nodes, at ``positions`` (node -> (x, y) or (x, y, z), m), else at those of
     :meth:`~tubefsi.Network.set_position`, else at :func:`tree_layout`'s. Every tube is a line
@@ -584,7 +590,7 @@ def write_vtp(network_or_solution, path, *, positions=None):
         points["node"] = np.array(nodes, dtype=np.int64)
     if solution is not None:
         points["pressure"] = solution.pressures
-    root = ET.Element("VTKFile", type="PolyData", version="1.0", byte_order="LittleEndian")
+    root = ET.Element("VTKFile", type="PolyData", version="1.0", byte_order="LittleEndian", header_type="UInt64")
     piece = ET.SubElement(ET.SubElement(root, "PolyData"), "Piece", NumberOfPoints=str(len(nodes)),
                           NumberOfVerts="0", NumberOfLines=str(len(rows)), NumberOfStrips="0", NumberOfPolys="0")
     _data_array(ET.SubElement(piece, "Points"), "Points", xyz, components=3)
@@ -603,7 +609,8 @@ def write_vtp(network_or_solution, path, *, positions=None):
 
 
 def _vtp_arrays(path):
-    """``(points, lines, point data, cell data)`` of a ``.vtp`` file of ASCII line cells."""
+    """``(points, lines, point data, cell data)`` of a ``.vtp`` file of line cells (ASCII or
+    uncompressed inline binary data arrays)."""
     label = Path(path).name
     try:
         root = ET.parse(path).getroot()
@@ -613,13 +620,26 @@ def _vtp_arrays(path):
     if piece is None:
         raise InvalidParameterError(label, "a VTKFile of type PolyData with a Piece", root.tag)
 
+    header = {"UInt32": np.dtype("u4"), "UInt64": np.dtype("u8")}.get(root.get("header_type", "UInt32"))
+    order = "<" if root.get("byte_order", "LittleEndian") == "LittleEndian" else ">"
+    kinds = {"Float64": "f8", "Float32": "f4", "Int64": "i8", "Int32": "i4", "UInt64": "u8", "UInt32": "u4",
+             "Int8": "i1", "UInt8": "u1", "Int16": "i2", "UInt16": "u2"}
+
     def values(element, what):
-        if element.get("format", "ascii") != "ascii":
-            raise InvalidParameterError(f"{label}, {what}", "ASCII data arrays (format='ascii')", element.get("format"))
+        form, kind = element.get("format", "ascii"), kinds.get(element.get("type"))
+        text = (element.text or "").strip()
         try:
-            return np.array((element.text or "").split(), dtype=float)
-        except ValueError:
-            raise InvalidParameterError(f"{label}, {what}", "numbers", (element.text or "")[:40]) from None
+            if form == "ascii":
+                return np.array(text.split(), dtype=float)
+            if form == "binary" and kind is not None and header is not None and root.get("compressor") is None:
+                raw = base64.b64decode(text)
+                size = int(np.frombuffer(raw[:header.itemsize], dtype=header.newbyteorder(order))[0])
+                data = raw[header.itemsize:header.itemsize + size]
+                return np.frombuffer(data, dtype=np.dtype(kind).newbyteorder(order)).astype(float)
+        except (ValueError, TypeError, IndexError):
+            raise InvalidParameterError(f"{label}, {what}", "numbers", text[:40]) from None
+        raise InvalidParameterError(f"{label}, {what}", "ASCII or uncompressed inline binary data arrays",
+                                    f"format={form!r}, type={element.get('type')!r}")
 
     points = piece.find("Points/DataArray")
     if points is None:
@@ -648,7 +668,8 @@ def _vtp_arrays(path):
 @checked_keywords
 def read_vtp(path, *, rheology=None, wall=None):
     """A :class:`~tubefsi.Network` from a ``.vtp`` file of line cells (as :func:`write_vtp`
-    writes them; ASCII data arrays).
+    writes them; ASCII or uncompressed inline binary data arrays, as VTK writes them with
+    ``SetDataModeToAscii`` or ``SetDataModeToBinary`` and no compressor).
 
     Each line cell is a tube from its first point to its second. Its radius is the cell data
     ``radius_proximal`` and ``radius_distal`` (a linear taper where they differ), else
