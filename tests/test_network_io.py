@@ -8,8 +8,10 @@ empirical thickness against its formula in centimetres, in mpmath.
 
 from __future__ import annotations
 
+import base64
 import csv
 import xml.etree.ElementTree as ET
+from pathlib import Path
 
 import mpmath as mp
 import numpy as np
@@ -54,7 +56,6 @@ def test_adan56_with_linear_tapers():
 
 def test_the_data_file_is_package_data():
     import tomllib
-    from pathlib import Path
 
     config = tomllib.loads((Path(__file__).resolve().parents[1] / "pyproject.toml").read_text(encoding="utf-8"))
     assert "data/*.csv" in config["tool"]["setuptools"]["package-data"]["tubefsi"]
@@ -213,13 +214,19 @@ def test_vtp_round_trip(tmp_path):
     # the file, read as XML: line cells from u to v, the results as cell and point data
     piece = ET.parse(path).getroot().find("PolyData/Piece")
     assert piece.get("NumberOfLines") == "3" and piece.get("NumberOfPoints") == "4"
-    cells = {a.get("Name"): np.array(a.text.split(), dtype=float) for a in piece.findall("CellData/DataArray")}
-    points = {a.get("Name"): np.array(a.text.split(), dtype=float) for a in piece.findall("PointData/DataArray")}
+
+    def decoded(a):      # VTK's inline binary: base64 of a UInt64 byte count, then little-endian values
+        raw = base64.b64decode(a.text.strip())
+        return np.frombuffer(raw[8:8 + int(np.frombuffer(raw[:8], "<u8")[0])], "<f8" if a.get("type") == "Float64"
+                             else "<i8")
+
+    cells = {a.get("Name"): decoded(a) for a in piece.findall("CellData/DataArray")}
+    points = {a.get("Name"): decoded(a) for a in piece.findall("PointData/DataArray")}
     np.testing.assert_array_equal(cells["flow_rate"], result.flow_rates)
     np.testing.assert_array_equal(cells["strain_u"], result.strain_u)
     np.testing.assert_array_equal(cells["radius"], [2e-3, 1e-3, 1.2e-3])
     np.testing.assert_array_equal(points["pressure"], result.pressures)
-    conn = np.array(piece.find("Lines/DataArray[@Name='connectivity']").text.split(), dtype=int).reshape(-1, 2)
+    conn = decoded(piece.find("Lines/DataArray[@Name='connectivity']")).reshape(-1, 2)
     assert [(result.nodes[i], result.nodes[j]) for i, j in conn] == [("in", "j"), ("j", "a"), ("j", "b")]
     # read back: the same geometry, walls and boundary conditions (the nodes by their index)
     again = network_io.read_vtp(path, rheology=NEWTONIAN)
@@ -242,9 +249,10 @@ def test_vtp_integer_nodes_and_bad_files(tmp_path):
     assert again.nodes == [1, 2, 3, 4] and again.positions[3] == (2.0, 1.0)
     assert network_io.network_table(again)["Rp(m)"] == network_io.network_table(net)["Rp(m)"]
     bad = tmp_path / "bad.vtp"
-    bad.write_text(path.read_text().replace('Name="radius_proximal" format="ascii">', 'Name="radius_proximal" '
-                                            'format="ascii">-1 '), encoding="utf-8")
-    with pytest.raises(InvalidParameterError, match="bad.vtp"):
+    vtk_file = Path(__file__).parent / "data" / "y_written_by_vtk_ascii.vtp"
+    bad.write_text(vtk_file.read_text(encoding="utf-8").replace("0.002 0.001 0.0012", "-1 0.001 0.0012"),
+                   encoding="utf-8")
+    with pytest.raises(InvalidParameterError, match="bad.vtp, cell 0, cell data 'radius'"):
         network_io.read_vtp(bad, rheology=NEWTONIAN)
     bad.write_text("<VTKFile type='UnstructuredGrid'/>", encoding="utf-8")
     with pytest.raises(InvalidParameterError, match="PolyData"):
@@ -288,8 +296,6 @@ def test_vtp_files_written_by_vtk_read_the_same(mode):
     """tests/data/y_written_by_vtk_*.vtp: write_vtp's file of _solved_y, read by VTK 9.7.2's
     vtkXMLPolyDataReader and written again by its vtkXMLPolyDataWriter (ASCII, and binary without
     a compressor): VTK reads write_vtp's file, and read_vtp reads VTK's."""
-    from pathlib import Path
-
     net, result = _solved_y()
     path = Path(__file__).parent / "data" / f"y_written_by_vtk_{mode}.vtp"
     again = network_io.read_vtp(path, rheology=NEWTONIAN)
