@@ -16,7 +16,7 @@ PUBLIC_MODULES = [
     "tubefsi", "tubefsi.fields", "tubefsi.scene", "tubefsi.couplers", "tubefsi.walls", "tubefsi.rheology",
     "tubefsi.registry", "tubefsi.errors", "tubefsi.advise", "tubefsi.fit", "tubefsi.network", "tubefsi.dimensionless",
     "tubefsi.chapter", "tubefsi.plotting", "tubefsi.cli", "tubefsi.testing", "tubefsi.validity", "tubefsi.export",
-    "tubefsi.fem",
+    "tubefsi.fem", "tubefsi.network_io", "tubefsi.datasets",
 ]
 
 _DIRECTIVE = re.compile(r"^\.\. (autofunction|autoclass|automodule|py:data):: (\S+)\s*$")
