@@ -16,6 +16,8 @@ from pathlib import Path
 import mpmath as mp
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import tubefsi
 from tubefsi import InvalidParameterError, datasets, network_io
@@ -108,6 +110,19 @@ def test_tapered_table_round_trip(tmp_path):
     _, rows = _adan56_rows()
     columns = network_io.network_table(tubefsi.read_network_table(path, rheology=NEWTONIAN))
     assert columns["Rd(m)"] == [float(r[7]) for r in rows]
+
+
+@TAPERED
+def test_a_tapered_rigid_vessel_against_poiseuille(tmp_path):
+    # a linear taper a(z) from a_p to a_d: R = (8 mu / pi) int_0^L dz / a^4
+    #                                          = 8 mu L (a_p^2 + a_p a_d + a_d^2) / (3 pi a_p^3 a_d^3)
+    path = tmp_path / "taper.csv"
+    path.write_text("Name,sn,tn,l(m),Rp(m),Rd(m),R1\ncone,1,2,0.2,0.004,0.002,0\n", encoding="utf-8")
+    net = tubefsi.read_network_table(path, rheology=NEWTONIAN, wall="rigid")
+    net.set_pressure(1, 500.0).set_pressure(2, 0.0)
+    mu, length, ap, ad = mp.mpf("3.5e-3"), mp.mpf("0.2"), mp.mpf("0.004"), mp.mpf("0.002")
+    resistance = 8 * mu * length * (ap**2 + ap * ad + ad**2) / (3 * mp.pi * ap**3 * ad**3)
+    assert net.solve().flow_rate["cone"] == pytest.approx(float(500 / resistance), rel=1e-10)
 
 
 def test_a_tapered_row_is_a_linear_taper():
@@ -302,3 +317,31 @@ def test_vtp_files_written_by_vtk_read_the_same(mode):
     assert network_io.network_table(again)["Rp(m)"] == network_io.network_table(net)["Rp(m)"]
     assert again._resistance == {3: (1e9, 20.0)} and again._pressure == {2: 100.0} and again._inflow == {0: 1e-6}
     np.testing.assert_allclose(again.solve().pressures, result.pressures, rtol=1e-13)
+
+
+@settings(max_examples=15, deadline=None)
+@given(st.integers(1, 6), st.data())
+def test_random_tables_round_trip(tmp_path_factory, n, data):
+    """Any table of a random tree (lengths, radii, moduli, thicknesses, external pressures and
+    terminal resistances drawn at random) is the table of the network read from it."""
+    positive = st.floats(1e-4, 1e-2)
+    parents = [data.draw(st.integers(1, k)) for k in range(1, n + 1)]
+    lines = ["Name, sn, tn, l(m), Rp(m), E(Pa), h(m), Pext, R1, R2"]
+    for k, parent in enumerate(parents):
+        r = data.draw(positive)
+        lines.append(f"v{k}, {parent}, {k + 2}, {data.draw(st.floats(1e-3, 1.0))!r}, "
+                     f"{r!r}, {data.draw(st.floats(1e3, 1e7))!r}, {data.draw(st.floats(0.05, 0.5)) * r!r}, "
+                     f"{data.draw(st.floats(-100.0, 100.0))!r}, {data.draw(st.sampled_from([0.0, 1e8, 3.5e9]))!r}, "
+                     f"{data.draw(st.sampled_from([0.0, 2e9]))!r}")
+    path = tmp_path_factory.mktemp("tables") / "random.csv"
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    columns = network_io.network_table(tubefsi.read_network_table(path, rheology=NEWTONIAN))
+    rows = [line.split(", ") for line in lines[1:]]
+    assert columns["Name"] == [r[0] for r in rows]
+    assert columns["sn"] == [int(r[1]) for r in rows] and columns["tn"] == [int(r[2]) for r in rows]
+    for key, j in (("l(m)", 3), ("Rp(m)", 4), ("E(Pa)", 5), ("h(m)", 6), ("Pext", 7)):
+        assert columns[key] == [float(r[j]) for r in rows]
+    assert columns["R1"] == [float(r[8]) + float(r[9]) for r in rows]
+    again = tmp_path_factory.mktemp("tables") / "again.csv"
+    network_io.write_network_table(tubefsi.read_network_table(path, rheology=NEWTONIAN), again)
+    assert network_io.network_table(tubefsi.read_network_table(again, rheology=NEWTONIAN)) == columns

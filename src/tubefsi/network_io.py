@@ -30,6 +30,7 @@ import scipy.sparse as sp
 from scipy.sparse import csgraph
 
 from ._keywords import checked_keywords
+from ._validation import as_array
 from .errors import InvalidParameterError
 from .geometry import Tube
 from .network import Network
@@ -279,9 +280,10 @@ def read_network_table(source, *, rheology=None, wall=None, thickness=None, dist
     make_wall, needs_e = _wall_maker(wall)
     if thickness is not None and not callable(thickness):
         raise InvalidParameterError("thickness", "a function of the radius (m -> m)", thickness)
-    p_d = float(np.asarray(distal_pressure, dtype=float)) if np.ndim(distal_pressure) == 0 else math.nan
-    if not math.isfinite(p_d):
-        raise InvalidParameterError("distal_pressure", "a finite number (Pa)", distal_pressure)
+    p_d = as_array("distal_pressure", distal_pressure, "a finite number (Pa)", np.isfinite)
+    if p_d.ndim:
+        raise InvalidParameterError("distal_pressure", "a finite number (Pa), one for every outlet", distal_pressure)
+    p_d = float(p_d)
 
     names = table.names("name")
     sn, tn = table.names("sn"), table.names("tn")
