@@ -137,6 +137,12 @@ class _Table:
             if default is None:
                 return None
             return np.full(n, float(default))
+        try:                                        # every cell a number: NumPy parses them at once
+            values = np.array(cells).astype(float)
+        except (TypeError, ValueError):
+            values = None
+        if values is not None and values.shape == (n,) and not np.any(np.isnan(values)):
+            return self._checked(key, cells, values, admissible, predicate)
         values = np.empty(n)
         for k, cell in enumerate(cells):            # a cell is text (a file) or a number (a DataFrame)
             text = cell.strip() if isinstance(cell, str) else cell
@@ -149,6 +155,10 @@ class _Table:
                 values[k] = float(text)
             except (TypeError, ValueError):
                 raise self.error(key, k, admissible, text) from None
+        return self._checked(key, cells, values, admissible, predicate)
+
+    def _checked(self, key, cells, values, admissible, predicate):
+        """``values``, or the error naming the first cell that is not finite or fails ``predicate``."""
         with np.errstate(invalid="ignore"):
             bad = ~(np.isfinite(values) & predicate(values))
         if np.any(bad):
@@ -158,6 +168,13 @@ class _Table:
 
     def names(self, key):
         """Column ``key`` as node or vessel names: integers where a cell is one, else its text."""
+        cells = self.columns[key]
+        if all(isinstance(c, str) for c in cells):     # a file's column: integers at once where all are
+            text = np.char.strip(np.array(cells, dtype=str))
+            digits = np.char.lstrip(text, "+-")
+            if text.size and np.all(np.char.isdigit(digits)) and np.all(np.char.str_len(text) - np.char.str_len(digits)
+                                                                          <= 1):
+                return text.astype(np.int64).tolist()
         out = []
         for k, cell in enumerate(self.columns[key]):
             if isinstance(cell, (int, np.integer)) and not isinstance(cell, bool):
@@ -192,8 +209,7 @@ def _read_csv(path):
         header = header[:-1]
     rows, where = [], []
     for i, row in parsed[1:]:
-        extra = row[len(header):]
-        if any(cell.strip() for cell in extra):
+        if len(row) > len(header) and any(cell.strip() for cell in row[len(header):]):
             raise InvalidParameterError(f"{label}, line {i}", f"{len(header)} cells, one per column of the header",
                                         len(row))
         if len(row) < len(header):
@@ -364,11 +380,44 @@ def _ends(tube):
     return float(a[0]), float(a[1]), float(t[0]), float(t[1]), length
 
 
-def _tubes(network):
-    """``(name, u, v, wall, tube, external pressure)`` per tube, in the network's order."""
+def _geometry(network) -> dict:
+    """Per tube, in the network's order: ``name``, ``u``, ``v`` (lists) and the arrays ``a0``,
+    ``a1`` (radius at the two ends), ``t0``, ``t1`` (thickness), ``length``, ``E`` (the wall's
+    ``youngs_modulus``, NaN for a wall without one) and ``p_ext``. The tubes that share their
+    models (one :meth:`~tubefsi.Network.add_tubes` call) are read in one indexing each; a graded
+    tube on its own."""
     if not isinstance(network, Network):
         raise InvalidParameterError("network", "a tubefsi.Network", network)
-    return [(t.name, t.u, t.v, *t.models()[:2], t.external_pressure) for t in network._tubes.values()]
+    tubes = list(network._tubes.values())
+    n = len(tubes)
+    out = {"name": [t.name for t in tubes], "u": [t.u for t in tubes], "v": [t.v for t in tubes],
+           "p_ext": np.array([t.external_pressure for t in tubes], dtype=float)}
+    for key in ("a0", "a1", "t0", "t1", "length", "E"):
+        out[key] = np.empty(n)
+    groups: dict = {}
+    for k, t in enumerate(tubes):
+        groups.setdefault((id(t.tube), id(t.wall)), []).append(k)
+    for members in groups.values():
+        index = np.asarray(members)
+        first = tubes[members[0]]
+        if first.tube.graded:
+            for k in members:
+                wall, tube, _ = tubes[k].models()
+                a0, a1, t0, t1, length = _ends(tube)
+                out["a0"][k], out["a1"][k], out["t0"][k], out["t1"][k], out["length"][k] = a0, a1, t0, t1, length
+                out["E"][k] = float(getattr(wall, "youngs_modulus", math.nan))
+            continue
+        rows = np.array([tubes[k].row or 0 for k in members])
+
+        def take(value):
+            a = np.asarray(value, dtype=float)
+            return a[rows] if a.ndim else np.full(rows.size, float(a))
+
+        out["a0"][index] = out["a1"][index] = take(first.tube.radius)
+        out["t0"][index] = out["t1"][index] = take(first.tube.thickness)
+        out["length"][index] = take(first.tube.length)
+        out["E"][index] = take(getattr(first.wall, "youngs_modulus", math.nan))
+    return out
 
 
 @checked_keywords
@@ -386,23 +435,32 @@ def network_table(network, *, thickness="auto") -> dict:
     """
     if thickness not in ("auto", True, False):
         raise InvalidParameterError("thickness", "'auto', True or False", thickness)
-    rows = _tubes(network)
+    g = _geometry(network)
+    if not g["name"]:
+        raise InvalidParameterError("network", "a network with at least one tube", network)
+    bad = ~np.isfinite(g["E"])
+    if np.any(bad):
+        k = int(np.flatnonzero(bad)[0])
+        raise InvalidParameterError(f"tube {g['name'][k]!r}", "a wall with a youngs_modulus (the table form holds "
+                                    "linear elastic walls)", type(network._tubes[g["name"][k]].wall).__name__)
     resistance = network._resistance
-    columns = {key: [] for key in _HEADER}
-    h_p, h_d, r_p, r_d = [], [], [], []
+    # a resistance outlet on the first vessel that ends at its node
+    first_into = {}
+    for k, v in enumerate(g["v"]):
+        first_into.setdefault(v, k)
+    terminal = np.zeros(len(g["name"]))
     written = set()
-    for name, u, v, wall, tube, p_ext in rows:
-        a0, a1, t0, t1, length = _ends(tube)
-        modulus = getattr(wall, "youngs_modulus", None)
-        if modulus is None:
-            raise InvalidParameterError(f"tube {name!r}", "a wall with a youngs_modulus (the table form holds "
-                                        "linear elastic walls)", type(wall).__name__)
-        terminal = resistance.get(v, (0.0, 0.0))[0] if v not in written else 0.0
-        written.add(v)
-        for key, value in zip(_HEADER, (name, u, v, 0, length, max(5, round(length * 1e3)), a0, a1, float(modulus),
-                                        p_ext, terminal, 0.0, 0.0)):
-            columns[key].append(value)
-        h_p.append(t0), h_d.append(t1), r_p.append(a0), r_d.append(a1)
+    for node, (r, _) in resistance.items():
+        if node in first_into:
+            terminal[first_into[node]] = r
+            written.add(node)
+    columns = {"Name": g["name"], "sn": g["u"], "tn": g["v"], "wkn": [0] * len(g["name"]),
+               "l(m)": g["length"].tolist(), "M": np.maximum(5, np.round(g["length"] * 1e3)).astype(int).tolist(),
+               "Rp(m)": g["a0"].tolist(), "Rd(m)": g["a1"].tolist(), "E(Pa)": g["E"].tolist(),
+               "Pext": g["p_ext"].tolist(), "R1": terminal.tolist(), "R2": [0.0] * len(g["name"]),
+               "C": [0.0] * len(g["name"])}
+    h_p, h_d, r_p, r_d = g["t0"], g["t1"], g["a0"], g["a1"]
+    rows = [(name,) for name in g["name"]]
     lost = [node for node in resistance if node not in written]
     if lost:
         raise InvalidParameterError("network", "resistance outlets at the target node of a tube (the table puts "
@@ -411,7 +469,6 @@ def network_table(network, *, thickness="auto") -> dict:
     if len(distal) > 1:
         raise InvalidParameterError("network", "one distal pressure for every resistance outlet (the table has "
                                     "none; read_network_table(distal_pressure=...) sets it)", sorted(distal))
-    h_p, h_d, r_p, r_d = map(np.asarray, (h_p, h_d, r_p, r_d))
     rule = bool(np.allclose(h_p, empirical_thickness(r_p), rtol=1e-12, atol=0)
                 and np.allclose(h_d, empirical_thickness(r_d), rtol=1e-12, atol=0))
     if thickness is True or (thickness == "auto" and not rule):
@@ -445,10 +502,12 @@ def write_network_table(network, path, *, thickness="auto", comment=None):
 def tree_layout(network, *, root=None) -> dict:
     r"""Node positions ``node -> (x, y)`` (m) that draw a network as a tree: ``x`` the distance
     from ``root`` along the tubes (their lengths), ``y`` the leaves one apart in depth-first
-    order and every other node midway between its first and last child. The tree is a
-    depth-first spanning tree (a graph with loops draws its other tubes across it); each
-    component of the graph starts at its first node (``root``: default the first node with an
-    inflow, else the first node). Vectorized per level of the tree."""
+    order and every other node midway between its first and last child. The tree is the
+    breadth-first spanning tree from ``root`` (default the first node with an inflow, else
+    the first node; a graph with loops draws its other tubes across it, and each further
+    component of the graph starts at its first node). Vectorized per level of the tree: the
+    cost is O(n log n) for n nodes, and a lattice's tree has about as many levels as hops
+    across it."""
     if not isinstance(network, Network):
         raise InvalidParameterError("network", "a tubefsi.Network", network)
     nodes = network.nodes
@@ -456,11 +515,11 @@ def tree_layout(network, *, root=None) -> dict:
     n = len(nodes)
     if n == 0:
         return {}
-    tubes = list(network._tubes.values())
-    u = np.array([index[t.u] for t in tubes])
-    v = np.array([index[t.v] for t in tubes])
-    length = np.array([float(t.models()[1].length) for t in tubes])
-    graph = sp.coo_matrix((np.ones(len(tubes)), (u, v)), shape=(n, n)).tocsr()
+    g = _geometry(network)
+    u = np.array([index[a] for a in g["u"]], dtype=np.int64)
+    v = np.array([index[b] for b in g["v"]], dtype=np.int64)
+    length = g["length"]
+    graph = sp.coo_matrix((np.ones(u.size), (u, v)), shape=(n, n)).tocsr()
     if root is None:
         root = next((node for node in nodes if node in network._inflow), nodes[0])
     elif root not in index:
@@ -475,27 +534,27 @@ def tree_layout(network, *, root=None) -> dict:
     order_keys = np.argsort(keys, kind="stable")
     keys, key_length = keys[order_keys], np.concatenate([length, length])[order_keys]
     for start in starts:
-        order, pred = csgraph.depth_first_order(graph, start, directed=False, return_predecessors=True)
-        children = order[1:]
+        # the breadth-first spanning tree (shallow: a level per hop from the root), its nodes in
+        # depth-first order (a subtree's leaves next to each other)
+        _, pred = csgraph.breadth_first_order(graph, start, directed=False, return_predecessors=True)
+        children = np.flatnonzero(pred >= 0)
         parents = pred[children]
-        depth = np.zeros(n, dtype=int)
-        ahead = pred.copy()
-        while np.any(ahead[children] >= 0):       # hops to the root, one vectorized step per level
-            moving = children[ahead[children] >= 0]
-            depth[moving] += 1
-            ahead[moving] = pred[ahead[moving]]
+        tree = sp.coo_matrix((np.ones(children.size), (parents, children)), shape=(n, n)).tocsr()
+        order = csgraph.depth_first_order(tree, start, directed=True, return_predecessors=False)
+        depth = np.zeros(n, dtype=np.int64)
+        hops = csgraph.shortest_path(tree, method="D", directed=True, unweighted=True, indices=start)
+        depth[order] = hops[order].astype(np.int64)
+        by_level = order[np.argsort(depth[order], kind="stable")]
+        levels = np.split(by_level, np.flatnonzero(np.diff(depth[by_level])) + 1)
         step = np.zeros(n)
         step[children] = key_length[np.searchsorted(keys, parents * n + children)]
-        height = int(depth[order].max(initial=0))
-        for level in range(1, height + 1):        # x: the distance from the root along the tree
-            at = order[depth[order] == level]
+        for at in levels[1:]:                     # x: the distance from the root along the tree
             x[at] = x[pred[at]] + step[at]
         has_child = np.zeros(n, dtype=bool)
         has_child[parents] = True
         leaves = order[~has_child[order]]
         y[leaves] = row + np.arange(leaves.size)
-        for level in range(height, 0, -1):        # y: midway between the first and last child
-            at = order[depth[order] == level]
+        for at in levels[:0:-1]:                  # y: midway between the first and last child
             low, high = np.full(n, np.inf), np.full(n, -np.inf)
             np.minimum.at(low, pred[at], y[at])
             np.maximum.at(high, pred[at], y[at])
@@ -569,18 +628,13 @@ def write_vtp(network_or_solution, path, *, positions=None):
                                     network_or_solution)
     nodes = network.nodes
     index = {node: i for i, node in enumerate(nodes)}
-    rows = _tubes(network)
-    if not rows:
+    g = _geometry(network)
+    if not g["name"]:
         raise InvalidParameterError("network_or_solution", "a network with at least one tube", network_or_solution)
     xyz = _positions(network, positions)
-    cells = {key: [] for key in _GEOMETRY}
-    connectivity = []
-    for name, u, v, wall, tube, p_ext in rows:
-        a0, a1, t0, t1, length = _ends(tube)
-        for key, value in zip(_GEOMETRY, (0.5 * (a0 + a1), a0, a1, t0, t1, length,
-                                          float(getattr(wall, "youngs_modulus", math.nan)), p_ext)):
-            cells[key].append(value)
-        connectivity.append((index[u], index[v]))
+    cells = dict(zip(_GEOMETRY, (0.5 * (g["a0"] + g["a1"]), g["a0"], g["a1"], g["t0"], g["t1"], g["length"], g["E"],
+                                 g["p_ext"])))
+    connectivity = np.array([[index[a] for a in g["u"]], [index[b] for b in g["v"]]], dtype=np.int64).T
     if solution is not None:
         for key, attribute in _RESULTS.items():
             cells[key] = getattr(solution, attribute)
@@ -594,11 +648,11 @@ def write_vtp(network_or_solution, path, *, positions=None):
         points["pressure"] = solution.pressures
     root = ET.Element("VTKFile", type="PolyData", version="1.0", byte_order="LittleEndian", header_type="UInt64")
     piece = ET.SubElement(ET.SubElement(root, "PolyData"), "Piece", NumberOfPoints=str(len(nodes)),
-                          NumberOfVerts="0", NumberOfLines=str(len(rows)), NumberOfStrips="0", NumberOfPolys="0")
+                          NumberOfVerts="0", NumberOfLines=str(len(g["name"])), NumberOfStrips="0", NumberOfPolys="0")
     _data_array(ET.SubElement(piece, "Points"), "Points", xyz, components=3)
     lines = ET.SubElement(piece, "Lines")
-    _data_array(lines, "connectivity", np.array(connectivity, dtype=np.int64))
-    _data_array(lines, "offsets", 2 * np.arange(1, len(rows) + 1, dtype=np.int64))
+    _data_array(lines, "connectivity", connectivity)
+    _data_array(lines, "offsets", 2 * np.arange(1, len(g["name"]) + 1, dtype=np.int64))
     point_data = ET.SubElement(piece, "PointData")
     for key, values in points.items():
         _data_array(point_data, key, np.asarray(values))
