@@ -42,6 +42,12 @@ class _Tube:
     external_pressure: float = 0.0
     row: object = None
 
+    @property
+    def graded(self) -> bool:
+        """Whether its radius, thickness or a wall parameter varies along it (a graded tube: never
+        from :meth:`Network.add_tubes`)."""
+        return self.tube.graded or varies(self.wall)
+
     def models(self):
         """This tube's wall, tube and fluid, each with scalar parameters."""
         if self.row is None:
@@ -102,7 +108,10 @@ class Network:
         (Pa, any sign) is the pressure outside this tube: its wall sees the node pressures minus
         it (``docs/walls_beyond.md``, "External pressure and collapse"); a node pressure whose
         transmural pressure falls below the wall's buckling bound raises ``BucklingError``.
-        Parameters are scalars.
+        Parameters are scalars or, for a graded (e.g. tapered) tube, functions of the position
+        along it (``docs/graded.md``; :meth:`tubefsi.Tube.tapered`), ``z = 0`` at ``u``: its flow
+        from ``v`` to ``u`` is that of the tube read from ``v`` (``docs/network.md``, "Graded
+        tubes").
         """
         name = (u, v) if name is None else name
         if u == v:
@@ -114,9 +123,6 @@ class Network:
         for label, model in (("wall", wall), ("rheology", fluid), ("tube", tube)):
             if parameter_shape(model) != ():
                 raise InvalidParameterError(label, "scalar parameters (one tube per add_tube)", model)
-            if varies(model):
-                raise InvalidParameterError(label, "a uniform tube and wall (a network takes no tube that varies along z)",
-                                            model)
         p_e = as_array("external_pressure", external_pressure, "the real numbers", np.isfinite)
         if p_e.ndim:
             raise InvalidParameterError("external_pressure", "a number (one tube per add_tube)", external_pressure)
@@ -172,8 +178,8 @@ class Network:
                 raise InvalidParameterError(label, f"scalar parameters or arrays of length {n} (one entry per "
                                             f"tube)", model, f"its parameters have the shape {parameter_shape(model)}")
             if varies(model):
-                raise InvalidParameterError(label, "a uniform tube and wall (a network takes no tube that varies "
-                                            "along z)", model)
+                raise InvalidParameterError(label, "a uniform tube and wall (add a tube that varies along z, a "
+                                            "graded tube, by add_tube)", model)
             models.append(broadcast_model(model, (n,)))
         wall, tube, fluid = models
         p_e = as_array("external_pressure", external_pressure, "the real numbers", np.isfinite)

@@ -109,6 +109,8 @@ class _Solver:
         self.feed_groups = _Groups(self.tubes, self.feeder)
         self.limit = np.where(self.feeder, self.feed_groups.limit, self.groups.limit)
         self.radius = np.where(self.feeder, self.feed_groups.radius, self.groups.radius)
+        self.radius0_u = np.where(self.feeder, self.feed_groups.radius_u, self.groups.radius_u)
+        self.radius0_v = np.where(self.feeder, self.feed_groups.radius_v, self.groups.radius_v)
         self.length = np.where(self.feeder, self.feed_groups.length, self.groups.length)
         # a node's bound: the smallest limit pressure of its tubes (an inlet must stay below it)
         self.p_limit = np.full(n_nodes, np.inf)
@@ -206,10 +208,10 @@ class _Solver:
         drop = np.abs(du)
         drop[drop <= _TINY * float(np.max(p))] = 0.0      # flow ~ (1e-30)^(1/n) of the network's
         outlet = np.where(forward, p[self.V], p[self.U])
-        q, d_in, d_out, r_in, r_out = self.groups.evaluate(drop, outlet)
+        q, d_in, d_out, r_in, r_out = self.groups.evaluate(drop, outlet, forward)
         bad = ~np.isfinite(q)
         if np.any(bad):
-            q, d_in, d_out = self._tiny_drops(bad, drop, outlet, q, d_in, d_out, float(np.max(p)))
+            q, d_in, d_out = self._tiny_drops(bad, drop, outlet, forward, q, d_in, d_out, float(np.max(p)))
         if self.feed_groups.parts:         # the feeders' known flows (their nodes are no unknowns)
             forward = np.where(self.feeder, self.feed_node == self.U, forward)
             q = np.where(self.feeder, self.source[self.feed_node], q)
@@ -234,7 +236,7 @@ class _Solver:
         except RuntimeError as exc:          # an exactly singular Jacobian
             raise ConvergenceError(f"network: singular Jacobian ({exc})") from None
 
-    def _tiny_drops(self, bad, drop, outlet, q, d_in, d_out, scale):
+    def _tiny_drops(self, bad, drop, outlet, forward, q, d_in, d_out, scale):
         """Flows the single-tube solve could not give (NaN): at a pressure drop far below the
         network's pressures the generic rheology path may not resolve the flow. Such a tube is in
         its linear (zero-shear) regime, so its flow is the secant of a probe drop of 1e-8 of the
@@ -246,10 +248,10 @@ class _Solver:
                 break
             probe = np.where(todo, np.maximum(drop, probe_ratio * scale), drop)
             mask = np.zeros_like(todo)
-            for index, *_ in self.groups.parts:
-                mask[index] = todo[index]
+            for part in self.groups.parts:
+                mask[part.index] = todo[part.index]
             sub = _Groups(self.tubes, mask)
-            qp, _, _, _, _ = sub.evaluate(probe, outlet)
+            qp, _, _, _, _ = sub.evaluate(probe, outlet, forward)
             ok = todo & np.isfinite(qp)
             secant = np.where(ok, qp / np.where(ok, probe, 1.0), 0.0)
             q[ok], d_in[ok], d_out[ok] = secant[ok] * drop[ok], secant[ok], -secant[ok]
@@ -363,22 +365,20 @@ class _Solver:
 
     def _result(self, p, q, r_u, r_v, iterations, residual):
         if self.feed_groups.parts:
-            other = np.where(self.feed_node == self.U, self.V, self.U)
-            p_in, r_in, r_out = self.feed_groups.inlet(np.where(self.feeder, q * np.where(self.feed_node == self.U,
-                                                                                         1.0, -1.0), 1.0),
-                                                       p[other], self.tubes)
+            at_u = self.feed_node == self.U
+            other = np.where(at_u, self.V, self.U)
+            p_in, r_in, r_out = self.feed_groups.inlet(np.where(self.feeder, q * np.where(at_u, 1.0, -1.0), 1.0),
+                                                       p[other], self.tubes, at_u)
             p = p.copy()
             p[self.feed_node[self.feeder]] = p_in[self.feeder]
-            at_u = self.feed_node == self.U
             r_u = np.where(self.feeder, np.where(at_u, r_in, r_out), r_u)
             r_v = np.where(self.feeder, np.where(at_u, r_out, r_in), r_v)
         for groups in (self.groups, self.feed_groups):
-            groups.check(q, r_u, r_v, self.tubes)
-        fluids = tuple((index, fluid) for groups in (self.groups, self.feed_groups)
-                       for index, fluid, _, _ in groups.parts)
+            groups.check(q, r_u, r_v, self.tubes, q >= 0)
+        fluids = self.groups.fluids() + self.feed_groups.fluids()
         return NetworkSolution(net=self.net, nodes=self.nodes, tubes=self.tubes, p=p, q=q, radius_u=r_u,
                                radius_v=r_v, iterations=iterations, residual=residual, U=self.U, V=self.V,
-                               radius0=self.radius, length=self.length, fluids=fluids)
+                               radius0=self.radius0_u, radius0_v=self.radius0_v, length=self.length, fluids=fluids)
 
     def _noise(self, p, q, gu, gv):
         """Per free node, the mass imbalance that rounding alone leaves: the pressures' rounding
