@@ -11,7 +11,7 @@ from numpy.typing import ArrayLike
 
 from .errors import InvalidParameterError
 from .fields import positive
-from .profiles import Profile
+from .profiles import Profile, sampled
 
 __all__ = ["Tube"]
 
@@ -63,8 +63,6 @@ class Tube:
         at the inlet, :math:`t_L = t_0 a_L/a_0`). Each is a linear :func:`~tubefsi.sampled` table
         over :math:`[0, L]` (``docs/graded.md``); equal ends give a uniform tube. All numbers (m,
         > 0); the command line's ``outlet_radius=..``."""
-        from .profiles import sampled
-
         values = {}
         for name, value in (("length", length), ("radius", radius), ("outlet_radius", outlet_radius),
                             ("thickness", thickness), ("outlet_thickness", outlet_thickness)):
