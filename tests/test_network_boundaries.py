@@ -149,3 +149,39 @@ def test_resistances_round_trip_through_networkx():
     net.set_pressure("in", 100.0).set_resistance("out", 3e11, distal_pressure=5.0)
     again = Network.from_networkx(net.to_networkx(), rheology=NEWTONIAN)
     np.testing.assert_array_equal(again.solve().pressures, net.solve().pressures)
+
+
+def test_resistance_outlets_are_equivalent_series_tubes():
+    """Two inlets (a fixed pressure, an inflow) and three resistance outlets, each with its own R
+    and distal pressure, on a compliant power-law network with a cycle, against the same network
+    with each resistance replaced by a rigid Newtonian tube of Poiseuille resistance
+    8 mu L / (pi a^4) = R ending at a node fixed at the distal pressure (the edge law instead of
+    the outlet term): the same pressures and flows to 1e-11."""
+    fluid = rheologies["power-law"](consistency=0.01, index=0.7)
+    wall = walls["thick-neo-hookean"](shear_modulus=4e3)
+    edges = [("p", "a"), ("q", "a"), ("a", "b"), ("a", "c"), ("b", "c"), ("b", "o1"), ("c", "o2"), ("c", "o3")]
+    outlets = {"o1": (3e12, 0.0), "o2": (5e12, 40.0), "o3": (8e12, 10.0)}
+    length = 1e-2
+
+    def build(with_tubes):
+        net = Network(rheology=fluid)
+        for k, (u, v) in enumerate(edges):
+            net.add_tube(u, v, wall, Tube(radius=1e-4 * (1 + 0.1 * k), thickness=3e-5, length=length))
+        net.set_pressure("p", 400.0).set_inflow("q", 2e-9)
+        for node, (r, p_d) in outlets.items():
+            if with_tubes:         # a rigid tube of resistance r: a = (8 mu L / (pi r))^(1/4)
+                a = (8 * MU * length / (math.pi * r)) ** 0.25
+                net.add_tube(node, node + "'", RIGID, Tube(radius=a, thickness=0.3 * a, length=length),
+                             rheology=NEWTONIAN)
+                net.set_pressure(node + "'", p_d)
+            else:
+                net.set_resistance(node, r, distal_pressure=p_d)
+        return net.solve()
+
+    plain, series = build(False), build(True)
+    for node in plain.nodes:
+        assert series.pressure[node] == pytest.approx(plain.pressure[node], rel=1e-11, abs=1e-9)
+    for name in plain.tube_names:
+        assert series.flow_rate[name] == pytest.approx(plain.flow_rate[name], rel=1e-11, abs=1e-11 * 2e-9)
+    for node, (r, p_d) in outlets.items():
+        assert series.flow_rate[(node, node + "'")] == pytest.approx((plain.pressure[node] - p_d) / r, rel=1e-11)
