@@ -333,7 +333,10 @@ class _Solver:
                     if not self._pinned_done(pinned, balance, p, max(rtol * through, 10 * float(np.sum(np.abs(F))))):
                         release = True
                         break
-                if alpha < 1e-10 and np.all(np.abs(F) <= 10 * self._noise(p, q, gu, gv)) \
+                # rounding alone: the imbalance within ten times what the pressures' rounding
+                # leaves, as a whole (the norm the line search decreases: a node whose own noise is
+                # small cannot be improved where its neighbours' rounding dwarfs it)
+                if alpha < 1e-10 and norm <= 10 * float(np.linalg.norm(self._noise(p, q, gu, gv))) \
                         and _share(worst, through) <= _WORST_ROUNDED:
                     warn_user(f"network: mass balance to {_share(worst, through):.1e} of the throughput, not rtol = "
                               f"{rtol:g}: pressures close to a limit pressure amplify the rounding of the "
