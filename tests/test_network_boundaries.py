@@ -185,3 +185,28 @@ def test_resistance_outlets_are_equivalent_series_tubes():
         assert series.flow_rate[name] == pytest.approx(plain.flow_rate[name], rel=1e-11, abs=1e-11 * 2e-9)
     for node, (r, p_d) in outlets.items():
         assert series.flow_rate[(node, node + "'")] == pytest.approx((plain.pressure[node] - p_d) / r, rel=1e-11)
+
+
+def test_inflow_beyond_what_the_resistance_outlets_take_is_no_steady_state():
+    """Without a fixed pressure all the inflow leaves by the resistance outlets, each taking at most
+    (p_lim - p_d)/R (p_lim = mu ln(1 + t/a), the thick neo-Hookean limit pressure in closed form):
+    an inflow beyond the sum raises NoSteadyStateError at once with that capacity; below it, a
+    steady state."""
+    wall = walls["thick-neo-hookean"](shear_modulus=4e3)
+    limit = 4e3 * math.log1p(0.3)
+    outlets = {"a": (2e12, 10.0), "b": (5e12, 0.0)}
+    capacity = sum((limit - p_d) / r for r, p_d in outlets.values())
+
+    def network(q):
+        net = Network(rheology=rheologies["power-law"](consistency=0.01, index=0.7))
+        net.add_tube("in", "j", wall, TUBE).add_tube("j", "a", wall, TUBE).add_tube("j", "b", wall, TUBE)
+        for node, (r, p_d) in outlets.items():
+            net.set_resistance(node, r, distal_pressure=p_d)
+        return net.set_inflow("in", q)
+
+    with pytest.raises(tubefsi.NoSteadyStateError, match="resistance outlets") as info:
+        network(1.01 * capacity).solve()
+    assert info.value.limit == pytest.approx(capacity, rel=1e-14)
+    result = network(0.3 * capacity).solve()
+    assert sum((result.pressure[n] - p_d) / r for n, (r, p_d) in outlets.items()) == pytest.approx(0.3 * capacity,
+                                                                                                  rel=1e-12)

@@ -90,7 +90,8 @@ def test_random_diamonds_balance(seed):
 
 @pytest.mark.slow
 def test_many_random_diamonds():
-    """The same for 400 fixed seeds (the long run; seeds 12, 33, 39, 66, 228, 245, 288 failed before
-    the fixes of this round)."""
-    for seed in range(400):
+    """The same for 400 fixed seeds and seed 1108 (the long run; seeds 12, 33, 39, 66, 228, 245,
+    288 and 1108 failed before the fixes of this round; 1108's inflow exceeds what its resistance
+    outlet takes below its limit pressure)."""
+    for seed in [*range(400), 1108]:
         test_random_diamonds_balance.hypothesis.inner_test(seed=seed)

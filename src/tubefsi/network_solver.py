@@ -122,8 +122,26 @@ class _Solver:
             raise NoSteadyStateError("pressure", self.p_limit[i], self.p_fixed[i],
                                      f"node {self.nodes[i]!r} is fixed at or beyond the limit pressure of tube "
                                      f"{self._limiting_tube(i)!r}")
+        self._check_outlet_capacity()
         self.n_tubes = n_tubes
         self._unknowns(~self.fixed)
+
+    def _check_outlet_capacity(self):
+        """Without a fixed pressure, all that enters leaves by the resistance outlets, each taking
+        at most :math:`(p_{lim} - p_d)/R` below its node's limit pressure: net inflows beyond that
+        sum have no steady state (``NoSteadyStateError`` at once, naming it)."""
+        if np.any(self.fixed):
+            return
+        outlets = np.flatnonzero(self.g_out)
+        capacity = float(np.sum(self.g_out[outlets] * (self.p_limit[outlets] - self.p_distal[outlets])))
+        inflow = float(np.sum(self.source))
+        if inflow > capacity:
+            i = int(outlets[np.argmin(self.p_limit[outlets])])
+            raise NoSteadyStateError("flow_rate", capacity, inflow,
+                                     f"the net inflow exceeds what the resistance outlets take with every outlet "
+                                     f"node below its limit pressure, sum (p_lim - p_d)/R (e.g. node "
+                                     f"{self.nodes[i]!r} at the limit pressure {self.p_limit[i]:.6g} Pa of tube "
+                                     f"{self._limiting_tube(i)!r})")
 
     def _check_connected(self, n):
         graph = sp.coo_matrix((np.ones(self.U.size), (self.U, self.V)), shape=(n, n))
