@@ -18,6 +18,7 @@ from ._validation import as_array
 from .errors import InvalidParameterError
 from .fields import broadcast_model, varies, _array_fields, parameter_shape
 from .geometry import Tube
+from .network_fit import fit_network
 from .network_solution import NetworkSolution, _hashable
 from .network_solver import _Solver
 from .rheology.base import Rheology
@@ -360,6 +361,49 @@ class Network:
             return solver.run(rtol, max_iterations, shown, start)
         finally:
             shown.close()
+
+    @checked_keywords
+    def fit(self, *, pressure=None, flow_rate=None, moduli=None, resistances=None, pressure_sigma=None,
+            flow_sigma=None, rtol: float = 1e-13):
+        r"""Calibrate per-group wall moduli and terminal resistances to measured node pressures and
+        tube flow rates by least squares (``docs/network.md``, "Calibration").
+
+        Parameters
+        ----------
+        pressure : mapping node -> Pa, optional
+            Measured node pressures.
+        flow_rate : mapping tube name -> m^3/s, optional
+            Measured flow rates (positive from the tube's ``u`` to its ``v``).
+        moduli : mapping group name -> sequence of tube names, optional
+            Each group's tubes share one value of the modulus that scales their walls' tube law
+            (:math:`P = \mu\hat P(\lambda)`: a neo-Hookean wall's shear modulus, a linear wall's
+            Young's modulus), fitted as ``"modulus[<group>]"``; they start from one value of it.
+        resistances : sequence of nodes, optional
+            Resistance outlets (:meth:`set_resistance`) whose resistance is fitted, as
+            ``"resistance[<node>]"``.
+        pressure_sigma, flow_sigma : float, optional
+            The scales of the pressure and flow residuals (default: the root mean square of the
+            measured values of each kind).
+
+        Every parameter is fitted through its logarithm, within a factor 1e4 of its start, with
+        the analytic Jacobian of the implicit function theorem on the Kirchhoff system; each
+        evaluation is one :meth:`solve`, warm-started from the previous one.
+
+        Returns
+        -------
+        NetworkFitResult
+            ``network`` (a copy with the fitted values), ``solution``, ``parameters``,
+            ``standard_errors`` (Gauss–Newton, by the delta method), ``covariance``,
+            ``residuals`` (weighted), ``success``, ``message``.
+
+        Warns
+        -----
+        FitWarning
+            Where the data do not support the fit (as :func:`tubefsi.fit`).
+        """
+        return fit_network(self, pressure=pressure, flow_rate=flow_rate, moduli=moduli, resistances=resistances,
+                           pressure_sigma=pressure_sigma, flow_sigma=flow_sigma,
+                           rtol=float(as_array("rtol", rtol, "[1e-15, 1)", lambda a: (a >= 1e-15) & (a < 1))))
 
     def _snapshot(self):
         """A copy that later changes to this network do not reach (the solution keeps it)."""

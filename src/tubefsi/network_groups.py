@@ -71,10 +71,15 @@ class _Groups:
         groups: dict = {}
         keys: dict = {}               # id(model) -> its class and non-array parameters
         graded: dict = {}             # (the same wall, tube and fluid) -> graded tubes
+        is_graded: dict = {}          # (id(wall), id(tube)) -> whether they vary along z
         for i, t in enumerate(tubes):
             if not subset[i]:
                 continue
-            if t.graded:
+            pair = (id(t.wall), id(t.tube))
+            found = is_graded.get(pair)
+            if found is None:
+                found = is_graded[pair] = t.graded
+            if found:
                 graded.setdefault((id(t.wall), id(t.tube), id(t.rheology)), []).append(i)
                 continue
             wall, fluid = t.wall, t.rheology
@@ -135,6 +140,35 @@ class _Groups:
         for part in self.parts:
             for where, wall, tube, p_e in part.split(forward):
                 yield part, part.index[where], wall, tube, p_e
+
+    def modulus_derivative(self, drop, outlet, forward):
+        r"""Per tube, :math:`\mu\,\partial q/\partial\mu` at fixed end pressures, :math:`\mu` the
+        modulus that scales its wall's tube law (:math:`P = \mu\hat P(\lambda)`), oriented as
+        :meth:`evaluate`'s flows (from the inlet), with its flows and their derivatives by the end
+        pressures: ``(q, d_in, d_out, scale)``.
+
+        The separated identity :math:`F = \int_{p_{out}}^{p_{in}} dp/G(q, R(p)) - L = 0` with
+        :math:`R = a\hat\lambda(p/\mu)` makes :math:`F + L` homogeneous of degree one in
+        :math:`(p_{in}, p_{out}, \mu)` (transmural pressures), so Euler's identity and
+        :math:`\partial_q F = -K/q` give
+        :math:`\mu\,\partial q/\partial\mu = (L G_{in} - p_{in})\,\partial q/\partial p_{in}
+        - p_{out}\,\partial q/\partial p_{out}` (:math:`L` the installed length, :math:`G_{in}`
+        the pressure gradient at the inlet). Uniform tubes only (a graded tube: NaN)."""
+        q, d_in, d_out, scale = (np.full(drop.size, np.nan) for _ in range(4))
+        for part, index, wall, tube, p_e in self._pieces(forward):
+            sol = solve_unchecked(part.fluid, wall, tube, pressure_drop=drop[index], outlet_pressure=outlet[index],
+                                  external_pressure=p_e)
+            qi = np.broadcast_to(np.asarray(sol.flow_rate, dtype=float), index.shape)
+            _, di, do = (np.broadcast_to(np.asarray(x, dtype=float), index.shape) for x in sol._sensitivities())
+            q[index], d_in[index], d_out[index] = qi, di, do
+            if part.reverse is not None:
+                continue
+            p_out = outlet[index] - np.asarray(p_e, dtype=float)
+            g_in = np.broadcast_to(np.asarray(part.fluid._pressure_gradient(
+                qi, np.broadcast_to(np.asarray(sol.inlet_radius, dtype=float), index.shape)), dtype=float), index.shape)
+            length = np.broadcast_to(np.asarray(sol.tube.length, dtype=float), index.shape)
+            scale[index] = (length * g_in - (p_out + drop[index])) * di - p_out * do
+        return q, d_in, d_out, scale
 
     def check(self, q, radius_u, radius_v, tubes, forward):
         """The converged tubes against the model's assumptions (:mod:`tubefsi.validity`): one
