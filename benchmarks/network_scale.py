@@ -18,7 +18,7 @@ The fluid is one power law (m = 0.01 Pa s^n, n = 0.8). Two timed runs, side by s
 alternating passes in one process (median of the passes):
 
 * **nonlinear**: ``Network()`` + one ``add_tubes`` call from the arrays + the boundary conditions
-  (``set_pressure`` per fixed node), ``solve()``, then reading every result: the arrays
+  (one ``set_pressures`` call for the fixed nodes), ``solve()``, then reading every result: the arrays
   ``pressures``, ``flow_rates``, ``pressure_drops``, ``radius_u/v``, ``strain_u/v``,
   ``wall_shear_stress_u/v``, and every flow rate by name (``result.flow_rate[name]`` for every
   tube);
@@ -92,8 +92,7 @@ def nonlinear(graph):
     net = tubefsi.Network(rheology=rheologies["power-law"](consistency=0.01, index=0.8))
     net.add_tubes(u, v, walls["thick-neo-hookean"](shear_modulus=modulus),
                   tubefsi.Tube(radius=radius, thickness=thickness, length=length))
-    for node, p in zip(fixed.tolist(), p_fixed.tolist()):
-        net.set_pressure(node, p)
+    net.set_pressures(fixed, p_fixed)
     result = net.solve()
     total = 0.0
     for a in (result.pressures, result.flow_rates, result.pressure_drops, result.radius_u, result.radius_v,

@@ -240,6 +240,55 @@ class Network:
         self._resistance[node] = (r, p_d)
         return self
 
+    @checked_keywords
+    def set_pressures(self, nodes, pressures) -> Network:
+        """Fix the pressures of many nodes at once, as :meth:`set_pressure` for each: ``nodes`` a
+        sequence or 1-D array of node names, ``pressures`` (Pa, >= 0) a number or an array as
+        long. Everything is checked before any is set."""
+        nodes, values = self._many(nodes, pressures, "pressures", "[0, inf)", lambda a: a >= 0)
+        self._free_of_all(nodes, "pressure")
+        self._pressure.update(zip(nodes, values))
+        return self
+
+    @checked_keywords
+    def set_inflows(self, nodes, flow_rates) -> Network:
+        """Inject flow rates at many nodes at once, as :meth:`set_inflow` for each (m^3/s, a
+        number or an array as long as ``nodes``)."""
+        nodes, values = self._many(nodes, flow_rates, "flow_rates", "(-inf, inf)", np.isfinite)
+        self._free_of_all(nodes, "inflow")
+        self._inflow.update(zip(nodes, values))
+        return self
+
+    @checked_keywords
+    def set_resistances(self, nodes, resistances, distal_pressures=0.0) -> Network:
+        """Make many nodes resistance outlets at once, as :meth:`set_resistance` for each, each
+        with its own terminal resistance (Pa s/m^3, > 0) and distal pressure (Pa): numbers or
+        arrays as long as ``nodes``."""
+        nodes, r = self._many(nodes, resistances, "resistances", "(0, inf) Pa s/m^3",
+                              lambda a: np.isfinite(a) & (a > 0))
+        _, p_d = self._many(nodes, distal_pressures, "distal_pressures", "the real numbers (Pa)", np.isfinite)
+        self._free_of_all(nodes, "resistance")
+        self._resistance.update(zip(nodes, zip(r, p_d)))
+        return self
+
+    def _many(self, nodes, values, label, admissible, check):
+        """``(nodes, values)`` of a bulk setter as lists, the values checked and broadcast."""
+        nodes = _names_of("nodes", nodes)
+        array = as_array(label, values, admissible, check)
+        if array.shape not in ((), (len(nodes),)):
+            raise InvalidParameterError(label, f"a number or an array of length {len(nodes)} (one per node)",
+                                        array.shape)
+        return nodes, np.broadcast_to(array.astype(float), (len(nodes),)).tolist()
+
+    def _free_of_all(self, nodes, kind):
+        """:meth:`_free_of` for many nodes (one set intersection per other kind)."""
+        for other, store in (("pressure", self._pressure), ("inflow", self._inflow),
+                             ("resistance", self._resistance)):
+            if other != kind and store:
+                clash = store.keys() & set(nodes)
+                if clash:
+                    self._free_of(next(iter(clash)), kind)
+
     def _free_of(self, node, kind):
         """Raise unless ``node`` has no boundary condition but one of ``kind`` (which it replaces)."""
         for other, store in (("pressure", self._pressure), ("inflow", self._inflow),

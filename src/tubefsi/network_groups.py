@@ -68,35 +68,33 @@ class _Groups:
     graded-tube engine (:class:`tubefsi.couplers.Graded`) from whichever end its flow enters."""
 
     def __init__(self, tubes, subset):
+        # one dict lookup per tube: the models' identities -> the group they belong to (a graded
+        # tube's: its very models; a uniform one's: its wall and fluid classes and fixed parameters)
         groups: dict = {}
-        keys: dict = {}               # id(model) -> its class and non-array parameters
-        graded: dict = {}             # (the same wall, tube and fluid) -> graded tubes
-        is_graded: dict = {}          # (id(wall), id(tube)) -> whether they vary along z
+        graded: dict = {}
+        by_models: dict = {}
+        take = subset.tolist()
         for i, t in enumerate(tubes):
-            if not subset[i]:
+            if not take[i]:
                 continue
-            pair = (id(t.wall), id(t.tube))
-            found = is_graded.get(pair)
+            ids = (id(t.wall), id(t.tube), id(t.rheology))
+            found = by_models.get(ids)
             if found is None:
-                found = is_graded[pair] = t.graded
-            if found:
-                graded.setdefault((id(t.wall), id(t.tube), id(t.rheology)), []).append(i)
-                continue
-            wall, fluid = t.wall, t.rheology
-            if id(wall) not in keys:
-                keys[id(wall)] = (type(wall), _fixed(wall))
-            if id(fluid) not in keys:
-                keys[id(fluid)] = (type(fluid), _fixed(fluid))
-            groups.setdefault((keys[id(wall)], keys[id(fluid)]), []).append(i)
+                if t.graded:
+                    found = by_models[ids] = graded.setdefault(ids, [])
+                else:
+                    key = ((type(t.wall), _fixed(t.wall)), (type(t.rheology), _fixed(t.rheology)))
+                    found = by_models[ids] = groups.setdefault(key, [])
+            found.append(i)
         self.parts = []
-        for index in groups.values():
+        for index in (g for g in groups.values() if g):
             members = [tubes[i] for i in index]
             wall = _stack(members, "wall")
             fluid = _stack(members, "rheology")
             tube = Tube(**_gather(members, "tube", ("radius", "thickness", "length")))
             self.parts.append(_Part(np.asarray(index), fluid, wall, tube,
                                     _column([m.external_pressure for m in members])))
-        for index in graded.values():
+        for index in (g for g in graded.values() if g):
             t = tubes[index[0]]
             self.parts.append(_Part(np.asarray(index), t.rheology, t.wall, t.tube,
                                     _column([tubes[i].external_pressure for i in index]), _reversed(t.wall, t.tube)))
@@ -305,14 +303,18 @@ def _gather(members, which, fields) -> dict:
     agree, else an array aligned with ``members``). Tubes added together by
     :meth:`Network.add_tubes` share one model: their entries are taken at their rows, in one
     indexing per model rather than one lookup per tube."""
-    by_model: dict = {}
-    for j, m in enumerate(members):
-        model = getattr(m, which)
-        entry = by_model.get(id(model))
-        if entry is None:
-            entry = by_model[id(model)] = (model, [], [])
-        entry[1].append(j)
-        entry[2].append(m.row)
+    models = [getattr(m, which) for m in members]
+    first = models[0]
+    if all(model is first for model in models):          # one model (one add_tubes call, or shared)
+        by_model = {id(first): (first, slice(None), [m.row for m in members])}
+    else:
+        by_model = {}
+        for j, (m, model) in enumerate(zip(members, models)):
+            entry = by_model.get(id(model))
+            if entry is None:
+                entry = by_model[id(model)] = (model, [], [])
+            entry[1].append(j)
+            entry[2].append(m.row)
     out = {f: np.empty(len(members)) for f in fields}
     for model, positions, rows in by_model.values():
         for f in fields:
