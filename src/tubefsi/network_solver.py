@@ -1,9 +1,11 @@
-r"""Steady flow through a network of soft tubes (``docs/network.md``).
+r"""Newton's method for the steady flow through a :class:`~tubefsi.Network` (``docs/network.md``).
 
 Nodes carry pressures :math:`p_i` (transmural, gauge); a tube :math:`e = (u, v)` carries the
 flow :math:`q_e = Q_e(p_u, p_v)` of the pressure-controlled single-tube problem, solved from the
 higher-pressure end, so that the edge law is odd in :math:`p_u - p_v`:
-:math:`Q_e = \operatorname{sign}(p_u - p_v)\,Q(|p_u - p_v|;\ \min(p_u, p_v))`. At every node
+:math:`Q_e = \operatorname{sign}(p_u - p_v)\,Q(|p_u - p_v|;\ \min(p_u, p_v))` (a graded tube's
+:math:`Q` is that of the tube read from the end its flow enters, so its law is not odd:
+:mod:`tubefsi.network_groups`). At every node
 without a fixed pressure Kirchhoff's law holds,
 
 .. math::  F_i(p) = \sum_{e:\,v_e = i} q_e - \sum_{e:\,u_e = i} q_e + s_i + (p_{d,i} - p_i)/R_i = 0,
