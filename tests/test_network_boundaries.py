@@ -210,3 +210,33 @@ def test_inflow_beyond_what_the_resistance_outlets_take_is_no_steady_state():
     result = network(0.3 * capacity).solve()
     assert sum((result.pressure[n] - p_d) / r for n, (r, p_d) in outlets.items()) == pytest.approx(0.3 * capacity,
                                                                                                   rel=1e-12)
+
+
+def test_bulk_boundary_conditions_are_the_single_ones():
+    """set_pressures, set_inflows and set_resistances give the network that the single setters
+    give (the same solution, bit for bit), and check their input before setting any."""
+    fluid = rheologies["power-law"](consistency=0.01, index=0.7)
+    wall = walls["thick-neo-hookean"](shear_modulus=4e3)
+
+    def tree():
+        net = Network(rheology=fluid)
+        for u, v in (("r", "j"), ("j", "a"), ("j", "b"), ("r", "k"), ("k", "c"), ("k", "d"), ("s", "r")):
+            net.add_tube(u, v, wall, TUBE)
+        return net
+
+    single = tree().set_pressure("a", 10.0).set_pressure("b", 20.0).set_inflow("s", 1e-10).set_inflow("k", 2e-11)
+    single.set_resistance("c", 1e12, 5.0).set_resistance("d", 2e12, 0.0)
+    bulk = tree().set_pressures(["a", "b"], np.array([10.0, 20.0])).set_inflows(["s", "k"], [1e-10, 2e-11])
+    bulk.set_resistances(np.array(["c", "d"]), [1e12, 2e12], distal_pressures=[5.0, 0.0])
+    one, many = single.solve(), bulk.solve()
+    assert np.array_equal(one.pressures, many.pressures)
+    assert np.array_equal(one.flow_rates, many.flow_rates)
+    net = tree()
+    with pytest.raises(InvalidParameterError, match="pressures"):
+        net.set_pressures(["a", "b"], [1.0, -2.0])
+    with pytest.raises(InvalidParameterError, match="length 2"):
+        net.set_pressures(["a", "b"], [1.0, 2.0, 3.0])
+    net.set_inflows(["a"], 1e-12)
+    with pytest.raises(InvalidParameterError, match="inflow already"):
+        net.set_pressures(["b", "a"], 1.0)
+    assert "b" not in net._pressure                   # nothing set
