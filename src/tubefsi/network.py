@@ -7,6 +7,7 @@ evaluation of its tubes by groups in :mod:`tubefsi.network_groups`, its results 
 from __future__ import annotations
 
 import copy
+import itertools
 from collections.abc import Hashable
 
 import attrs
@@ -162,16 +163,18 @@ class Network:
         names = [(a, b) for a, b in zip(u, v)] if names is None else _names_of("names", names)
         if len(names) != n:
             raise InvalidParameterError("names", f"{n} names, one per tube", len(names))
-        for k, (a, b) in enumerate(zip(u, v)):
-            if a == b:
-                raise InvalidParameterError(f"v[{k}]", "a node other than u[k]", b, "a tube joins two distinct nodes")
+        loops = [k for k, (a, b) in enumerate(zip(u, v)) if a == b]
+        if loops:
+            k = loops[0]
+            raise InvalidParameterError(f"v[{k}]", "a node other than u[k]", v[k], "a tube joins two distinct nodes")
         taken = self._tubes.keys()
-        seen = set()
-        for k, name in enumerate(names):
-            if name in taken or name in seen:
-                raise InvalidParameterError(f"names[{k}]", "a name no other tube has", name,
-                                            "tubes between the same two nodes need distinct names")
-            seen.add(name)
+        if len(set(names)) != n or not taken.isdisjoint(names):       # (set operations: one pass in C)
+            seen = set()
+            for k, name in enumerate(names):
+                if name in taken or name in seen:
+                    raise InvalidParameterError(f"names[{k}]", "a name no other tube has", name,
+                                                "tubes between the same two nodes need distinct names")
+                seen.add(name)
         wall, tube, fluid = self._models(wall, tube, rheology)
         models = []
         for label, model in (("wall", wall), ("tube", tube), ("rheology", fluid)):
@@ -188,11 +191,12 @@ class Network:
             raise InvalidParameterError("external_pressure", f"a number or an array of length {n}", p_e.shape)
         p_e = np.broadcast_to(p_e.astype(float), (n,)).tolist()
         shared = parameter_shape(wall) == parameter_shape(tube) == parameter_shape(fluid) == ()
-        for node in u + v:
-            self._nodes.setdefault(node, len(self._nodes))
-        tubes = self._tubes
-        for k in range(n):
-            tubes[names[k]] = _Tube(names[k], u[k], v[k], wall, tube, fluid, p_e[k], None if shared else k)
+        nodes = self._nodes
+        fresh = [node for node in dict.fromkeys(u + v) if node not in nodes]
+        nodes.update(zip(fresh, range(len(nodes), len(nodes) + len(fresh))))
+        rows = itertools.repeat(None, n) if shared else range(n)
+        self._tubes.update(zip(names, map(_Tube, names, u, v, itertools.repeat(wall, n), itertools.repeat(tube, n),
+                                          itertools.repeat(fluid, n), p_e, rows)))
         return self
 
     @checked_keywords
