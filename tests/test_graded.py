@@ -348,16 +348,6 @@ def test_separable_taper_derivatives_and_unsupported_ones():
         sol.diagnostics()
 
 
-def test_networks_take_no_graded_tube():
-    net = tubefsi.Network(rheology=power_law(0.7))
-    with pytest.raises(tubefsi.InvalidParameterError, match="varies along z"):
-        net.add_tube("a", "b", walls["thick-neo-hookean"](shear_modulus=MU),
-                     tubefsi.Tube(radius=taper(), thickness=2e-4, length=L))
-    with pytest.raises(tubefsi.InvalidParameterError, match="varies along z"):
-        net.add_tube("a", "b", walls["thick-neo-hookean"](shear_modulus=lambda z: MU),
-                     tubefsi.Tube(radius=A0, thickness=2e-4, length=L))
-
-
 # ------------------------------------------------------------------ derivatives of a graded solve
 def _central(f, x, h):
     """Richardson-extrapolated central difference of ``f`` at ``x`` with steps ``h``, ``h/2`` (error

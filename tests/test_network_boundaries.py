@@ -149,3 +149,94 @@ def test_resistances_round_trip_through_networkx():
     net.set_pressure("in", 100.0).set_resistance("out", 3e11, distal_pressure=5.0)
     again = Network.from_networkx(net.to_networkx(), rheology=NEWTONIAN)
     np.testing.assert_array_equal(again.solve().pressures, net.solve().pressures)
+
+
+def test_resistance_outlets_are_equivalent_series_tubes():
+    """Two inlets (a fixed pressure, an inflow) and three resistance outlets, each with its own R
+    and distal pressure, on a compliant power-law network with a cycle, against the same network
+    with each resistance replaced by a rigid Newtonian tube of Poiseuille resistance
+    8 mu L / (pi a^4) = R ending at a node fixed at the distal pressure (the edge law instead of
+    the outlet term): the same pressures and flows to 1e-11."""
+    fluid = rheologies["power-law"](consistency=0.01, index=0.7)
+    wall = walls["thick-neo-hookean"](shear_modulus=4e3)
+    edges = [("p", "a"), ("q", "a"), ("a", "b"), ("a", "c"), ("b", "c"), ("b", "o1"), ("c", "o2"), ("c", "o3")]
+    outlets = {"o1": (3e12, 0.0), "o2": (5e12, 40.0), "o3": (8e12, 10.0)}
+    length = 1e-2
+
+    def build(with_tubes):
+        net = Network(rheology=fluid)
+        for k, (u, v) in enumerate(edges):
+            net.add_tube(u, v, wall, Tube(radius=1e-4 * (1 + 0.1 * k), thickness=3e-5, length=length))
+        net.set_pressure("p", 400.0).set_inflow("q", 2e-9)
+        for node, (r, p_d) in outlets.items():
+            if with_tubes:         # a rigid tube of resistance r: a = (8 mu L / (pi r))^(1/4)
+                a = (8 * MU * length / (math.pi * r)) ** 0.25
+                net.add_tube(node, node + "'", RIGID, Tube(radius=a, thickness=0.3 * a, length=length),
+                             rheology=NEWTONIAN)
+                net.set_pressure(node + "'", p_d)
+            else:
+                net.set_resistance(node, r, distal_pressure=p_d)
+        return net.solve()
+
+    plain, series = build(False), build(True)
+    for node in plain.nodes:
+        assert series.pressure[node] == pytest.approx(plain.pressure[node], rel=1e-11, abs=1e-9)
+    for name in plain.tube_names:
+        assert series.flow_rate[name] == pytest.approx(plain.flow_rate[name], rel=1e-11, abs=1e-11 * 2e-9)
+    for node, (r, p_d) in outlets.items():
+        assert series.flow_rate[(node, node + "'")] == pytest.approx((plain.pressure[node] - p_d) / r, rel=1e-11)
+
+
+def test_inflow_beyond_what_the_resistance_outlets_take_is_no_steady_state():
+    """Without a fixed pressure all the inflow leaves by the resistance outlets, each taking at most
+    (p_lim - p_d)/R (p_lim = mu ln(1 + t/a), the thick neo-Hookean limit pressure in closed form):
+    an inflow beyond the sum raises NoSteadyStateError at once with that capacity; below it, a
+    steady state."""
+    wall = walls["thick-neo-hookean"](shear_modulus=4e3)
+    limit = 4e3 * math.log1p(0.3)
+    outlets = {"a": (2e12, 10.0), "b": (5e12, 0.0)}
+    capacity = sum((limit - p_d) / r for r, p_d in outlets.values())
+
+    def network(q):
+        net = Network(rheology=rheologies["power-law"](consistency=0.01, index=0.7))
+        net.add_tube("in", "j", wall, TUBE).add_tube("j", "a", wall, TUBE).add_tube("j", "b", wall, TUBE)
+        for node, (r, p_d) in outlets.items():
+            net.set_resistance(node, r, distal_pressure=p_d)
+        return net.set_inflow("in", q)
+
+    with pytest.raises(tubefsi.NoSteadyStateError, match="resistance outlets") as info:
+        network(1.01 * capacity).solve()
+    assert info.value.limit == pytest.approx(capacity, rel=1e-14)
+    result = network(0.3 * capacity).solve()
+    assert sum((result.pressure[n] - p_d) / r for n, (r, p_d) in outlets.items()) == pytest.approx(0.3 * capacity,
+                                                                                                  rel=1e-12)
+
+
+def test_bulk_boundary_conditions_are_the_single_ones():
+    """set_pressures, set_inflows and set_resistances give the network that the single setters
+    give (the same solution, bit for bit), and check their input before setting any."""
+    fluid = rheologies["power-law"](consistency=0.01, index=0.7)
+    wall = walls["thick-neo-hookean"](shear_modulus=4e3)
+
+    def tree():
+        net = Network(rheology=fluid)
+        for u, v in (("r", "j"), ("j", "a"), ("j", "b"), ("r", "k"), ("k", "c"), ("k", "d"), ("s", "r")):
+            net.add_tube(u, v, wall, TUBE)
+        return net
+
+    single = tree().set_pressure("a", 10.0).set_pressure("b", 20.0).set_inflow("s", 1e-10).set_inflow("k", 2e-11)
+    single.set_resistance("c", 1e12, 5.0).set_resistance("d", 2e12, 0.0)
+    bulk = tree().set_pressures(["a", "b"], np.array([10.0, 20.0])).set_inflows(["s", "k"], [1e-10, 2e-11])
+    bulk.set_resistances(np.array(["c", "d"]), [1e12, 2e12], distal_pressures=[5.0, 0.0])
+    one, many = single.solve(), bulk.solve()
+    assert np.array_equal(one.pressures, many.pressures)
+    assert np.array_equal(one.flow_rates, many.flow_rates)
+    net = tree()
+    with pytest.raises(InvalidParameterError, match="pressures"):
+        net.set_pressures(["a", "b"], [1.0, -2.0])
+    with pytest.raises(InvalidParameterError, match="length 2"):
+        net.set_pressures(["a", "b"], [1.0, 2.0, 3.0])
+    net.set_inflows(["a"], 1e-12)
+    with pytest.raises(InvalidParameterError, match="inflow already"):
+        net.set_pressures(["b", "a"], 1.0)
+    assert "b" not in net._pressure                   # nothing set

@@ -31,6 +31,7 @@ from .errors import (AccuracyWarning, BucklingError, ConvergenceError, FitWarnin
 __all__ = [
     "dimensionless", "fields", "Tube", "solve", "max_flow_rate", "select_coupler", "Solution", "registry",
     "advise", "Advice", "Diagnostics", "ModelValidityWarning", "fit", "FitResult", "Network", "NetworkSolution",
+    "NetworkFitResult",
     "TubefsiError", "InvalidParameterError", "KeywordError", "NoSteadyStateError", "ConvergenceError", "AccuracyWarning",
     "StretchRangeError", "BucklingError", "FitWarning", "Profile", "sampled", "Problem", "cache_clear", "cache_info",
     "read_network_table", "write_network_table", "datasets",
@@ -46,7 +47,7 @@ _LAZY = {
     "cache_clear": "couplers.tables", "cache_info": "couplers.tables",
     "advise": "advise", "Advice": "advise", "Diagnostics": "advise",
     "fit": "fit", "FitResult": "fit",
-    "Network": "network", "NetworkSolution": "network",
+    "Network": "network", "NetworkSolution": "network", "NetworkFitResult": "network_fit",
     "read_network_table": "network_io", "write_network_table": "network_io", "datasets": None,
 }
 
@@ -60,6 +61,7 @@ if _typing.TYPE_CHECKING:      # never run: tells type checkers what the lazy na
     from .network import Network, NetworkSolution
     from .network_io import read_network_table, write_network_table
     from . import datasets
+    from .network_fit import NetworkFitResult
     from .profiles import Profile, sampled
     from .solution import Solution
     from .solve import Problem, max_flow_rate, select_coupler, solve

@@ -87,7 +87,22 @@ def _parameter_names(parameters):
     return names
 
 
-def _warn_if_unsupported(names, result, at_edge, standard_errors, values):
+def _covariance(result, m, logs, values):
+    r"""The parameters' covariance: the Gauss–Newton :math:`s^2 (J^T J)^{-1}` of ``result`` (a
+    :func:`scipy.optimize.least_squares` result over ``m`` residuals),
+    :math:`s^2 = \sum r_i^2/(m - k)`, mapped back by the delta method where a parameter was fitted
+    through its logarithm (``logs``; ``values`` the fitted values)."""
+    k = result.x.size
+    s2 = 2.0 * result.cost / max(m - k, 1)
+    try:
+        cov_theta = s2 * np.linalg.inv(result.jac.T @ result.jac)
+    except np.linalg.LinAlgError:
+        cov_theta = np.full((k, k), np.inf)
+    scale = np.where(logs, values, 1.0)
+    return cov_theta * np.outer(scale, scale)
+
+
+def _warn_if_unsupported(names, result, at_edge, standard_errors, values, who="tubefsi.fit"):
     """A :class:`~tubefsi.FitWarning` where the data do not support the fit, saying what to try."""
     problems = []
     if not result.success:
@@ -100,7 +115,7 @@ def _warn_if_unsupported(names, result, at_edge, standard_errors, values):
             problems.append(f"{name} is not determined by the data (standard error {error:.3g} for a value of "
                             f"{value:.6g})")
     if problems:
-        warn_user("tubefsi.fit: " + "; ".join(problems) + ". Try starting values closer to the data (fit one "
+        warn_user(f"{who}: " + "; ".join(problems) + ". Try starting values closer to the data (fit one "
                   "parameter first, then the others from its result), fewer parameters, or data over a wider "
                   "range of flow rates.", FitWarning)
 
@@ -251,15 +266,8 @@ def fit(flow_rate: ArrayLike, pressure_drop: ArrayLike, rheology: Rheology, wall
                                      x_scale="jac", method="dogbox", xtol=1e-12, ftol=1e-12, gtol=1e-12)
     finally:
         shown.close()
-    dof = max(q.size - len(names), 1)
-    s2 = 2.0 * res.cost / dof
-    try:
-        cov_theta = s2 * np.linalg.inv(res.jac.T @ res.jac)
-    except np.linalg.LinAlgError:
-        cov_theta = np.full((len(names), len(names)), np.inf)
     values = natural(res.x)
-    scale = np.where(logs, values, 1.0)                    # delta method for log parameters
-    cov = cov_theta * np.outer(scale, scale)
+    cov = _covariance(res, q.size, logs, values)
     fitted = build(res.x)
     standard_errors = {n: float(math.sqrt(max(cov[i, i], 0.0))) if np.isfinite(cov[i, i]) else math.inf
                        for i, n in enumerate(names)}

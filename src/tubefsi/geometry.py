@@ -11,7 +11,7 @@ from numpy.typing import ArrayLike
 
 from .errors import InvalidParameterError
 from .fields import positive
-from .profiles import Profile
+from .profiles import Profile, sampled
 
 __all__ = ["Tube"]
 
@@ -50,6 +50,37 @@ class Tube:
             raise InvalidParameterError("thickness", "values with a finite, nonzero t/a", self.thickness,
                                         f"t/a = {np.ravel(tb)[np.argmin(np.isfinite(tb) & (tb > 0))]!r} with radius "
                                         f"{self.radius!r}")
+
+    @classmethod
+    def tapered(cls, *, length: float, radius: float, outlet_radius: float, thickness: float,
+                outlet_thickness: float | None = None) -> Tube:
+        r"""A linearly tapered tube: the radius runs from ``radius`` at :math:`z = 0` to
+        ``outlet_radius`` at :math:`z = L` = ``length``,
+
+        .. math::  a(z) = a_0 + (a_L - a_0)\,z/L, \qquad t(z) = t_0 + (t_L - t_0)\,z/L,
+
+        and the thickness from ``thickness`` to ``outlet_thickness`` (default: the same ``t/a`` as
+        at the inlet, :math:`t_L = t_0 a_L/a_0`). Each is a linear :func:`~tubefsi.sampled` table
+        over :math:`[0, L]` (``docs/graded.md``); equal ends give a uniform tube. All numbers (m,
+        > 0); the command line's ``outlet_radius=..``."""
+        values = {}
+        for name, value in (("length", length), ("radius", radius), ("outlet_radius", outlet_radius),
+                            ("thickness", thickness), ("outlet_thickness", outlet_thickness)):
+            if name == "outlet_thickness" and value is None:
+                value = values["thickness"] * values["outlet_radius"] / values["radius"]
+            try:
+                x = float(value)
+            except (TypeError, ValueError):
+                x = math.nan
+            if np.ndim(value) != 0 or not (0 < x < math.inf):
+                raise InvalidParameterError(name, "a number in (0, inf) m", value)
+            values[name] = x
+        ends = [0.0, values["length"]]
+        fields = {}
+        for name in ("radius", "thickness"):
+            inlet, outlet = values[name], values[f"outlet_{name}"]
+            fields[name] = inlet if inlet == outlet else sampled(ends, [inlet, outlet], kind="linear")
+        return cls(length=values["length"], **fields)
 
     @property
     def graded(self) -> bool:

@@ -1,85 +1,32 @@
-r"""Steady flow through a network of soft tubes (``docs/network.md``).
-
-Nodes carry pressures :math:`p_i` (transmural, gauge); a tube :math:`e = (u, v)` carries the
-flow :math:`q_e = Q_e(p_u, p_v)` of the pressure-controlled single-tube problem, solved from the
-higher-pressure end, so that the edge law is odd in :math:`p_u - p_v`:
-:math:`Q_e = \operatorname{sign}(p_u - p_v)\,Q(|p_u - p_v|;\ \min(p_u, p_v))`. At every node
-without a fixed pressure Kirchhoff's law holds,
-
-.. math::  F_i(p) = \sum_{e:\,v_e = i} q_e - \sum_{e:\,u_e = i} q_e + s_i + (p_{d,i} - p_i)/R_i = 0,
-
-with :math:`s_i` the injected flow rate and, at a resistance outlet, :math:`R_i` its terminal
-resistance to the distal pressure :math:`p_{d,i}` (the term is absent elsewhere). The free pressures solve :math:`F = 0` by Newton's
-method: the Jacobian is assembled from the analytic derivatives :math:`\partial q/\partial p_{in}`
-and :math:`\partial q/\partial p_{out}` of each tube (``docs/theory.md``, section
-"Sensitivities") and factorized by :func:`scipy.sparse.linalg.splu`. Every tube of a network is
-evaluated in one broadcast :func:`tubefsi.solve` per iteration and per group of tubes that
-share their wall and fluid classes (their parameters stacked into arrays).
-
-Globalization: the start is the rigid Newtonian network (each tube a Hagen–Poiseuille
-conductance :math:`\pi a^4/(8\mu L)` at the fluid's apparent viscosity, refined by three
-Picard sweeps); every Newton step is cut to stay inside :math:`0 \le p_i < p_{lim}` (a step goes
-at most 90 % of the way to a tube's limit pressure or to zero) and then halved until the
-residual norm :math:`\|F\|_2` decreases (Armijo). The derivative of a tube without flow is
-degenerate — :math:`\partial q/\partial p \to 0` for a shear-thinning fluid, :math:`\infty` for a
-shear-thickening one, as :math:`\Delta p \to 0` — so a tube whose pressure drop is below
-:math:`10^{-8}` of the largest pressure enters the Jacobian with its secant conductance
-:math:`q/\Delta p` (which zeroes the flow into a dead end in one step; the rigid start
-conductance at :math:`\Delta p = 0`), and no conductance goes below :math:`10^{-8}` of the rigid
-start one. That changes the step only, never the residual, so the converged pressures are those
-of the exact edge laws. (A drop below :math:`10^{-30}` of the largest pressure is taken as
-zero; the flow it would carry is below :math:`10^{-30/n}` of the network's.)
-
-A trial pressure beyond what a wall's tube law reaches halves the step; a flow rate the
-single-tube solve cannot give at a drop far below the pressures (NaN, the generic rheology path)
-is the secant of a probe drop (``docs/network.md``). A node with an inflow and a single
-tube is no unknown: that tube is solved flow-controlled at the end.
-
-Converged means that the mass balance of every free node is below ``rtol`` times the
-throughput (the total flow that enters the network); otherwise :class:`ConvergenceError`.
+r"""Steady flow through a network of soft tubes (``docs/network.md``): the :class:`Network` a user
+builds (tubes, boundary conditions, networkx). Its Newton solver is in :mod:`tubefsi.network_solver`, the
+evaluation of its tubes by groups in :mod:`tubefsi.network_groups`, its results in
+:mod:`tubefsi.network_solution`.
 """
 
 from __future__ import annotations
 
 import copy
-import math
+import itertools
 from collections.abc import Hashable
 
 import attrs
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse import csgraph
-from scipy.sparse import linalg as spla
 
 from ._keywords import checked_keywords
 from ._progress import bar
 from ._validation import as_array
-from . import validity
-from .errors import (AccuracyWarning, ConvergenceError, InvalidParameterError, NoSteadyStateError, warn_user)
+from .errors import InvalidParameterError
 from .fields import broadcast_model, varies, _array_fields, parameter_shape
 from .geometry import Tube
+from .network_fit import fit_network
 from .network_solution import NetworkSolution, _hashable
+from .network_solver import _Solver
 from .rheology.base import Rheology
-from .scene import make_scene, resolve
-from .solve import max_flow_rate as tubefsi_max_flow
-from .solve import solve_unchecked
+from .scene import resolve
 from .walls.base import WallModel
 
 __all__ = ["Network", "NetworkSolution"]
-
-#: Jacobian conductances are clipped to [_CLIP, 1/_CLIP] times the rigid start conductance
-_CLIP = 1e-8
-#: fraction of the way to a bound (a limit pressure, zero) that one Newton step may go
-_TO_BOUND = 0.9
-#: a tube whose pressure drop is below this times the largest pressure counts as without flow
-#: (its Jacobian entry is the secant); below _TINY times it the drop is zero
-_STILL = 1e-8
-_TINY = 1e-30
-#: a node this close (relative) to its bound with the step still pushing outward is at the bound
-_AT_BOUND = 1e-12
-#: a node within this (relative) of its bound whose step into it the line search must cut is held
-#: at the bound (an active set: ``_Solver._pinned_done``); farther away such a cut is a one-off
-_NEAR_BOUND = 1e-2
 
 
 @attrs.define(eq=False)
@@ -96,6 +43,12 @@ class _Tube:
     rheology: object
     external_pressure: float = 0.0
     row: object = None
+
+    @property
+    def graded(self) -> bool:
+        """Whether its radius, thickness or a wall parameter varies along it (a graded tube: never
+        from :meth:`Network.add_tubes`)."""
+        return self.tube.graded or varies(self.wall)
 
     def models(self):
         """This tube's wall, tube and fluid, each with scalar parameters."""
@@ -157,7 +110,10 @@ class Network:
         (Pa, any sign) is the pressure outside this tube: its wall sees the node pressures minus
         it (``docs/walls_beyond.md``, "External pressure and collapse"); a node pressure whose
         transmural pressure falls below the wall's buckling bound raises ``BucklingError``.
-        Parameters are scalars.
+        Parameters are scalars or, for a graded (e.g. tapered) tube, functions of the position
+        along it (``docs/graded.md``; :meth:`tubefsi.Tube.tapered`), ``z = 0`` at ``u``: its flow
+        from ``v`` to ``u`` is that of the tube read from ``v`` (``docs/network.md``, "Graded
+        tubes").
         """
         name = (u, v) if name is None else name
         if u == v:
@@ -169,9 +125,6 @@ class Network:
         for label, model in (("wall", wall), ("rheology", fluid), ("tube", tube)):
             if parameter_shape(model) != ():
                 raise InvalidParameterError(label, "scalar parameters (one tube per add_tube)", model)
-            if varies(model):
-                raise InvalidParameterError(label, "a uniform tube and wall (a network takes no tube that varies along z)",
-                                            model)
         p_e = as_array("external_pressure", external_pressure, "the real numbers", np.isfinite)
         if p_e.ndim:
             raise InvalidParameterError("external_pressure", "a number (one tube per add_tube)", external_pressure)
@@ -210,16 +163,18 @@ class Network:
         names = [(a, b) for a, b in zip(u, v)] if names is None else _names_of("names", names)
         if len(names) != n:
             raise InvalidParameterError("names", f"{n} names, one per tube", len(names))
-        for k, (a, b) in enumerate(zip(u, v)):
-            if a == b:
-                raise InvalidParameterError(f"v[{k}]", "a node other than u[k]", b, "a tube joins two distinct nodes")
+        loops = [k for k, (a, b) in enumerate(zip(u, v)) if a == b]
+        if loops:
+            k = loops[0]
+            raise InvalidParameterError(f"v[{k}]", "a node other than u[k]", v[k], "a tube joins two distinct nodes")
         taken = self._tubes.keys()
-        seen = set()
-        for k, name in enumerate(names):
-            if name in taken or name in seen:
-                raise InvalidParameterError(f"names[{k}]", "a name no other tube has", name,
-                                            "tubes between the same two nodes need distinct names")
-            seen.add(name)
+        if len(set(names)) != n or not taken.isdisjoint(names):       # (set operations: one pass in C)
+            seen = set()
+            for k, name in enumerate(names):
+                if name in taken or name in seen:
+                    raise InvalidParameterError(f"names[{k}]", "a name no other tube has", name,
+                                                "tubes between the same two nodes need distinct names")
+                seen.add(name)
         wall, tube, fluid = self._models(wall, tube, rheology)
         models = []
         for label, model in (("wall", wall), ("tube", tube), ("rheology", fluid)):
@@ -227,8 +182,8 @@ class Network:
                 raise InvalidParameterError(label, f"scalar parameters or arrays of length {n} (one entry per "
                                             f"tube)", model, f"its parameters have the shape {parameter_shape(model)}")
             if varies(model):
-                raise InvalidParameterError(label, "a uniform tube and wall (a network takes no tube that varies "
-                                            "along z)", model)
+                raise InvalidParameterError(label, "a uniform tube and wall (add a tube that varies along z, a "
+                                            "graded tube, by add_tube)", model)
             models.append(broadcast_model(model, (n,)))
         wall, tube, fluid = models
         p_e = as_array("external_pressure", external_pressure, "the real numbers", np.isfinite)
@@ -236,11 +191,12 @@ class Network:
             raise InvalidParameterError("external_pressure", f"a number or an array of length {n}", p_e.shape)
         p_e = np.broadcast_to(p_e.astype(float), (n,)).tolist()
         shared = parameter_shape(wall) == parameter_shape(tube) == parameter_shape(fluid) == ()
-        for node in u + v:
-            self._nodes.setdefault(node, len(self._nodes))
-        tubes = self._tubes
-        for k in range(n):
-            tubes[names[k]] = _Tube(names[k], u[k], v[k], wall, tube, fluid, p_e[k], None if shared else k)
+        nodes = self._nodes
+        fresh = [node for node in dict.fromkeys(u + v) if node not in nodes]
+        nodes.update(zip(fresh, range(len(nodes), len(nodes) + len(fresh))))
+        rows = itertools.repeat(None, n) if shared else range(n)
+        self._tubes.update(zip(names, map(_Tube, names, u, v, itertools.repeat(wall, n), itertools.repeat(tube, n),
+                                          itertools.repeat(fluid, n), p_e, rows)))
         return self
 
     @checked_keywords
@@ -287,6 +243,55 @@ class Network:
         p_d = float(as_array("distal_pressure", distal_pressure, "the real numbers (Pa)", np.isfinite))
         self._resistance[node] = (r, p_d)
         return self
+
+    @checked_keywords
+    def set_pressures(self, nodes, pressures) -> Network:
+        """Fix the pressures of many nodes at once, as :meth:`set_pressure` for each: ``nodes`` a
+        sequence or 1-D array of node names, ``pressures`` (Pa, >= 0) a number or an array as
+        long. Everything is checked before any is set."""
+        nodes, values = self._many(nodes, pressures, "pressures", "[0, inf)", lambda a: a >= 0)
+        self._free_of_all(nodes, "pressure")
+        self._pressure.update(zip(nodes, values))
+        return self
+
+    @checked_keywords
+    def set_inflows(self, nodes, flow_rates) -> Network:
+        """Inject flow rates at many nodes at once, as :meth:`set_inflow` for each (m^3/s, a
+        number or an array as long as ``nodes``)."""
+        nodes, values = self._many(nodes, flow_rates, "flow_rates", "(-inf, inf)", np.isfinite)
+        self._free_of_all(nodes, "inflow")
+        self._inflow.update(zip(nodes, values))
+        return self
+
+    @checked_keywords
+    def set_resistances(self, nodes, resistances, distal_pressures=0.0) -> Network:
+        """Make many nodes resistance outlets at once, as :meth:`set_resistance` for each, each
+        with its own terminal resistance (Pa s/m^3, > 0) and distal pressure (Pa): numbers or
+        arrays as long as ``nodes``."""
+        nodes, r = self._many(nodes, resistances, "resistances", "(0, inf) Pa s/m^3",
+                              lambda a: np.isfinite(a) & (a > 0))
+        _, p_d = self._many(nodes, distal_pressures, "distal_pressures", "the real numbers (Pa)", np.isfinite)
+        self._free_of_all(nodes, "resistance")
+        self._resistance.update(zip(nodes, zip(r, p_d)))
+        return self
+
+    def _many(self, nodes, values, label, admissible, check):
+        """``(nodes, values)`` of a bulk setter as lists, the values checked and broadcast."""
+        nodes = _names_of("nodes", nodes)
+        array = as_array(label, values, admissible, check)
+        if array.shape not in ((), (len(nodes),)):
+            raise InvalidParameterError(label, f"a number or an array of length {len(nodes)} (one per node)",
+                                        array.shape)
+        return nodes, np.broadcast_to(array.astype(float), (len(nodes),)).tolist()
+
+    def _free_of_all(self, nodes, kind):
+        """:meth:`_free_of` for many nodes (one set intersection per other kind)."""
+        for other, store in (("pressure", self._pressure), ("inflow", self._inflow),
+                             ("resistance", self._resistance)):
+            if other != kind and store:
+                clash = store.keys() & set(nodes)
+                if clash:
+                    self._free_of(next(iter(clash)), kind)
 
     def _free_of(self, node, kind):
         """Raise unless ``node`` has no boundary condition but one of ``kind`` (which it replaces)."""
@@ -410,566 +415,55 @@ class Network:
         finally:
             shown.close()
 
+    @checked_keywords
+    def fit(self, *, pressure=None, flow_rate=None, moduli=None, resistances=None, pressure_sigma=None,
+            flow_sigma=None, rtol: float = 1e-13):
+        r"""Calibrate per-group wall moduli and terminal resistances to measured node pressures and
+        tube flow rates by least squares (``docs/network.md``, "Calibration").
+
+        Parameters
+        ----------
+        pressure : mapping node -> Pa, optional
+            Measured node pressures.
+        flow_rate : mapping tube name -> m^3/s, optional
+            Measured flow rates (positive from the tube's ``u`` to its ``v``).
+        moduli : mapping group name -> sequence of tube names, optional
+            Each group's tubes share one value of the modulus that scales their walls' tube law
+            (:math:`P = \mu\hat P(\lambda)`: a neo-Hookean wall's shear modulus, a linear wall's
+            Young's modulus), fitted as ``"modulus[<group>]"``; they start from one value of it.
+        resistances : sequence of nodes, optional
+            Resistance outlets (:meth:`set_resistance`) whose resistance is fitted, as
+            ``"resistance[<node>]"``.
+        pressure_sigma, flow_sigma : float, optional
+            The scales of the pressure and flow residuals (default: the root mean square of the
+            measured values of each kind).
+
+        Every parameter is fitted through its logarithm, within a factor 1e4 of its start, with
+        the analytic Jacobian of the implicit function theorem on the Kirchhoff system; each
+        evaluation is one :meth:`solve`, warm-started from the previous one.
+
+        Returns
+        -------
+        NetworkFitResult
+            ``network`` (a copy with the fitted values), ``solution``, ``parameters``,
+            ``standard_errors`` (Gauss–Newton, by the delta method), ``covariance``,
+            ``residuals`` (weighted), ``success``, ``message``.
+
+        Warns
+        -----
+        FitWarning
+            Where the data do not support the fit (as :func:`tubefsi.fit`).
+        """
+        return fit_network(self, pressure=pressure, flow_rate=flow_rate, moduli=moduli, resistances=resistances,
+                           pressure_sigma=pressure_sigma, flow_sigma=flow_sigma,
+                           rtol=float(as_array("rtol", rtol, "[1e-15, 1)", lambda a: (a >= 1e-15) & (a < 1))))
+
     def _snapshot(self):
         """A copy that later changes to this network do not reach (the solution keeps it)."""
         new = copy.copy(self)
         for name in ("_tubes", "_nodes", "_pressure", "_inflow", "_resistance", "positions"):
             setattr(new, name, dict(getattr(self, name)))
         return new
-
-
-class _Groups:
-    """The tubes grouped by (wall class, fluid class, non-array parameters), each group's
-    parameters stacked into arrays, and one broadcast solve per group."""
-
-    def __init__(self, tubes, subset):
-        groups: dict = {}
-        keys: dict = {}               # id(model) -> its class and non-array parameters
-        self.external = []            # per part: the external pressure of its tubes (float or array)
-        for i, t in enumerate(tubes):
-            if not subset[i]:
-                continue
-            wall, fluid = t.wall, t.rheology
-            if id(wall) not in keys:
-                keys[id(wall)] = (type(wall), _fixed(wall))
-            if id(fluid) not in keys:
-                keys[id(fluid)] = (type(fluid), _fixed(fluid))
-            groups.setdefault((keys[id(wall)], keys[id(fluid)]), []).append(i)
-        self.parts = []
-        for index in groups.values():
-            members = [tubes[i] for i in index]
-            wall = _stack(members, "wall")
-            fluid = _stack(members, "rheology")
-            tube = Tube(**_gather(members, "tube", ("radius", "thickness", "length")))
-            self.parts.append((np.asarray(index), fluid, wall, tube))
-            self.external.append(_column([m.external_pressure for m in members]))
-        n = len(tubes)
-        self.limit = np.zeros(n)
-        self.radius = np.zeros(n)
-        self.length = np.zeros(n)
-        for (index, fluid, wall, tube), p_e in zip(self.parts, self.external):
-            # the node (gauge) pressure at which the transmural one reaches the limit pressure
-            self.limit[index] = np.broadcast_to(wall.limit_pressure(tube.reduced_thickness) + np.asarray(p_e),
-                                                index.shape)
-            self.radius[index] = np.broadcast_to(tube.radius, index.shape)
-            self.length[index] = np.broadcast_to(tube.length, index.shape)
-
-    def evaluate(self, drop, outlet):
-        """Flow rates and the derivatives by the inlet and outlet pressures of the tubes (pressure-
-        controlled; zeros for the tubes of no group)."""
-        q, d_in, d_out, radius_in, radius_out = (np.zeros(drop.size) for _ in range(5))
-        for (index, fluid, wall, tube), p_e in zip(self.parts, self.external):
-            # Newton's trial pressures: unchecked (the result is checked once; no process-wide
-            # warning filter, which would silence other threads too)
-            sol = solve_unchecked(fluid, wall, tube, pressure_drop=drop[index], outlet_pressure=outlet[index],
-                                  external_pressure=p_e)
-            q[index] = sol.flow_rate
-            _, d_in[index], d_out[index] = sol._sensitivities()
-            radius_in[index] = sol.inlet_radius
-            radius_out[index] = np.broadcast_to(tube.radius * sol.scene.outlet_stretch, index.shape)
-        return q, d_in, d_out, radius_in, radius_out
-
-    def check(self, q, radius_u, radius_v, tubes):
-        """The converged tubes against the model's assumptions (:mod:`tubefsi.validity`): one
-        ModelValidityWarning per failed assumption of a group, naming its first offending tube."""
-        for index, fluid, wall, tube in self.parts:
-            scene = make_scene(fluid, wall, tube)
-            scene = scene.flat(index.shape) if scene.shape != () else scene
-            big = np.maximum(radius_u[index], radius_v[index])
-            found = validity.check(scene, np.abs(q[index]), big / np.broadcast_to(tube.radius, index.shape) - 1.0)
-            if found.messages:
-                slender = big / np.broadcast_to(tube.length, index.shape)
-                name = tubes[index[int(np.argmax(slender))]].name
-                validity.warn(attrs.evolve(found, messages=tuple(
-                    f"network (e.g. tube {name!r}): {m.replace(' points', ' tubes')}" for m in found.messages)))
-
-    def inlet(self, q, outlet, tubes):
-        """Flow-controlled: the inlet pressure and the inlet and outlet radii of the tubes carrying
-        ``q > 0`` with ``outlet`` pressure; a flow rate beyond a tube's maximum raises, naming it."""
-        p_in, radius_in, radius_out = (np.zeros(q.size) for _ in range(3))
-        for (index, fluid, wall, tube), p_e in zip(self.parts, self.external):
-            # checked with the rest of the result
-            sol = solve_unchecked(fluid, wall, tube, flow_rate=q[index], outlet_pressure=outlet[index],
-                                  external_pressure=p_e, on_infeasible="nan")
-            if not np.all(sol.feasible):
-                j = int(np.flatnonzero(~sol.feasible)[0])
-                limit = np.broadcast_to(tubefsi_max_flow(fluid, wall, tube, outlet_pressure=outlet[index],
-                                                         external_pressure=p_e), index.shape)[j]
-                raise NoSteadyStateError("flow_rate", float(limit), float(q[index][j]),
-                                         f"the inflow into tube {tubes[index[j]].name!r} reaches its maximum flow rate "
-                                         f"at the outlet pressure {outlet[index][j]:.10g} Pa")
-            p_in[index] = sol.inlet_pressure
-            radius_in[index] = sol.inlet_radius
-            radius_out[index] = np.broadcast_to(tube.radius * sol.scene.outlet_stretch, index.shape)
-        return p_in, radius_in, radius_out
-
-    def apparent_viscosity(self, q, mu):
-        """Per tube, the Newtonian viscosity with the fluid's pressure gradient at ``|q|`` in the
-        undeformed tube (``mu`` where q = 0)."""
-        out = mu.copy()
-        for index, fluid, wall, tube in self.parts:
-            qi = np.abs(q[index])
-            ok = qi > 0
-            if np.any(ok):
-                a = np.broadcast_to(tube.radius, index.shape)
-                g = np.asarray(fluid.pressure_gradient(np.where(ok, qi, 1.0), tube.radius), dtype=float)
-                g = np.broadcast_to(g, index.shape)
-                value = g * math.pi * a**4 / (8 * np.where(ok, qi, 1.0))
-                out[index] = np.where(ok & np.isfinite(value) & (value > 0), value, mu[index])
-        return out
-
-    def nominal_viscosity(self, n):
-        mu = np.empty(n)
-        for index, fluid, wall, tube in self.parts:
-            mu[index] = np.broadcast_to(np.asarray(fluid.apparent_viscosity(1.0), dtype=float), index.shape)
-        return mu
-
-
-def _fixed(model):
-    """The values of a model's parameters that cannot be arrays (they split groups)."""
-    return tuple(getattr(model, name) for name in _scalar_fields(type(model)))
-
-
-def _scalar_fields(cls):
-    arrays = set(_array_fields(cls))
-    return tuple(f.name for f in attrs.fields(cls) if f.init and f.name not in arrays) if attrs.has(cls) else ()
-
-
-def _column(values):
-    a = np.asarray(values, dtype=float)
-    return float(a[0]) if np.all(a == a[0]) else a
-
-
-def _gather(members, which, fields) -> dict:
-    """field -> the members' values of that parameter of their ``which`` model (a float where all
-    agree, else an array aligned with ``members``). Tubes added together by
-    :meth:`Network.add_tubes` share one model: their entries are taken at their rows, in one
-    indexing per model rather than one lookup per tube."""
-    by_model: dict = {}
-    for j, m in enumerate(members):
-        model = getattr(m, which)
-        entry = by_model.get(id(model))
-        if entry is None:
-            entry = by_model[id(model)] = (model, [], [])
-        entry[1].append(j)
-        entry[2].append(m.row)
-    out = {f: np.empty(len(members)) for f in fields}
-    for model, positions, rows in by_model.values():
-        for f in fields:
-            value = getattr(model, f)
-            out[f][positions] = value[rows] if isinstance(value, np.ndarray) and value.ndim else value
-    return {f: _column(column) for f, column in out.items()}
-
-
-def _stack(members, which):
-    """One model whose array parameters hold the members' values (a scalar where all agree)."""
-    first = getattr(members[0], which)
-    if all(getattr(m, which) is first and m.row is None for m in members):
-        return first
-    return attrs.evolve(first, **_gather(members, which, _array_fields(type(first))))
-
-
-class _Solver:
-    def __init__(self, net: Network):
-        if not net._tubes:
-            raise InvalidParameterError("network", "at least one tube", 0)
-        for node in list(net._pressure) + list(net._inflow) + list(net._resistance):
-            if node not in net._nodes:
-                raise InvalidParameterError("node", "a node of some tube", node, "it has a boundary condition "
-                                            "but no tube")
-        self.net = net
-        self.tubes = list(net._tubes.values())
-        self.nodes = list(net._nodes)
-        index = net._nodes
-        self.U = np.array([index[t.u] for t in self.tubes])
-        self.V = np.array([index[t.v] for t in self.tubes])
-        n_nodes, n_tubes = len(self.nodes), len(self.tubes)
-        self.fixed = np.zeros(n_nodes, dtype=bool)
-        self.p_fixed = np.zeros(n_nodes)
-        for node, p in net._pressure.items():
-            self.fixed[index[node]], self.p_fixed[index[node]] = True, p
-        self.source = np.zeros(n_nodes)
-        for node, s in net._inflow.items():
-            self.source[index[node]] = s
-        # resistance outlets: q = g (p - p_d) leaves node i, g = 1/R (0 elsewhere)
-        self.g_out = np.zeros(n_nodes)
-        self.p_distal = np.zeros(n_nodes)
-        for node, (r, p_d) in net._resistance.items():
-            self.g_out[index[node]], self.p_distal[index[node]] = 1.0 / r, p_d
-        self._check_connected(n_nodes)
-        # a feeder: a node with an inflow and one tube; that tube's flow is known, so it is solved
-        # flow-controlled after the rest (no pressure unknown near a limit pressure at the inlet)
-        degree = np.bincount(self.U, minlength=n_nodes) + np.bincount(self.V, minlength=n_nodes)
-        feeds = ~self.fixed & (self.source > 0) & (degree == 1)
-        self.feeder = feeds[self.U] | feeds[self.V]
-        self.feed_node = np.where(feeds[self.U], self.U, self.V)
-        self.feeds = feeds
-        self.groups = _Groups(self.tubes, ~self.feeder)
-        self.feed_groups = _Groups(self.tubes, self.feeder)
-        self.limit = np.where(self.feeder, self.feed_groups.limit, self.groups.limit)
-        self.radius = np.where(self.feeder, self.feed_groups.radius, self.groups.radius)
-        self.length = np.where(self.feeder, self.feed_groups.length, self.groups.length)
-        # a node's bound: the smallest limit pressure of its tubes (an inlet must stay below it)
-        self.p_limit = np.full(n_nodes, np.inf)
-        np.minimum.at(self.p_limit, self.U, self.limit)
-        np.minimum.at(self.p_limit, self.V, self.limit)
-        over = self.fixed & (self.p_fixed >= self.p_limit)
-        if np.any(over):
-            i = int(np.flatnonzero(over)[0])
-            raise NoSteadyStateError("pressure", self.p_limit[i], self.p_fixed[i],
-                                     f"node {self.nodes[i]!r} is fixed at or beyond the limit pressure of tube "
-                                     f"{self._limiting_tube(i)!r}")
-        self.n_tubes = n_tubes
-        self._unknowns(~self.fixed)
-
-    def _check_connected(self, n):
-        graph = sp.coo_matrix((np.ones(self.U.size), (self.U, self.V)), shape=(n, n))
-        count, labels = csgraph.connected_components(graph, directed=False)
-        anchor = self.fixed | (self.g_out > 0)
-        if not np.any(anchor):
-            raise InvalidParameterError("network", "at least one node with a fixed pressure or a resistance outlet",
-                                        None, "set_pressure(node, p) or set_resistance(node, R) on an outlet")
-        anchored = np.zeros(count, dtype=bool)
-        anchored[labels[anchor]] = True
-        if not np.all(anchored):
-            c = int(np.flatnonzero(~anchored)[0])
-            members = [self.nodes[i] for i in np.flatnonzero(labels == c)]
-            raise InvalidParameterError("network", "every node connected to a fixed pressure or a resistance "
-                                        "outlet",
-                                        members[0], f"a component of {len(members)} node(s), disconnected "
-                                        f"from every fixed pressure: {members[:5]!r}")
-
-    def _unknowns(self, mask):
-        """Make the nodes of ``mask`` the unknowns (the rigid start: every free node; Newton: the
-        free nodes but the feeders)."""
-        self.unknown = mask
-        self.free = np.flatnonzero(mask)
-        self.where = np.full(mask.size, -1)
-        self.where[self.free] = np.arange(self.free.size)
-
-    def _limiting_tube(self, i):
-        at = np.flatnonzero((self.U == i) | (self.V == i))
-        return self.tubes[int(at[np.argmin(self.limit[at])])].name
-
-    # ------------------------------------------------------------------ linear algebra
-    def _jacobian(self, gu, gv):
-        """dF/dp over the free nodes from dq_e/dp_u = gu, dq_e/dp_v = gv, and the exact -1/R of
-        each resistance outlet on the diagonal."""
-        U, V = self.U, self.V
-        outlets = np.flatnonzero(self.g_out)
-        rows = np.concatenate([U, U, V, V, outlets])
-        cols = np.concatenate([U, V, U, V, outlets])
-        vals = np.concatenate([-gu, -gv, gu, gv, -self.g_out[outlets]])
-        keep = self.unknown[rows] & self.unknown[cols]
-        m = self.free.size
-        return sp.csc_matrix((vals[keep], (self.where[rows[keep]], self.where[cols[keep]])), shape=(m, m))
-
-    def _balance(self, q, p):
-        """Net inflow at every node: sum of q into it - sum out of it + injection + what a
-        resistance outlet supplies, (p_d - p)/R."""
-        n = len(self.nodes)
-        return (np.bincount(self.V, q, n) - np.bincount(self.U, q, n)) + self._supplied(p)
-
-    def _supplied(self, p):
-        """What the boundary supplies at the nodes without a fixed pressure: the injections and the
-        resistance outlets' flows (negative where they take flow out)."""
-        return self.source + self.g_out * (self.p_distal - p)
-
-    def _rigid_start(self):
-        """Pressures of the rigid Newtonian network (apparent viscosities, three Picard sweeps)."""
-        a, length = self.radius, self.length
-        mu = np.where(self.feeder, self.feed_groups.nominal_viscosity(self.n_tubes),
-                      self.groups.nominal_viscosity(self.n_tubes))
-        good = np.isfinite(mu) & (mu > 0)
-        mu = np.where(good, mu, np.median(mu[good]) if np.any(good) else 1e-3)
-        p = self.p_fixed.copy()
-        for sweep in range(4):
-            c = math.pi * a**4 / (8 * mu * length)
-            rhs = self._supplied(np.zeros_like(p))
-            # K p = s with K the weighted Laplacian; move the fixed columns to the right
-            known = np.where(self.fixed, self.p_fixed, 0.0)
-            flow = c * (known[self.U] - known[self.V])
-            rhs += np.bincount(self.V, flow, len(self.nodes)) - np.bincount(self.U, flow, len(self.nodes))
-            jac = self._jacobian(c, -c)
-            p[self.free] = spla.spsolve(jac, -rhs[self.free]) if self.free.size else p[self.free]
-            q = c * (p[self.U] - p[self.V])
-            if sweep < 3:
-                mu = self.feed_groups.apparent_viscosity(q, self.groups.apparent_viscosity(q, mu))
-        self._unknowns(~self.fixed & ~self.feeds)
-        return p, c
-
-    # ------------------------------------------------------------------ Newton
-    def _edges(self, p):
-        du = p[self.U] - p[self.V]
-        forward = du >= 0
-        drop = np.abs(du)
-        drop[drop <= _TINY * float(np.max(p))] = 0.0      # flow ~ (1e-30)^(1/n) of the network's
-        outlet = np.where(forward, p[self.V], p[self.U])
-        q, d_in, d_out, r_in, r_out = self.groups.evaluate(drop, outlet)
-        bad = ~np.isfinite(q)
-        if np.any(bad):
-            q, d_in, d_out = self._tiny_drops(bad, drop, outlet, q, d_in, d_out, float(np.max(p)))
-        if self.feed_groups.parts:         # the feeders' known flows (their nodes are no unknowns)
-            forward = np.where(self.feeder, self.feed_node == self.U, forward)
-            q = np.where(self.feeder, self.source[self.feed_node], q)
-            d_in, d_out, drop = (np.where(self.feeder, 0.0, x) for x in (d_in, d_out, drop))
-        sign = np.where(forward, 1.0, -1.0)
-        gu = np.where(forward, d_in, -d_out)
-        gv = np.where(forward, d_out, -d_in)
-        # a tube (almost) without flow: dq/dp -> 0 (shear-thinning) or inf (shear-thickening); the
-        # secant q/dp instead (it zeroes a dead end in one step), the rigid start conductance at dp = 0
-        still = (drop <= _STILL * float(np.max(p))) & ~self.feeder
-        if np.any(still):
-            with np.errstate(divide="ignore", invalid="ignore"):
-                secant = np.where(drop[still] > 0, q[still] / drop[still], self.c[still])
-            secant = np.where(np.isfinite(secant) & (secant > 0), secant, self.c[still])
-            gu[still], gv[still] = secant, -secant
-        r_u, r_v = np.where(forward, r_in, r_out), np.where(forward, r_out, r_in)
-        return sign * q, gu, gv, r_u, r_v
-
-    def _linear_solve(self, jac, rhs):
-        try:
-            return spla.splu(jac).solve(rhs)
-        except RuntimeError as exc:          # an exactly singular Jacobian
-            raise ConvergenceError(f"network: singular Jacobian ({exc})") from None
-
-    def _tiny_drops(self, bad, drop, outlet, q, d_in, d_out, scale):
-        """Flows the single-tube solve could not give (NaN): at a pressure drop far below the
-        network's pressures the generic rheology path may not resolve the flow. Such a tube is in
-        its linear (zero-shear) regime, so its flow is the secant of a probe drop of 1e-8 of the
-        largest pressure (1e-6 if that fails too), scaled to its drop; anything else raises."""
-        q, d_in, d_out = q.copy(), d_in.copy(), d_out.copy()
-        todo = bad & (drop > 0) & (drop < 1e-6 * scale)
-        for probe_ratio in (1e-8, 1e-6):
-            if not np.any(todo):
-                break
-            probe = np.where(todo, np.maximum(drop, probe_ratio * scale), drop)
-            mask = np.zeros_like(todo)
-            for index, *_ in self.groups.parts:
-                mask[index] = todo[index]
-            sub = _Groups(self.tubes, mask)
-            qp, _, _, _, _ = sub.evaluate(probe, outlet)
-            ok = todo & np.isfinite(qp)
-            secant = np.where(ok, qp / np.where(ok, probe, 1.0), 0.0)
-            q[ok], d_in[ok], d_out[ok] = secant[ok] * drop[ok], secant[ok], -secant[ok]
-            todo &= ~ok
-        left = ~np.isfinite(q)
-        if np.any(left):
-            i = int(np.flatnonzero(left)[0])
-            raise ConvergenceError(f"network: the single-tube solve of tube {self.tubes[i].name!r} gave no flow "
-                                   f"rate at pressure drop {drop[i]:.6g} Pa, outlet pressure {outlet[i]:.6g} Pa")
-        return q, d_in, d_out
-
-    def run(self, rtol, max_iterations, shown=None, start=None):
-        p, c = self._rigid_start()
-        self.c = c
-        free = self.free
-        if start:                      # a warm start: the given pressures at the free nodes they name
-            index = self.net._nodes
-            for node, value in start.items():
-                i = index.get(node) if _hashable(node) else None
-                if i is not None and not self.fixed[i]:
-                    p[i] = value
-        room = np.where(np.isfinite(self.p_limit), self.p_limit, np.inf)
-        p[free] = np.clip(p[free], 0.0, np.where(np.isfinite(room[free]), _TO_BOUND * room[free], np.inf))
-        for _ in range(60):            # a start beyond what a wall law reaches: halve it
-            try:
-                q, gu, gv, r_u, r_v = self._edges(p)
-                break
-            except NoSteadyStateError:
-                p[free] *= 0.5
-        else:
-            q, gu, gv, r_u, r_v = self._edges(p)
-        balance = self._balance(q, p)
-        # nodes held at their bound (an active set): where Newton pushes a node into its limit
-        # pressure and the line search must cut the step, the node is held there and the rest
-        # solved; see _pinned_done
-        pinned = np.zeros(len(self.nodes), dtype=bool)
-        released = pinned.copy()          # (a node released once is not held again: no ping-pong)
-        held_from = p.copy()              # a pinned node's pressure before it was held
-        for iteration in range(max_iterations + 1):
-            free = self.free
-            F = balance[free]
-            through = self._throughput(balance, p)
-            worst = float(np.max(np.abs(F), initial=0.0))
-            if worst <= rtol * through or through == 0.0 and worst == 0.0:
-                if not np.any(pinned) or self._pinned_done(pinned, balance, p, rtol * through):
-                    return self._result(p, q, r_u, r_v, iteration, worst / through if through else 0.0)
-                # a pinned node takes flow out: its pressure goes down
-                p, q, gu, gv, r_u, r_v, balance = self._release(p, pinned, released, held_from)
-                continue
-            if iteration == max_iterations:
-                break
-            ju = np.maximum(np.nan_to_num(gu, nan=c, posinf=c / _CLIP), _CLIP * c)
-            jv = -np.maximum(np.nan_to_num(-gv, nan=c, posinf=c / _CLIP), _CLIP * c)
-            step = self._linear_solve(self._jacobian(ju, jv), -F)
-            alpha, bounded = self._to_bound(p, step)
-            first = alpha
-            # the node a cut step would hold at its bound: within _NEAR_BOUND of it, never released
-            pin = bounded if (bounded is not None and not released[bounded]
-                              and self.p_limit[bounded] - p[bounded] <= _NEAR_BOUND * self.p_limit[bounded]) else None
-            norm = float(np.linalg.norm(F))
-            release = False
-            while True:
-                trial = p.copy()
-                trial[free] = np.clip(p[free] + alpha * step, 0.0, None)
-                try:
-                    t_q, t_gu, t_gv, t_ru, t_rv = self._edges(trial)
-                except NoSteadyStateError:    # beyond what a wall law reaches (a peak): shorter
-                    t_balance = None
-                else:
-                    t_balance = self._balance(t_q, trial)
-                if t_balance is not None and np.linalg.norm(t_balance[free]) <= (1 - 1e-4 * alpha) * norm:
-                    break
-                alpha *= 0.5
-                if alpha < 1e-10 and pin is not None:
-                    break                        # pushed into its bound without a better point: hold it there
-                if alpha < 1e-10 and np.any(pinned):
-                    # the rest stalls near its own bounds (rounding): the pinned nodes' excess
-                    # still decides where it dwarfs the rest's imbalance
-                    if not self._pinned_done(pinned, balance, p, max(rtol * through, 10 * float(np.sum(np.abs(F))))):
-                        release = True
-                        break
-                if alpha < 1e-10 and np.all(np.abs(F) <= 10 * self._noise(p, q, gu, gv)) \
-                        and _share(worst, through) <= _WORST_ROUNDED:
-                    warn_user(f"network: mass balance to {_share(worst, through):.1e} of the throughput, not rtol = "
-                              f"{rtol:g}: pressures close to a limit pressure amplify the rounding of the "
-                              f"pressures into the flows beyond that", AccuracyWarning)
-                    return self._result(p, q, r_u, r_v, iteration, _share(worst, through))
-                if alpha < 1e-10:
-                    raise ConvergenceError(f"network: the line search stalled after {iteration} Newton iterations; "
-                                           f"largest mass imbalance {worst:.3e} m^3/s = {_share(worst, through):.3e} of "
-                                           f"the throughput (rtol {rtol:g}){_UNRESOLVED if through == 0 else ''}")
-            if release:                 # a pinned node takes flow out: its pressure goes down
-                p, q, gu, gv, r_u, r_v, balance = self._release(p, pinned, released, held_from)
-                continue
-            if pin is not None and alpha < first:
-                # the step into the bound was cut: hold the node at its bound (to _AT_BOUND)
-                if alpha < 1e-10:
-                    trial = p.copy()
-                pinned[pin] = True
-                held_from[pin] = trial[pin]
-                trial[pin] = (1.0 - _AT_BOUND) * self.p_limit[pin]
-                self._unknowns(self.unknown & ~pinned)
-                t_q, t_gu, t_gv, t_ru, t_rv = self._edges(trial)
-                t_balance = self._balance(t_q, trial)
-            p, q, gu, gv, r_u, r_v, balance = trial, t_q, t_gu, t_gv, t_ru, t_rv, t_balance
-            if shown is not None:
-                shown.update()
-        raise ConvergenceError(f"network: no convergence in {max_iterations} Newton iterations; largest mass "
-                               f"imbalance {worst:.3e} m^3/s = {_share(worst, through):.3e} of the throughput "
-                               f"(rtol {rtol:g}){_UNRESOLVED if through == 0 else ''}")
-
-    def _result(self, p, q, r_u, r_v, iterations, residual):
-        if self.feed_groups.parts:
-            other = np.where(self.feed_node == self.U, self.V, self.U)
-            p_in, r_in, r_out = self.feed_groups.inlet(np.where(self.feeder, q * np.where(self.feed_node == self.U,
-                                                                                         1.0, -1.0), 1.0),
-                                                       p[other], self.tubes)
-            p = p.copy()
-            p[self.feed_node[self.feeder]] = p_in[self.feeder]
-            at_u = self.feed_node == self.U
-            r_u = np.where(self.feeder, np.where(at_u, r_in, r_out), r_u)
-            r_v = np.where(self.feeder, np.where(at_u, r_out, r_in), r_v)
-        for groups in (self.groups, self.feed_groups):
-            groups.check(q, r_u, r_v, self.tubes)
-        fluids = tuple((index, fluid) for groups in (self.groups, self.feed_groups)
-                       for index, fluid, _, _ in groups.parts)
-        return NetworkSolution(net=self.net, nodes=self.nodes, tubes=self.tubes, p=p, q=q, radius_u=r_u,
-                               radius_v=r_v, iterations=iterations, residual=residual, U=self.U, V=self.V,
-                               radius0=self.radius, length=self.length, fluids=fluids)
-
-    def _noise(self, p, q, gu, gv):
-        """Per free node, the mass imbalance that rounding alone leaves: the pressures' rounding
-        through the tubes' conductances plus the flows' own relative accuracy (~1e-14)."""
-        n = len(self.nodes)
-        eps = np.finfo(float).eps
-        per_tube = 4 * eps * (np.abs(gu * p[self.U]) + np.abs(gv * p[self.V])) + 1e-14 * np.abs(q)
-        per_outlet = 4 * eps * self.g_out * (np.abs(p) + np.abs(self.p_distal))
-        return (np.bincount(self.U, per_tube, n) + np.bincount(self.V, per_tube, n) + per_outlet)[self.free]
-
-    def _throughput(self, balance, p):
-        """The flow that enters the network: injections plus what the fixed nodes and the
-        resistance outlets supply."""
-        supplied = np.where(self.fixed, -balance, self._supplied(p))
-        return float(np.sum(np.maximum(supplied, 0.0)))
-
-    def _release(self, p, pinned, released, held_from):
-        """Let the pinned nodes go, back to their pressures before they were held (Newton's
-        iterate from the bound itself would start among enormous conductances); the new state."""
-        p = p.copy()
-        p[pinned] = held_from[pinned]
-        released |= pinned
-        pinned[:] = False
-        self._unknowns(~self.fixed & ~self.feeds)
-        q, gu, gv, r_u, r_v = self._edges(p)
-        return p, q, gu, gv, r_u, r_v, self._balance(q, p)
-
-    def _pinned_done(self, pinned, balance, p, tolerance):
-        """At a solution of the other nodes with the ``pinned`` ones at their limit pressures:
-        False where a pinned node takes flow out (a negative excess: its pressure goes down, so
-        it is released); True where they balance (a steady state at the bound); raises where they
-        keep an excess. Why that excess means no steady state: a tube's flow rises with its inlet
-        pressure and falls with its outlet one, so raising some nodes' pressures to their limits
-        raises every other free node's pressure, and with them what the fixed nodes and the
-        resistance outlets take out; the free nodes' total excess can then only fall. A steady
-        state below the limits would thus leave the pinned nodes' total excess <= 0."""
-        excess = balance[pinned]
-        if np.any(excess < -tolerance):
-            return False
-        if float(np.sum(excess)) <= tolerance:
-            return True
-        nodes = np.flatnonzero(pinned)
-        i = int(nodes[np.argmax(excess)])
-        tube = self._limiting_tube(i)
-        raise NoSteadyStateError("pressure", float(self.p_limit[i]), float(p[i]),
-                                 f"tube {tube!r} reaches its limit pressure at node {self.nodes[i]!r} (to "
-                                 f"{_AT_BOUND:g} relative): held there, the network still leaves "
-                                 f"{float(np.sum(excess)):.6g} m^3/s it cannot carry, so no steady state "
-                                 f"below it carries these inflows")
-
-    def _to_bound(self, p, step):
-        """The largest step fraction (<= 1) that goes at most 90 % of the way to a bound, and the
-        node whose limit pressure sets it (None where none does); raises when a node sits at a
-        bound and the step still pushes outward."""
-        pf, lim = p[self.free], self.p_limit[self.free]
-        up = step > 0
-        with np.errstate(divide="ignore", invalid="ignore"):
-            gap_up = np.where(up, lim - pf, np.inf)
-            gap_down = np.where(~up, pf, np.inf)
-            frac = np.where(up, _TO_BOUND * gap_up / step, _TO_BOUND * gap_down / -step)
-        frac = np.where(step == 0, np.inf, frac)
-        i = int(np.argmin(frac))
-        if frac[i] >= 1:
-            return 1.0, None
-        node = int(self.free[i])
-        if up[i] and gap_up[i] <= _AT_BOUND * lim[i]:
-            tube = self._limiting_tube(node)
-            raise NoSteadyStateError("pressure", float(lim[i]), float(pf[i]),
-                                     f"tube {tube!r} reaches its limit pressure at node {self.nodes[node]!r} "
-                                     f"(to {_AT_BOUND:g} relative): no steady state below it carries these inflows")
-        if not up[i] and gap_down[i] <= _AT_BOUND * max(float(np.max(p)), 1e-300):
-            raise InvalidParameterError("inflow", "inflows that keep every pressure >= 0 (tubefsi models "
-                                        "inflation, not collapse)", self.nodes[node],
-                                        f"node {self.nodes[node]!r} would need a negative transmural pressure")
-        return float(frac[i]), (node if up[i] else None)
-
-
-#: Why a network can have no resolvable throughput: tubes in series whose conductances differ by
-#: more than double precision resolves (the drop over the wide one is below one rounding unit of
-#: the pressures, so its flow is either 0 or far too large).
-_UNRESOLVED = ("; no flow is resolved at all: tubes in series whose conductances differ beyond double "
-               "precision (e.g. radii 5 m and 0.1 mm) cannot balance; model the wide one as a node")
-
-
-#: The largest mass imbalance (a share of the throughput) accepted, with an AccuracyWarning, where
-#: the rounding of the pressures allows no better; beyond it the line search's stall is an error.
-_WORST_ROUNDED = 1e-6
-
-
-def _share(worst, through) -> float:
-    """The imbalance as a share of the throughput (inf where nothing flows but something should)."""
-    return worst / through if through > 0 else (0.0 if worst == 0 else float("inf"))
 
 
 def _initial_pressures(initial):

@@ -22,6 +22,7 @@ from ._keywords import checked_keywords
 from ._validation import as_array
 from .export import _require
 from .fields import _array_fields
+from .network_groups import _reversed
 from .errors import InvalidParameterError
 from .solution import Solution
 from .solve import solve
@@ -81,11 +82,13 @@ class NetworkSolution:
     radius_v: np.ndarray = attrs.field(converter=_frozen)
     iterations: int
     residual: float
-    #: per tube: the indices of its two nodes into ``nodes``, its undeformed radius and its length
+    #: per tube: the indices of its two nodes into ``nodes``, its undeformed radius (at its ``u``
+    #: end; ``radius0_v`` at its ``v`` end where it differs: a graded tube) and its length
     U: np.ndarray
     V: np.ndarray
     radius0: np.ndarray = attrs.field(converter=_frozen)
     length: np.ndarray = attrs.field(converter=_frozen)
+    radius0_v: np.ndarray | None = attrs.field(default=None, converter=attrs.converters.optional(_frozen))
     #: (tube indices, their fluid with parameters stacked in that order) per group of tubes
     fluids: tuple = ()
     _memo: dict = attrs.field(init=False, factory=dict)
@@ -143,7 +146,8 @@ class NetworkSolution:
     @property
     def strain_v(self) -> np.ndarray:
         """Hoop strain ``R/a - 1`` at each tube's ``v`` end (read-only)."""
-        return self._once("strain_v", lambda: _frozen(self.radius_v / self.radius0 - 1.0))
+        a = self.radius0 if self.radius0_v is None else self.radius0_v
+        return self._once("strain_v", lambda: _frozen(self.radius_v / a - 1.0))
 
     @property
     def wall_shear_stress_u(self) -> np.ndarray:
@@ -195,6 +199,8 @@ class NetworkSolution:
         t = self.tubes[i]
         wall, tube, fluid = t.models()
         pu, pv = self.p[self.U[i]], self.p[self.V[i]]
+        if t.graded and pv > pu:           # the flow enters at v: the tube read from there
+            wall, tube = _reversed(wall, tube)
         return solve(fluid, wall, tube, flow_rate=abs(float(self.q[i])), outlet_pressure=float(min(pu, pv)),
                      external_pressure=t.external_pressure)
 

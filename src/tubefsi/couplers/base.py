@@ -204,7 +204,9 @@ class Coupler(abc.ABC):
         r_in = np.where(flowing, r_in, r_out)
         if not np.all(flowing):
             still = ~flowing
-            k_int[still] = length[still] * rheo._flow_index(q_use[still], r_out[still])
+            # (over every point: a fluid's array parameters are aligned with all of them)
+            k = np.broadcast_to(np.asarray(rheo._flow_index(q_use, r_out), dtype=float), (n,))
+            k_int[still] = length[still] * k[still]
         g_in = rheo._pressure_gradient(q_use, r_in)
         g_out = rheo._pressure_gradient(q_use, r_out)
         with np.errstate(divide="ignore", over="ignore"):

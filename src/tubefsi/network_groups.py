@@ -1,0 +1,331 @@
+r"""The tubes of a :class:`~tubefsi.Network` evaluated by groups (``docs/network.md``): tubes that share
+their wall and fluid classes are stacked into one model with array parameters and solved in one broadcast
+:func:`tubefsi.solve` per Newton iteration. :func:`_gather` and :func:`_stack` build those arrays from
+the tubes of :meth:`Network.add_tube` and :meth:`Network.add_tubes` alike.
+"""
+
+from __future__ import annotations
+
+import math
+
+import attrs
+import numpy as np
+
+from . import validity
+from .errors import NoSteadyStateError
+from .fields import _array_fields
+from .couplers.graded import _breakpoints
+from .geometry import Tube
+from .profiles import Profile
+from .scene import make_scene
+from .solve import max_flow_rate as tubefsi_max_flow
+from .solve import solve_unchecked
+
+
+@attrs.frozen(eq=False)
+class _Part:
+    """Tubes evaluated together: ``index`` (into the network's tubes), one fluid, wall and tube
+    whose array parameters are aligned with ``index``, and their external pressure(s). The tubes
+    of a graded part share one wall, tube and fluid (the same objects); ``reverse`` then holds
+    that wall and tube read from the other end (a flow from ``v`` to ``u`` enters at ``z = L``),
+    None for a uniform part."""
+
+    index: np.ndarray
+    fluid: object
+    wall: object
+    tube: Tube
+    external: object
+    reverse: tuple | None = None
+
+    def models(self, forward=True):
+        """``(wall, tube)`` of the tubes with the flow from u to v (``forward``) or from v to u."""
+        return (self.wall, self.tube) if forward or self.reverse is None else self.reverse
+
+    def split(self, forward):
+        """``(positions, wall, tube, external)`` per direction of flow present: the positions in
+        ``index`` of the tubes whose flow enters at u (``forward``, a mask over every tube) and
+        then at v (a uniform part: all of them, one direction)."""
+        if self.reverse is None:
+            yield slice(None), self.wall, self.tube, self.external
+            return
+        ahead = np.asarray(forward[self.index], dtype=bool)
+        p_e = np.broadcast_to(np.asarray(self.external, dtype=float), self.index.shape)
+        for mask, models in ((ahead, (self.wall, self.tube)), (~ahead, self.reverse)):
+            if np.any(mask):
+                where = np.flatnonzero(mask)
+                yield where, models[0], models[1], _column(p_e[where])
+
+    def ends(self, forward=True):
+        """The undeformed radii (m) at the inlet and the outlet of the flow."""
+        tube = self.models(forward)[1]
+        return _radius_at(tube, 0.0), _radius_at(tube, tube.length)
+
+
+class _Groups:
+    """The tubes grouped by (wall class, fluid class, non-array parameters), each group's
+    parameters stacked into arrays, and one broadcast solve per group; each graded tube (a
+    radius, thickness or wall parameter that varies along it) is a part of its own, solved by the
+    graded-tube engine (:class:`tubefsi.couplers.Graded`) from whichever end its flow enters."""
+
+    def __init__(self, tubes, subset):
+        # one dict lookup per tube: the models' identities -> the group they belong to (a graded
+        # tube's: its very models; a uniform one's: its wall and fluid classes and fixed parameters)
+        groups: dict = {}
+        graded: dict = {}
+        by_models: dict = {}
+        take = subset.tolist()
+        for i, t in enumerate(tubes):
+            if not take[i]:
+                continue
+            ids = (id(t.wall), id(t.tube), id(t.rheology))
+            found = by_models.get(ids)
+            if found is None:
+                if t.graded:
+                    found = by_models[ids] = graded.setdefault(ids, [])
+                else:
+                    key = ((type(t.wall), _fixed(t.wall)), (type(t.rheology), _fixed(t.rheology)))
+                    found = by_models[ids] = groups.setdefault(key, [])
+            found.append(i)
+        self.parts = []
+        for index in (g for g in groups.values() if g):
+            members = [tubes[i] for i in index]
+            wall = _stack(members, "wall")
+            fluid = _stack(members, "rheology")
+            tube = Tube(**_gather(members, "tube", ("radius", "thickness", "length")))
+            self.parts.append(_Part(np.asarray(index), fluid, wall, tube,
+                                    _column([m.external_pressure for m in members])))
+        for index in (g for g in graded.values() if g):
+            t = tubes[index[0]]
+            self.parts.append(_Part(np.asarray(index), t.rheology, t.wall, t.tube,
+                                    _column([tubes[i].external_pressure for i in index]), _reversed(t.wall, t.tube)))
+        n = len(tubes)
+        self.limit = np.zeros(n)
+        self.radius = np.zeros(n)            # a uniform tube's radius; a graded tube's Poiseuille mean
+        self.radius_u = np.zeros(n)          # the undeformed radii at the two ends
+        self.radius_v = np.zeros(n)
+        self.length = np.zeros(n)
+        for part in self.parts:
+            index, wall, tube = part.index, part.wall, part.tube
+            if part.reverse is None:
+                # the node (gauge) pressure at which the transmural one reaches the limit pressure
+                limit = wall.limit_pressure(tube.reduced_thickness)
+                self.radius[index] = np.broadcast_to(tube.radius, index.shape)
+            else:
+                limit, self.radius[index] = _along(part)
+            self.limit[index] = np.broadcast_to(limit + np.asarray(part.external), index.shape)
+            self.radius_u[index], self.radius_v[index] = (np.broadcast_to(a, index.shape) for a in part.ends())
+            self.length[index] = np.broadcast_to(tube.length, index.shape)
+
+    def evaluate(self, drop, outlet, forward):
+        """Flow rates and the derivatives by the inlet and outlet pressures of the tubes (pressure-
+        controlled, the flow entering at u where ``forward``, else at v; zeros for the tubes of no
+        group)."""
+        q, d_in, d_out, radius_in, radius_out = (np.zeros(drop.size) for _ in range(5))
+        for part, index, wall, tube, p_e in self._pieces(forward):
+            # Newton's trial pressures: unchecked (the result is checked once; no process-wide
+            # warning filter, which would silence other threads too)
+            sol = solve_unchecked(part.fluid, wall, tube, pressure_drop=drop[index], outlet_pressure=outlet[index],
+                                  external_pressure=p_e)
+            q[index] = sol.flow_rate
+            _, d_in[index], d_out[index] = sol._sensitivities()
+            radius_in[index] = sol.inlet_radius
+            radius_out[index] = np.broadcast_to(_radius_at(tube, tube.length) * sol.scene.outlet_stretch, index.shape)
+        return q, d_in, d_out, radius_in, radius_out
+
+    def _pieces(self, forward):
+        """``(part, index, wall, tube, external)``: the tubes of each part, split by the direction
+        of their flow where they are graded, each with the models read from where it enters."""
+        for part in self.parts:
+            for where, wall, tube, p_e in part.split(forward):
+                yield part, part.index[where], wall, tube, p_e
+
+    def modulus_derivative(self, drop, outlet, forward):
+        r"""Per tube, :math:`\mu\,\partial q/\partial\mu` at fixed end pressures, :math:`\mu` the
+        modulus that scales its wall's tube law (:math:`P = \mu\hat P(\lambda)`), oriented as
+        :meth:`evaluate`'s flows (from the inlet), with its flows and their derivatives by the end
+        pressures: ``(q, d_in, d_out, scale)``.
+
+        The separated identity :math:`F = \int_{p_{out}}^{p_{in}} dp/G(q, R(p)) - L = 0` with
+        :math:`R = a\hat\lambda(p/\mu)` makes :math:`F + L` homogeneous of degree one in
+        :math:`(p_{in}, p_{out}, \mu)` (transmural pressures), so Euler's identity and
+        :math:`\partial_q F = -K/q` give
+        :math:`\mu\,\partial q/\partial\mu = (L G_{in} - p_{in})\,\partial q/\partial p_{in}
+        - p_{out}\,\partial q/\partial p_{out}` (:math:`L` the installed length, :math:`G_{in}`
+        the pressure gradient at the inlet). Uniform tubes only (a graded tube: NaN)."""
+        q, d_in, d_out, scale = (np.full(drop.size, np.nan) for _ in range(4))
+        for part, index, wall, tube, p_e in self._pieces(forward):
+            sol = solve_unchecked(part.fluid, wall, tube, pressure_drop=drop[index], outlet_pressure=outlet[index],
+                                  external_pressure=p_e)
+            qi = np.broadcast_to(np.asarray(sol.flow_rate, dtype=float), index.shape)
+            _, di, do = (np.broadcast_to(np.asarray(x, dtype=float), index.shape) for x in sol._sensitivities())
+            q[index], d_in[index], d_out[index] = qi, di, do
+            if part.reverse is not None:
+                continue
+            p_out = outlet[index] - np.asarray(p_e, dtype=float)
+            g_in = np.broadcast_to(np.asarray(part.fluid._pressure_gradient(
+                qi, np.broadcast_to(np.asarray(sol.inlet_radius, dtype=float), index.shape)), dtype=float), index.shape)
+            length = np.broadcast_to(np.asarray(sol.tube.length, dtype=float), index.shape)
+            scale[index] = (length * g_in - (p_out + drop[index])) * di - p_out * do
+        return q, d_in, d_out, scale
+
+    def check(self, q, radius_u, radius_v, tubes, forward):
+        """The converged tubes against the model's assumptions (:mod:`tubefsi.validity`): one
+        ModelValidityWarning per failed assumption of a group, naming its first offending tube (a
+        graded tube: the section where its flow enters, as for a single graded tube)."""
+        for part, index, wall, tube, _ in self._pieces(forward):
+            if part.reverse is None:
+                scene = make_scene(part.fluid, part.wall, part.tube)
+                scene = scene.flat(index.shape) if scene.shape != () else scene
+                a_u = a_v = np.broadcast_to(part.tube.radius, index.shape)
+            else:
+                scene = make_scene(part.fluid, wall, tube).uniform_at(0.0)
+                a_u, a_v = self.radius_u[index], self.radius_v[index]
+            strain = np.maximum(radius_u[index] / a_u, radius_v[index] / a_v) - 1.0
+            found = validity.check(scene, np.abs(q[index]), strain)
+            if found.messages:
+                slender = np.maximum(radius_u[index], radius_v[index]) / np.broadcast_to(part.tube.length, index.shape)
+                name = tubes[index[int(np.argmax(slender))]].name
+                validity.warn(attrs.evolve(found, messages=tuple(
+                    f"network (e.g. tube {name!r}): {m.replace(' points', ' tubes')}" for m in found.messages)))
+
+    def inlet(self, q, outlet, tubes, forward):
+        """Flow-controlled: the inlet pressure and the inlet and outlet radii of the tubes carrying
+        ``q > 0`` with ``outlet`` pressure (entering at u where ``forward``, else at v); a flow
+        rate beyond a tube's maximum raises, naming it."""
+        p_in, radius_in, radius_out = (np.zeros(q.size) for _ in range(3))
+        for part, index, wall, tube, p_e in self._pieces(forward):
+            fluid = part.fluid
+            # checked with the rest of the result
+            sol = solve_unchecked(fluid, wall, tube, flow_rate=q[index], outlet_pressure=outlet[index],
+                                  external_pressure=p_e, on_infeasible="nan")
+            if not np.all(sol.feasible):
+                j = int(np.flatnonzero(~sol.feasible)[0])
+                limit = np.broadcast_to(tubefsi_max_flow(fluid, wall, tube, outlet_pressure=outlet[index],
+                                                         external_pressure=p_e), index.shape)[j]
+                raise NoSteadyStateError("flow_rate", float(limit), float(q[index][j]),
+                                         f"the inflow into tube {tubes[index[j]].name!r} reaches its maximum flow rate "
+                                         f"at the outlet pressure {outlet[index][j]:.10g} Pa")
+            p_in[index] = sol.inlet_pressure
+            radius_in[index] = sol.inlet_radius
+            radius_out[index] = np.broadcast_to(_radius_at(tube, tube.length) * sol.scene.outlet_stretch, index.shape)
+        return p_in, radius_in, radius_out
+
+    def apparent_viscosity(self, q, mu):
+        """Per tube, the Newtonian viscosity with the fluid's pressure gradient at ``|q|`` in the
+        undeformed tube (``mu`` where q = 0; a graded tube: in the uniform tube of its Poiseuille
+        mean radius)."""
+        out = mu.copy()
+        for part in self.parts:
+            index, fluid = part.index, part.fluid
+            qi = np.abs(q[index])
+            ok = qi > 0
+            if np.any(ok):
+                a = self.radius[index]
+                g = np.asarray(fluid.pressure_gradient(np.where(ok, qi, 1.0), part.tube.radius if part.reverse is None
+                                                       else a), dtype=float)
+                g = np.broadcast_to(g, index.shape)
+                value = g * math.pi * a**4 / (8 * np.where(ok, qi, 1.0))
+                out[index] = np.where(ok & np.isfinite(value) & (value > 0), value, mu[index])
+        return out
+
+    def nominal_viscosity(self, n):
+        mu = np.empty(n)
+        for part in self.parts:
+            mu[part.index] = np.broadcast_to(np.asarray(part.fluid.apparent_viscosity(1.0), dtype=float),
+                                             part.index.shape)
+        return mu
+
+    def fluids(self):
+        """``(index, fluid)`` per part (the results' wall shear stresses)."""
+        return tuple((part.index, part.fluid) for part in self.parts)
+
+
+def _radius_at(tube, z):
+    """The undeformed radius at the position ``z`` (m): a(z) of a graded tube, else its radius."""
+    if isinstance(tube.radius, Profile):
+        return float(tube.radius(np.asarray(float(z))))
+    return tube.radius
+
+
+#: Positions (besides the breakpoints) where a graded tube's limit pressure and mean radius are sampled.
+_SAMPLES = 65
+
+
+def _along(part):
+    r"""A graded tube's bound for its nodes' pressures and its radius for the rigid start: the
+    smallest local limit pressure of its sections (sampled at 65 positions and its breakpoints: a
+    node pressure below it keeps every section below its own, since the pressure falls along the
+    flow), and the Poiseuille mean :math:`(\frac1L\int_0^L a^{-4}\,dz)^{-1/4}` (trapezoidal rule)."""
+    scene = make_scene(part.fluid, part.wall, part.tube)
+    L = float(part.tube.length)
+    z = np.union1d(np.linspace(0.0, L, _SAMPLES), [b for b in _breakpoints(scene) if 0.0 < b < L])
+    wall, a, tb = scene.at_position(z)
+    limit = float(np.min(np.broadcast_to(wall._limit_pressure(tb), z.shape)))
+    a = np.broadcast_to(a, z.shape)
+    mean = float((np.trapezoid(a**-4.0, z) / L) ** -0.25)
+    return limit, mean
+
+
+def _flipped(profile, length):
+    r"""The profile read from the other end of a tube of ``length``: :math:`z \mapsto f(L - z)`
+    (it validates its values as the original does)."""
+    lo, hi = profile.span
+    return Profile(lambda z: profile(length - np.asarray(z, dtype=float)),
+                   breakpoints=[length - b for b in profile.breakpoints], span=(length - hi, length - lo))
+
+
+def _reversed(wall, tube):
+    """``(wall, tube)`` of a graded tube read from its outlet: every profile flipped along the
+    (stress-free) length, the numbers kept."""
+    L = float(tube.length)
+    flip = {f: _flipped(v, L) for f in _array_fields(type(wall)) if isinstance(v := getattr(wall, f), Profile)}
+    tube_flip = {f: _flipped(v, L) for f in ("radius", "thickness") if isinstance(v := getattr(tube, f), Profile)}
+    return (attrs.evolve(wall, **flip) if flip else wall), attrs.evolve(tube, **tube_flip)
+
+
+def _fixed(model):
+    """The values of a model's parameters that cannot be arrays (they split groups)."""
+    return tuple(getattr(model, name) for name in _scalar_fields(type(model)))
+
+
+def _scalar_fields(cls):
+    arrays = set(_array_fields(cls))
+    return tuple(f.name for f in attrs.fields(cls) if f.init and f.name not in arrays) if attrs.has(cls) else ()
+
+
+def _column(values):
+    a = np.asarray(values, dtype=float)
+    return float(a[0]) if np.all(a == a[0]) else a
+
+
+def _gather(members, which, fields) -> dict:
+    """field -> the members' values of that parameter of their ``which`` model (a float where all
+    agree, else an array aligned with ``members``). Tubes added together by
+    :meth:`Network.add_tubes` share one model: their entries are taken at their rows, in one
+    indexing per model rather than one lookup per tube."""
+    models = [getattr(m, which) for m in members]
+    first = models[0]
+    if all(model is first for model in models):          # one model (one add_tubes call, or shared)
+        by_model = {id(first): (first, slice(None), [m.row for m in members])}
+    else:
+        by_model = {}
+        for j, (m, model) in enumerate(zip(members, models)):
+            entry = by_model.get(id(model))
+            if entry is None:
+                entry = by_model[id(model)] = (model, [], [])
+            entry[1].append(j)
+            entry[2].append(m.row)
+    out = {f: np.empty(len(members)) for f in fields}
+    for model, positions, rows in by_model.values():
+        for f in fields:
+            value = getattr(model, f)
+            out[f][positions] = value[rows] if isinstance(value, np.ndarray) and value.ndim else value
+    return {f: _column(column) for f, column in out.items()}
+
+
+def _stack(members, which):
+    """One model whose array parameters hold the members' values (a scalar where all agree)."""
+    first = getattr(members[0], which)
+    if all(getattr(m, which) is first and m.row is None for m in members):
+        return first
+    return attrs.evolve(first, **_gather(members, which, _array_fields(type(first))))

@@ -1,0 +1,498 @@
+r"""Newton's method for the steady flow through a :class:`~tubefsi.Network` (``docs/network.md``).
+
+Nodes carry pressures :math:`p_i` (transmural, gauge); a tube :math:`e = (u, v)` carries the
+flow :math:`q_e = Q_e(p_u, p_v)` of the pressure-controlled single-tube problem, solved from the
+higher-pressure end, so that the edge law is odd in :math:`p_u - p_v`:
+:math:`Q_e = \operatorname{sign}(p_u - p_v)\,Q(|p_u - p_v|;\ \min(p_u, p_v))` (a graded tube's
+:math:`Q` is that of the tube read from the end its flow enters, so its law is not odd:
+:mod:`tubefsi.network_groups`). At every node
+without a fixed pressure Kirchhoff's law holds,
+
+.. math::  F_i(p) = \sum_{e:\,v_e = i} q_e - \sum_{e:\,u_e = i} q_e + s_i + (p_{d,i} - p_i)/R_i = 0,
+
+with :math:`s_i` the injected flow rate and, at a resistance outlet, :math:`R_i` its terminal
+resistance to the distal pressure :math:`p_{d,i}` (the term is absent elsewhere). The free pressures solve :math:`F = 0` by Newton's
+method: the Jacobian is assembled from the analytic derivatives :math:`\partial q/\partial p_{in}`
+and :math:`\partial q/\partial p_{out}` of each tube (``docs/theory.md``, section
+"Sensitivities") and factorized by :func:`scipy.sparse.linalg.splu`. Every tube of a network is
+evaluated in one broadcast :func:`tubefsi.solve` per iteration and per group of tubes that
+share their wall and fluid classes (their parameters stacked into arrays).
+
+Globalization: the start is the rigid Newtonian network (each tube a Hagen–Poiseuille
+conductance :math:`\pi a^4/(8\mu L)` at the fluid's apparent viscosity, refined by three
+Picard sweeps); every Newton step is cut to stay inside :math:`0 \le p_i < p_{lim}` (a step goes
+at most 90 % of the way to a tube's limit pressure or to zero) and then halved until the
+residual norm :math:`\|F\|_2` decreases (Armijo). The derivative of a tube without flow is
+degenerate — :math:`\partial q/\partial p \to 0` for a shear-thinning fluid, :math:`\infty` for a
+shear-thickening one, as :math:`\Delta p \to 0` — so a tube whose pressure drop is below
+:math:`10^{-8}` of the largest pressure enters the Jacobian with its secant conductance
+:math:`q/\Delta p` (which zeroes the flow into a dead end in one step; the rigid start
+conductance at :math:`\Delta p = 0`), and no conductance goes below :math:`10^{-8}` of the rigid
+start one. That changes the step only, never the residual, so the converged pressures are those
+of the exact edge laws. (A drop below :math:`10^{-30}` of the largest pressure is taken as
+zero; the flow it would carry is below :math:`10^{-30/n}` of the network's.)
+
+A trial pressure beyond what a wall's tube law reaches halves the step; a flow rate the
+single-tube solve cannot give at a drop far below the pressures (NaN, the generic rheology path)
+is the secant of a probe drop (``docs/network.md``). A node with an inflow and a single
+tube is no unknown: that tube is solved flow-controlled at the end.
+
+Converged means that the mass balance of every free node is below ``rtol`` times the
+throughput (the total flow that enters the network); otherwise :class:`ConvergenceError`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse import csgraph
+from scipy.sparse import linalg as spla
+
+from .errors import (AccuracyWarning, ConvergenceError, InvalidParameterError, NoSteadyStateError, warn_user)
+from .network_groups import _Groups
+from .network_solution import NetworkSolution, _hashable
+
+
+#: Jacobian conductances are clipped to [_CLIP, 1/_CLIP] times the rigid start conductance
+_CLIP = 1e-8
+#: fraction of the way to a bound (a limit pressure, zero) that one Newton step may go
+_TO_BOUND = 0.9
+#: a tube whose pressure drop is below this times the largest pressure counts as without flow
+#: (its Jacobian entry is the secant); below _TINY times it the drop is zero
+_STILL = 1e-8
+_TINY = 1e-30
+#: a node this close (relative) to its bound with the step still pushing outward is at the bound
+_AT_BOUND = 1e-12
+#: a node within this (relative) of its bound whose step into it the line search must cut is held
+#: at the bound (an active set: ``_Solver._pinned_done``); farther away such a cut is a one-off
+_NEAR_BOUND = 1e-2
+
+
+class _Solver:
+    """Newton's method on the Kirchhoff system of a snapshot of a :class:`~tubefsi.Network`."""
+
+    def __init__(self, net):
+        if not net._tubes:
+            raise InvalidParameterError("network", "at least one tube", 0)
+        for node in list(net._pressure) + list(net._inflow) + list(net._resistance):
+            if node not in net._nodes:
+                raise InvalidParameterError("node", "a node of some tube", node, "it has a boundary condition "
+                                            "but no tube")
+        self.net = net
+        self.tubes = list(net._tubes.values())
+        self.nodes = list(net._nodes)
+        index = net._nodes
+        self.U = np.array([index[t.u] for t in self.tubes])
+        self.V = np.array([index[t.v] for t in self.tubes])
+        n_nodes, n_tubes = len(self.nodes), len(self.tubes)
+        self.fixed = np.zeros(n_nodes, dtype=bool)
+        self.p_fixed = np.zeros(n_nodes)
+        for node, p in net._pressure.items():
+            self.fixed[index[node]], self.p_fixed[index[node]] = True, p
+        self.source = np.zeros(n_nodes)
+        for node, s in net._inflow.items():
+            self.source[index[node]] = s
+        # resistance outlets: q = g (p - p_d) leaves node i, g = 1/R (0 elsewhere)
+        self.g_out = np.zeros(n_nodes)
+        self.p_distal = np.zeros(n_nodes)
+        for node, (r, p_d) in net._resistance.items():
+            self.g_out[index[node]], self.p_distal[index[node]] = 1.0 / r, p_d
+        self._check_connected(n_nodes)
+        # a feeder: a node with an inflow and one tube; that tube's flow is known, so it is solved
+        # flow-controlled after the rest (no pressure unknown near a limit pressure at the inlet)
+        degree = np.bincount(self.U, minlength=n_nodes) + np.bincount(self.V, minlength=n_nodes)
+        feeds = ~self.fixed & (self.source > 0) & (degree == 1)
+        self.feeder = feeds[self.U] | feeds[self.V]
+        self.feed_node = np.where(feeds[self.U], self.U, self.V)
+        self.feeds = feeds
+        self.groups = _Groups(self.tubes, ~self.feeder)
+        self.feed_groups = _Groups(self.tubes, self.feeder)
+        self.limit = np.where(self.feeder, self.feed_groups.limit, self.groups.limit)
+        self.radius = np.where(self.feeder, self.feed_groups.radius, self.groups.radius)
+        self.radius0_u = np.where(self.feeder, self.feed_groups.radius_u, self.groups.radius_u)
+        self.radius0_v = np.where(self.feeder, self.feed_groups.radius_v, self.groups.radius_v)
+        self.length = np.where(self.feeder, self.feed_groups.length, self.groups.length)
+        # a node's bound: the smallest limit pressure of its tubes (an inlet must stay below it)
+        self.p_limit = np.full(n_nodes, np.inf)
+        np.minimum.at(self.p_limit, self.U, self.limit)
+        np.minimum.at(self.p_limit, self.V, self.limit)
+        over = self.fixed & (self.p_fixed >= self.p_limit)
+        if np.any(over):
+            i = int(np.flatnonzero(over)[0])
+            raise NoSteadyStateError("pressure", self.p_limit[i], self.p_fixed[i],
+                                     f"node {self.nodes[i]!r} is fixed at or beyond the limit pressure of tube "
+                                     f"{self._limiting_tube(i)!r}")
+        self._check_outlet_capacity()
+        self.n_tubes = n_tubes
+        self._unknowns(~self.fixed)
+
+    def _check_outlet_capacity(self):
+        """Without a fixed pressure, all that enters leaves by the resistance outlets, each taking
+        at most :math:`(p_{lim} - p_d)/R` below its node's limit pressure: net inflows beyond that
+        sum have no steady state (``NoSteadyStateError`` at once, naming it)."""
+        if np.any(self.fixed):
+            return
+        outlets = np.flatnonzero(self.g_out)
+        capacity = float(np.sum(self.g_out[outlets] * (self.p_limit[outlets] - self.p_distal[outlets])))
+        inflow = float(np.sum(self.source))
+        if inflow > capacity:
+            i = int(outlets[np.argmin(self.p_limit[outlets])])
+            raise NoSteadyStateError("flow_rate", capacity, inflow,
+                                     f"the net inflow exceeds what the resistance outlets take with every outlet "
+                                     f"node below its limit pressure, sum (p_lim - p_d)/R (e.g. node "
+                                     f"{self.nodes[i]!r} at the limit pressure {self.p_limit[i]:.6g} Pa of tube "
+                                     f"{self._limiting_tube(i)!r})")
+
+    def _check_connected(self, n):
+        graph = sp.coo_matrix((np.ones(self.U.size), (self.U, self.V)), shape=(n, n))
+        count, labels = csgraph.connected_components(graph, directed=False)
+        anchor = self.fixed | (self.g_out > 0)
+        if not np.any(anchor):
+            raise InvalidParameterError("network", "at least one node with a fixed pressure or a resistance outlet",
+                                        None, "set_pressure(node, p) or set_resistance(node, R) on an outlet")
+        anchored = np.zeros(count, dtype=bool)
+        anchored[labels[anchor]] = True
+        if not np.all(anchored):
+            c = int(np.flatnonzero(~anchored)[0])
+            members = [self.nodes[i] for i in np.flatnonzero(labels == c)]
+            raise InvalidParameterError("network", "every node connected to a fixed pressure or a resistance "
+                                        "outlet",
+                                        members[0], f"a component of {len(members)} node(s), disconnected "
+                                        f"from every fixed pressure: {members[:5]!r}")
+
+    def _unknowns(self, mask):
+        """Make the nodes of ``mask`` the unknowns (the rigid start: every free node; Newton: the
+        free nodes but the feeders)."""
+        self.unknown = mask
+        self.free = np.flatnonzero(mask)
+        self.where = np.full(mask.size, -1)
+        self.where[self.free] = np.arange(self.free.size)
+
+    def _limiting_tube(self, i):
+        at = np.flatnonzero((self.U == i) | (self.V == i))
+        return self.tubes[int(at[np.argmin(self.limit[at])])].name
+
+    # ------------------------------------------------------------------ linear algebra
+    def _jacobian(self, gu, gv):
+        """dF/dp over the free nodes from dq_e/dp_u = gu, dq_e/dp_v = gv, and the exact -1/R of
+        each resistance outlet on the diagonal."""
+        U, V = self.U, self.V
+        outlets = np.flatnonzero(self.g_out)
+        rows = np.concatenate([U, U, V, V, outlets])
+        cols = np.concatenate([U, V, U, V, outlets])
+        vals = np.concatenate([-gu, -gv, gu, gv, -self.g_out[outlets]])
+        keep = self.unknown[rows] & self.unknown[cols]
+        m = self.free.size
+        return sp.csc_matrix((vals[keep], (self.where[rows[keep]], self.where[cols[keep]])), shape=(m, m))
+
+    def _balance(self, q, p):
+        """Net inflow at every node: sum of q into it - sum out of it + injection + what a
+        resistance outlet supplies, (p_d - p)/R."""
+        n = len(self.nodes)
+        return (np.bincount(self.V, q, n) - np.bincount(self.U, q, n)) + self._supplied(p)
+
+    def _supplied(self, p):
+        """What the boundary supplies at the nodes without a fixed pressure: the injections and the
+        resistance outlets' flows (negative where they take flow out)."""
+        return self.source + self.g_out * (self.p_distal - p)
+
+    def _rigid_start(self):
+        """Pressures of the rigid Newtonian network (apparent viscosities, three Picard sweeps)."""
+        a, length = self.radius, self.length
+        mu = np.where(self.feeder, self.feed_groups.nominal_viscosity(self.n_tubes),
+                      self.groups.nominal_viscosity(self.n_tubes))
+        good = np.isfinite(mu) & (mu > 0)
+        mu = np.where(good, mu, np.median(mu[good]) if np.any(good) else 1e-3)
+        p = self.p_fixed.copy()
+        for sweep in range(4):
+            c = math.pi * a**4 / (8 * mu * length)
+            rhs = self._supplied(np.zeros_like(p))
+            # K p = s with K the weighted Laplacian; move the fixed columns to the right
+            known = np.where(self.fixed, self.p_fixed, 0.0)
+            flow = c * (known[self.U] - known[self.V])
+            rhs += np.bincount(self.V, flow, len(self.nodes)) - np.bincount(self.U, flow, len(self.nodes))
+            jac = self._jacobian(c, -c)
+            p[self.free] = self._linear_solve(jac, -rhs[self.free]) if self.free.size else p[self.free]
+            q = c * (p[self.U] - p[self.V])
+            if sweep < 3:
+                mu = self.feed_groups.apparent_viscosity(q, self.groups.apparent_viscosity(q, mu))
+        self._unknowns(~self.fixed & ~self.feeds)
+        return p, c
+
+    # ------------------------------------------------------------------ Newton
+    def _edges(self, p):
+        du = p[self.U] - p[self.V]
+        forward = du >= 0
+        drop = np.abs(du)
+        drop[drop <= _TINY * float(np.max(p))] = 0.0      # flow ~ (1e-30)^(1/n) of the network's
+        outlet = np.where(forward, p[self.V], p[self.U])
+        q, d_in, d_out, r_in, r_out = self.groups.evaluate(drop, outlet, forward)
+        bad = ~np.isfinite(q)
+        if np.any(bad):
+            q, d_in, d_out = self._tiny_drops(bad, drop, outlet, forward, q, d_in, d_out, float(np.max(p)))
+        if self.feed_groups.parts:         # the feeders' known flows (their nodes are no unknowns)
+            forward = np.where(self.feeder, self.feed_node == self.U, forward)
+            q = np.where(self.feeder, self.source[self.feed_node], q)
+            d_in, d_out, drop = (np.where(self.feeder, 0.0, x) for x in (d_in, d_out, drop))
+        sign = np.where(forward, 1.0, -1.0)
+        gu = np.where(forward, d_in, -d_out)
+        gv = np.where(forward, d_out, -d_in)
+        # a tube (almost) without flow: dq/dp -> 0 (shear-thinning) or inf (shear-thickening); the
+        # secant q/dp instead (it zeroes a dead end in one step), the rigid start conductance at dp = 0
+        still = (drop <= _STILL * float(np.max(p))) & ~self.feeder
+        if np.any(still):
+            with np.errstate(divide="ignore", invalid="ignore"):
+                secant = np.where(drop[still] > 0, q[still] / drop[still], self.c[still])
+            secant = np.where(np.isfinite(secant) & (secant > 0), secant, self.c[still])
+            gu[still], gv[still] = secant, -secant
+        r_u, r_v = np.where(forward, r_in, r_out), np.where(forward, r_out, r_in)
+        return sign * q, gu, gv, r_u, r_v
+
+    def _linear_solve(self, jac, rhs):
+        try:
+            # the Jacobian's pattern is symmetric (a graph's): minimum degree on A^T + A orders it
+            # with less fill than the default COLAMD (a 10^5-vessel tree: 0.05 s against 0.15 s)
+            return spla.splu(jac, permc_spec="MMD_AT_PLUS_A").solve(rhs)
+        except RuntimeError as exc:          # an exactly singular Jacobian
+            raise ConvergenceError(f"network: singular Jacobian ({exc})") from None
+
+    def _tiny_drops(self, bad, drop, outlet, forward, q, d_in, d_out, scale):
+        """Flows the single-tube solve could not give (NaN): at a pressure drop far below the
+        network's pressures the generic rheology path may not resolve the flow. Such a tube is in
+        its linear (zero-shear) regime, so its flow is the secant of a probe drop of 1e-8 of the
+        largest pressure (1e-6 if that fails too), scaled to its drop; anything else raises."""
+        q, d_in, d_out = q.copy(), d_in.copy(), d_out.copy()
+        todo = bad & (drop > 0) & (drop < 1e-6 * scale)
+        for probe_ratio in (1e-8, 1e-6):
+            if not np.any(todo):
+                break
+            probe = np.where(todo, np.maximum(drop, probe_ratio * scale), drop)
+            mask = np.zeros_like(todo)
+            for part in self.groups.parts:
+                mask[part.index] = todo[part.index]
+            sub = _Groups(self.tubes, mask)
+            qp, _, _, _, _ = sub.evaluate(probe, outlet, forward)
+            ok = todo & np.isfinite(qp)
+            secant = np.where(ok, qp / np.where(ok, probe, 1.0), 0.0)
+            q[ok], d_in[ok], d_out[ok] = secant[ok] * drop[ok], secant[ok], -secant[ok]
+            todo &= ~ok
+        left = ~np.isfinite(q)
+        if np.any(left):
+            i = int(np.flatnonzero(left)[0])
+            raise ConvergenceError(f"network: the single-tube solve of tube {self.tubes[i].name!r} gave no flow "
+                                   f"rate at pressure drop {drop[i]:.6g} Pa, outlet pressure {outlet[i]:.6g} Pa")
+        return q, d_in, d_out
+
+    def run(self, rtol, max_iterations, shown=None, start=None):
+        p, c = self._rigid_start()
+        self.c = c
+        free = self.free
+        if start:                      # a warm start: the given pressures at the free nodes they name
+            index = self.net._nodes
+            for node, value in start.items():
+                i = index.get(node) if _hashable(node) else None
+                if i is not None and not self.fixed[i]:
+                    p[i] = value
+        room = np.where(np.isfinite(self.p_limit), self.p_limit, np.inf)
+        p[free] = np.clip(p[free], 0.0, np.where(np.isfinite(room[free]), _TO_BOUND * room[free], np.inf))
+        for _ in range(60):            # a start beyond what a wall law reaches: halve it
+            try:
+                q, gu, gv, r_u, r_v = self._edges(p)
+                break
+            except NoSteadyStateError:
+                p[free] *= 0.5
+        else:
+            q, gu, gv, r_u, r_v = self._edges(p)
+        balance = self._balance(q, p)
+        # nodes held at their bound (an active set): where Newton pushes a node into its limit
+        # pressure and the line search must cut the step, the node is held there and the rest
+        # solved; see _pinned_done
+        pinned = np.zeros(len(self.nodes), dtype=bool)
+        released = pinned.copy()          # (a node released once is not held again: no ping-pong)
+        held_from = p.copy()              # a pinned node's pressure before it was held
+        for iteration in range(max_iterations + 1):
+            free = self.free
+            F = balance[free]
+            through = self._throughput(balance, p)
+            worst = float(np.max(np.abs(F), initial=0.0))
+            if worst <= rtol * through or through == 0.0 and worst == 0.0:
+                if not np.any(pinned) or self._pinned_done(pinned, balance, p, rtol * through):
+                    return self._result(p, q, r_u, r_v, iteration, worst / through if through else 0.0)
+                # a pinned node takes flow out: its pressure goes down
+                p, q, gu, gv, r_u, r_v, balance = self._release(p, pinned, released, held_from)
+                continue
+            if iteration == max_iterations:
+                break
+            ju = np.maximum(np.nan_to_num(gu, nan=c, posinf=c / _CLIP), _CLIP * c)
+            jv = -np.maximum(np.nan_to_num(-gv, nan=c, posinf=c / _CLIP), _CLIP * c)
+            step = self._linear_solve(self._jacobian(ju, jv), -F)
+            alpha, bounded = self._to_bound(p, step)
+            first = alpha
+            # the node a cut step would hold at its bound: within _NEAR_BOUND of it, never released
+            pin = bounded if (bounded is not None and not released[bounded]
+                              and self.p_limit[bounded] - p[bounded] <= _NEAR_BOUND * self.p_limit[bounded]) else None
+            norm = float(np.linalg.norm(F))
+            release = False
+            while True:
+                trial = p.copy()
+                trial[free] = np.clip(p[free] + alpha * step, 0.0, None)
+                try:
+                    t_q, t_gu, t_gv, t_ru, t_rv = self._edges(trial)
+                except NoSteadyStateError:    # beyond what a wall law reaches (a peak): shorter
+                    t_balance = None
+                else:
+                    t_balance = self._balance(t_q, trial)
+                if t_balance is not None and np.linalg.norm(t_balance[free]) <= (1 - 1e-4 * alpha) * norm:
+                    break
+                alpha *= 0.5
+                if alpha < 1e-10 and pin is not None:
+                    break                        # pushed into its bound without a better point: hold it there
+                if alpha < 1e-10 and np.any(pinned):
+                    # the rest stalls near its own bounds (rounding): the pinned nodes' excess
+                    # still decides where it dwarfs the rest's imbalance
+                    if not self._pinned_done(pinned, balance, p, max(rtol * through, 10 * float(np.sum(np.abs(F))))):
+                        release = True
+                        break
+                # rounding alone: the imbalance within ten times what the pressures' rounding
+                # leaves, as a whole (the norm the line search decreases: a node whose own noise is
+                # small cannot be improved where its neighbours' rounding dwarfs it)
+                if alpha < 1e-10 and norm <= 10 * float(np.linalg.norm(self._noise(p, q, gu, gv))) \
+                        and _share(worst, through) <= _WORST_ROUNDED:
+                    warn_user(f"network: mass balance to {_share(worst, through):.1e} of the throughput, not rtol = "
+                              f"{rtol:g}: pressures close to a limit pressure amplify the rounding of the "
+                              f"pressures into the flows beyond that", AccuracyWarning)
+                    return self._result(p, q, r_u, r_v, iteration, _share(worst, through))
+                if alpha < 1e-10:
+                    raise ConvergenceError(f"network: the line search stalled after {iteration} Newton iterations; "
+                                           f"largest mass imbalance {worst:.3e} m^3/s = {_share(worst, through):.3e} of "
+                                           f"the throughput (rtol {rtol:g}){_UNRESOLVED if through == 0 else ''}")
+            if release:                 # a pinned node takes flow out: its pressure goes down
+                p, q, gu, gv, r_u, r_v, balance = self._release(p, pinned, released, held_from)
+                continue
+            if pin is not None and alpha < first:
+                # the step into the bound was cut: hold the node at its bound (to _AT_BOUND)
+                if alpha < 1e-10:
+                    trial = p.copy()
+                pinned[pin] = True
+                held_from[pin] = trial[pin]
+                trial[pin] = (1.0 - _AT_BOUND) * self.p_limit[pin]
+                self._unknowns(self.unknown & ~pinned)
+                t_q, t_gu, t_gv, t_ru, t_rv = self._edges(trial)
+                t_balance = self._balance(t_q, trial)
+            p, q, gu, gv, r_u, r_v, balance = trial, t_q, t_gu, t_gv, t_ru, t_rv, t_balance
+            if shown is not None:
+                shown.update()
+        raise ConvergenceError(f"network: no convergence in {max_iterations} Newton iterations; largest mass "
+                               f"imbalance {worst:.3e} m^3/s = {_share(worst, through):.3e} of the throughput "
+                               f"(rtol {rtol:g}){_UNRESOLVED if through == 0 else ''}")
+
+    def _result(self, p, q, r_u, r_v, iterations, residual):
+        if self.feed_groups.parts:
+            at_u = self.feed_node == self.U
+            other = np.where(at_u, self.V, self.U)
+            p_in, r_in, r_out = self.feed_groups.inlet(np.where(self.feeder, q * np.where(at_u, 1.0, -1.0), 1.0),
+                                                       p[other], self.tubes, at_u)
+            p = p.copy()
+            p[self.feed_node[self.feeder]] = p_in[self.feeder]
+            r_u = np.where(self.feeder, np.where(at_u, r_in, r_out), r_u)
+            r_v = np.where(self.feeder, np.where(at_u, r_out, r_in), r_v)
+        for groups in (self.groups, self.feed_groups):
+            groups.check(q, r_u, r_v, self.tubes, q >= 0)
+        fluids = self.groups.fluids() + self.feed_groups.fluids()
+        return NetworkSolution(net=self.net, nodes=self.nodes, tubes=self.tubes, p=p, q=q, radius_u=r_u,
+                               radius_v=r_v, iterations=iterations, residual=residual, U=self.U, V=self.V,
+                               radius0=self.radius0_u, radius0_v=self.radius0_v, length=self.length, fluids=fluids)
+
+    def _noise(self, p, q, gu, gv):
+        """Per free node, the mass imbalance that rounding alone leaves: the pressures' rounding
+        through the tubes' conductances plus the flows' own relative accuracy (~1e-14)."""
+        n = len(self.nodes)
+        eps = np.finfo(float).eps
+        per_tube = 4 * eps * (np.abs(gu * p[self.U]) + np.abs(gv * p[self.V])) + 1e-14 * np.abs(q)
+        per_outlet = 4 * eps * self.g_out * (np.abs(p) + np.abs(self.p_distal))
+        return (np.bincount(self.U, per_tube, n) + np.bincount(self.V, per_tube, n) + per_outlet)[self.free]
+
+    def _throughput(self, balance, p):
+        """The flow that enters the network: injections plus what the fixed nodes and the
+        resistance outlets supply."""
+        supplied = np.where(self.fixed, -balance, self._supplied(p))
+        return float(np.sum(np.maximum(supplied, 0.0)))
+
+    def _release(self, p, pinned, released, held_from):
+        """Let the pinned nodes go, back to their pressures before they were held (Newton's
+        iterate from the bound itself would start among enormous conductances); the new state."""
+        p = p.copy()
+        p[pinned] = held_from[pinned]
+        released |= pinned
+        pinned[:] = False
+        self._unknowns(~self.fixed & ~self.feeds)
+        q, gu, gv, r_u, r_v = self._edges(p)
+        return p, q, gu, gv, r_u, r_v, self._balance(q, p)
+
+    def _pinned_done(self, pinned, balance, p, tolerance):
+        """At a solution of the other nodes with the ``pinned`` ones at their limit pressures:
+        False where a pinned node takes flow out (a negative excess: its pressure goes down, so
+        it is released); True where they balance (a steady state at the bound); raises where they
+        keep an excess. Why that excess means no steady state: a tube's flow rises with its inlet
+        pressure and falls with its outlet one, so raising some nodes' pressures to their limits
+        raises every other free node's pressure, and with them what the fixed nodes and the
+        resistance outlets take out; the free nodes' total excess can then only fall. A steady
+        state below the limits would thus leave the pinned nodes' total excess <= 0."""
+        excess = balance[pinned]
+        if np.any(excess < -tolerance):
+            return False
+        if float(np.sum(excess)) <= tolerance:
+            return True
+        nodes = np.flatnonzero(pinned)
+        i = int(nodes[np.argmax(excess)])
+        tube = self._limiting_tube(i)
+        raise NoSteadyStateError("pressure", float(self.p_limit[i]), float(p[i]),
+                                 f"tube {tube!r} reaches its limit pressure at node {self.nodes[i]!r} (to "
+                                 f"{_AT_BOUND:g} relative): held there, the network still leaves "
+                                 f"{float(np.sum(excess)):.6g} m^3/s it cannot carry, so no steady state "
+                                 f"below it carries these inflows")
+
+    def _to_bound(self, p, step):
+        """The largest step fraction (<= 1) that goes at most 90 % of the way to a bound, and the
+        node whose limit pressure sets it (None where none does); raises when a node sits at a
+        bound and the step still pushes outward."""
+        pf, lim = p[self.free], self.p_limit[self.free]
+        up = step > 0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            gap_up = np.where(up, lim - pf, np.inf)
+            gap_down = np.where(~up, pf, np.inf)
+            frac = np.where(up, _TO_BOUND * gap_up / step, _TO_BOUND * gap_down / -step)
+        frac = np.where(step == 0, np.inf, frac)
+        i = int(np.argmin(frac))
+        if frac[i] >= 1:
+            return 1.0, None
+        node = int(self.free[i])
+        if up[i] and gap_up[i] <= _AT_BOUND * lim[i]:
+            tube = self._limiting_tube(node)
+            raise NoSteadyStateError("pressure", float(lim[i]), float(pf[i]),
+                                     f"tube {tube!r} reaches its limit pressure at node {self.nodes[node]!r} "
+                                     f"(to {_AT_BOUND:g} relative): no steady state below it carries these inflows")
+        if not up[i] and gap_down[i] <= _AT_BOUND * max(float(np.max(p)), 1e-300):
+            raise InvalidParameterError("inflow", "inflows that keep every pressure >= 0 (tubefsi models "
+                                        "inflation, not collapse)", self.nodes[node],
+                                        f"node {self.nodes[node]!r} would need a negative transmural pressure")
+        return float(frac[i]), (node if up[i] else None)
+
+
+#: Why a network can have no resolvable throughput: tubes in series whose conductances differ by
+#: more than double precision resolves (the drop over the wide one is below one rounding unit of
+#: the pressures, so its flow is either 0 or far too large).
+_UNRESOLVED = ("; no flow is resolved at all: tubes in series whose conductances differ beyond double "
+               "precision (e.g. radii 5 m and 0.1 mm) cannot balance; model the wide one as a node")
+
+
+#: The largest mass imbalance (a share of the throughput) accepted, with an AccuracyWarning, where
+#: the rounding of the pressures allows no better; beyond it the line search's stall is an error.
+_WORST_ROUNDED = 1e-6
+
+
+def _share(worst, through) -> float:
+    """The imbalance as a share of the throughput (inf where nothing flows but something should)."""
+    return worst / through if through > 0 else (0.0 if worst == 0 else float("inf"))

@@ -1,0 +1,97 @@
+"""Random diamonds with a cross edge (``docs/network.md``): the cyclic network whose cross flow's
+direction is not known in advance, with random walls, fluids and boundary conditions.
+
+Reference: Kirchhoff's law at every free node with each tube's flow recomputed by its own
+single-tube :func:`tubefsi.solve` at the network's node pressures (from the higher-pressure end),
+independent of the network's grouping, Jacobian and globalization.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+
+import tubefsi
+from tubefsi import Network, NoSteadyStateError, Tube
+from tubefsi.registry import rheologies, walls
+from tubefsi.testing.profiles import scaled
+
+EDGES = [("i", "s"), ("s", "l"), ("s", "r"), ("l", "r"), ("l", "o"), ("r", "o")]
+
+
+def random_diamond(seed):
+    """A diamond i -> s -> {l, r} -> o with the cross edge l -> r: per tube a random radius,
+    length, wall (thick neo-Hookean of a random modulus, or rigid) and fluid (power law n in
+    [0.5, 1.3] or Newtonian); the inlet a fixed pressure or an inflow (a fraction of what the
+    rigid network would carry), the outlet a fixed pressure or a resistance outlet."""
+    rng = np.random.default_rng(seed)
+    net = Network()
+    for j, (u, v) in enumerate(EDGES):
+        a = 1e-4 * rng.uniform(0.5, 1.5)
+        mu = rng.uniform(3e3, 3e4)
+        wall = walls["rigid"]() if rng.random() < 0.2 else walls["thick-neo-hookean"](shear_modulus=mu)
+        fluid = (rheologies["newtonian"](viscosity=rng.uniform(1e-3, 5e-3)) if rng.random() < 0.3 else
+                 rheologies["power-law"](consistency=rng.uniform(0.002, 0.05), index=rng.uniform(0.5, 1.3)))
+        net.add_tube(u, v, wall, Tube(radius=a, thickness=0.3 * a, length=a * rng.uniform(40, 160)),
+                     rheology=fluid)
+    limit = 3e3 * np.log1p(0.3)                  # below every thick neo-Hookean limit pressure
+    p_out = rng.uniform(0.0, 0.3) * limit
+    if rng.random() < 0.5:
+        net.set_pressure("o", p_out)
+    else:
+        net.set_resistance("o", 10 ** rng.uniform(10, 13), distal_pressure=p_out)
+    if rng.random() < 0.5:
+        net.set_pressure("i", p_out + rng.uniform(0.05, 0.6) * (limit - p_out))
+    else:
+        net.set_inflow("i", 10 ** rng.uniform(-12, -9))
+    return net
+
+
+def kirchhoff_residual(net, result):
+    """The largest mass imbalance of a free node over the throughput, each tube's flow from its
+    own single-tube solve at the node pressures."""
+    p = result.pressure
+    balance = {node: net._inflow.get(node, 0.0) for node in result.nodes}
+    for name, t in net._tubes.items():
+        pu, pv = p[t.u], p[t.v]
+        if pu == pv:
+            continue
+        q = tubefsi.solve(t.rheology, t.wall, t.tube, pressure_drop=abs(pu - pv), outlet_pressure=min(pu, pv)).flow_rate
+        q = q if pu > pv else -q
+        balance[t.u] -= q
+        balance[t.v] += q
+    for node, (r, p_d) in net._resistance.items():
+        balance[node] -= (p[node] - p_d) / r
+    through = abs(result.flow_rate[("i", "s")])
+    return max(abs(balance[n]) for n in result.nodes if n not in net._pressure) / through
+
+
+@settings(max_examples=scaled(6), deadline=None)
+@given(seed=st.integers(0, 2**31 - 1))
+def test_random_diamonds_balance(seed):
+    """Every random diamond either solves, with Kirchhoff's law to 1e-11 of the throughput by
+    independent single-tube solves (or to the balance an AccuracyWarning states: seed 228 has a
+    node 1e-5 below a tube's limit pressure, where rounding leaves 2.8e-9), or raises
+    NoSteadyStateError (an inflow beyond what the walls carry)."""
+    net = random_diamond(seed)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            result = net.solve()
+        except NoSteadyStateError:
+            return
+    rounded = any(issubclass(w.category, tubefsi.AccuracyWarning) for w in caught)
+    # an AccuracyWarning (a node within rounding of a limit pressure) states the balance reached
+    assert kirchhoff_residual(net, result) <= (2 * result.residual if rounded else 0.0) + 1e-11
+
+
+@pytest.mark.slow
+def test_many_random_diamonds():
+    """The same for 400 fixed seeds and seed 1108 (the long run; seeds 12, 33, 39, 66, 228, 245,
+    288 and 1108 failed before the fixes of this round; 1108's inflow exceeds what its resistance
+    outlet takes below its limit pressure)."""
+    for seed in [*range(400), 1108]:
+        test_random_diamonds_balance.hypothesis.inner_test(seed=seed)
