@@ -23,9 +23,6 @@ import tubefsi
 from tubefsi import InvalidParameterError, datasets, network_io
 from tubefsi.registry import rheologies, walls
 
-#: needs tapered tubes in networks (a taper is refused by add_tube on this branch)
-TAPERED = pytest.mark.xfail(reason="tapered edges land with the solver branch", strict=False,
-                            raises=InvalidParameterError)
 NEWTONIAN = rheologies["newtonian"](viscosity=3.5e-3)
 
 
@@ -50,7 +47,6 @@ def test_adan56_ships_77_vessels_78_nodes_and_its_terminals():
     assert sorted(int(r[2]) for r in rows) == list(range(2, 79))
 
 
-@TAPERED
 def test_adan56_with_linear_tapers():
     net = tubefsi.read_network_table(datasets.adan56(), rheology=NEWTONIAN)
     assert len(net.tube_names) == 77
@@ -103,7 +99,6 @@ def test_table_round_trip_with_thickness_and_external_pressure(tmp_path):
     assert network_io.network_table(tubefsi.read_network_table(path, rheology=NEWTONIAN)) == columns
 
 
-@TAPERED
 def test_tapered_table_round_trip(tmp_path):
     net = tubefsi.read_network_table(datasets.adan56(), rheology=NEWTONIAN)
     path = network_io.write_network_table(net, tmp_path / "adan.csv")
@@ -112,7 +107,6 @@ def test_tapered_table_round_trip(tmp_path):
     assert columns["Rd(m)"] == [float(r[7]) for r in rows]
 
 
-@TAPERED
 def test_a_tapered_rigid_vessel_against_poiseuille(tmp_path):
     # a linear taper a(z) from a_p to a_d: R = (8 mu / pi) int_0^L dz / a^4
     #                                          = 8 mu L (a_p^2 + a_p a_d + a_d^2) / (3 pi a_p^3 a_d^3)
