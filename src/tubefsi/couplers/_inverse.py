@@ -27,17 +27,18 @@ import numpy as np
 
 from .._lazy import lazy_module
 from ..errors import ConvergenceError, InvalidParameterError, NoSteadyStateError, StretchRangeError
-from ..numerics.kernels import EPS, rows_dot
+from ..numerics.kernels import EPS, blocked_matmul, rows_dot
 from ..numerics.quadrature import Integral, warn_unconverged
 from ..numerics.roots import solve_increasing
-from ..numerics.spectral import CHEBYSHEV_DEGREE, solve_integral
+from ..numerics.spectral import CHEBYSHEV_DEGREE, lobatto_rule, solve_integral
 from ..rheology import flow_map
 
 optimize = lazy_module("scipy.optimize", globals(), "optimize")
 elementwise = lazy_module("scipy.optimize.elementwise", globals(), "elementwise")
 
 __all__ = ["MAX_LOG_STRETCH", "newton", "one_batch", "inlet_log_stretch", "solve_flow_rate", "j_infinity",
-           "beyond_limit", "clearly_beyond", "max_flow_rate", "classify_runaway", "log_stretch_cap"]
+           "beyond_limit", "clearly_beyond", "max_flow_rate", "classify_runaway", "log_stretch_cap",
+           "one_batch_mapped", "solve_flow_rate_mapped"]
 
 #: Largest inlet stretch (relative to the outlet) a solve may reach: ln(1e15). Not a physical
 #: limit (``max_flow_rate`` is the one limit): beyond it ``StretchRangeError``.
@@ -535,7 +536,7 @@ def solve_flow_rate(engine, scene, v, dp, index):
     q_lo = rheo._flow_rate(a * pts.outlet_stretch + 0.0 * g, g)
     q_hi = rheo._flow_rate(a * engine.stretch_at(pts, v), g)
     flowing = (q_hi > 0) & (dp > 0)
-    if scene.rheology.yield_stress > 0 and np.any(flowing):
+    if np.any(np.asarray(scene.rheology.yield_stress) > 0) and np.any(flowing):
         sel = np.flatnonzero(flowing)
         flowing[sel] = engine._J(scene, v[sel], index[sel], np.zeros(sel.size)).value > _pick(L + 0.0 * v, sel)
     q = np.zeros(v.shape)
@@ -634,3 +635,131 @@ def one_batch_mapped(engine, scene, target, index, q, bound):
         top[live[again]] = wider
         live = np.sort(np.concatenate([live[again][keep], live[~good & ~short & vouched]]))
     return v, solved
+
+
+#: The degrees :func:`solve_flow_rate_mapped` tries, in turn, on the interval [0, v].
+_FLOW_DEGREES = (24, 48)
+#: Its Newton iteration in ln q: at most this many steps, the last one below ``_FLOW_STEP``.
+_FLOW_ITERATIONS, _FLOW_STEP = 40, 1e-9
+#: Where the outlet alone would not yield a yield-stress fluid, the search starts this far below the
+#: inlet's bound in ln q (a flow rate e^-60 of it: below that, the adaptive route decides).
+_UNYIELDED_REACH = 60.0
+
+
+def solve_flow_rate_mapped(engine, scene, v, dp, index):
+    r"""``(q, solved)``: the flow rate of a non-separable fluid at a given inlet log-stretch ``v``
+    (the pressure-controlled problem), from the flow map of its law, for every point at once.
+
+    With :math:`v` known the separated identity is :math:`H(q) = \int_0^v c(u)/\tau_w(\Gamma(q, u))\,du
+    = L`, :math:`c = sP'(s)\,a s/2` (the wall's part, fixed) and
+    :math:`\ln\Gamma = \ln(4q/\pi) - 3\ln(a\lambda_{out}) - 3u`. On the Chebyshev–Lobatto nodes of
+    :math:`[0, v]` the map (:mod:`~tubefsi.rheology.flow_map`, built once over the range of
+    :math:`\ln\Gamma` that the bracket of :func:`solve_flow_rate` spans) gives :math:`\tau_w`, and
+    Newton's method on :math:`\ln H(\ln q) = \ln L` uses
+    :math:`dH/d\ln q = -\int_0^v (c/\tau_w)\,k\,du`, :math:`k = d\ln\tau_w/d\ln\Gamma =
+    \Gamma/(4\dot\gamma_w - 3\Gamma)` (the Rabinowitsch–Mooney identity), kept inside the
+    bracket (bisection where a step leaves it). A point is solved only where the map vouches for
+    every node and the tail of the interpolant of the integrand at the answer meets the
+    tolerance, :math:`v\sum_{k=n-2}^n|c_k| \le 5\cdot10^{-14} L`; the others are left to
+    :func:`solve_flow_rate`. A yield-stress fluid that the pressure drop cannot yield all along
+    the tube (:math:`H(0^+) \le L`, :math:`\tau_w = \tau_y` at every node) has ``q = 0``."""
+    v = np.asarray(v, dtype=float).ravel()
+    dp = np.asarray(dp, dtype=float).ravel()
+    index = np.asarray(index).ravel()
+    n = v.size
+    q = np.zeros(n)
+    solved = np.zeros(n, dtype=bool)
+    if flow_map.kind(scene.rheology) is None or engine._coarse or n == 0:
+        return q, solved
+    pts = scene.at(index)
+    if pts.wall._slope_kinks(pts.tb):          # (a kinked tube law: the adaptive route splits it)
+        return q, solved
+    a, L, rheo = pts.radius, pts.length, pts.rheology
+    a_out = a * pts.outlet_stretch + np.zeros(n)
+    length = np.asarray(L, dtype=float) + np.zeros(n)
+    tau_y = np.asarray(rheo.yield_stress, dtype=float) + np.zeros(n)
+    log_shift = math.log(4.0 / math.pi) - 3.0 * np.log(a_out)       # ln Gamma at u = 0 is ln q + this
+    a_in = a * engine.stretch_at(pts, v) + np.zeros(n)
+    g = np.where(dp > 0, dp, 1.0) / length
+    stress_law = flow_map.kind(scene.rheology) == "stress"
+    # the bracket in ln q: rigid tubes of the outlet's and the inlet's radii under the mean gradient
+    with np.errstate(all="ignore"):
+        if stress_law:
+            # (in the law's own variable: x_out below the outlet's wall shear rate starts the map,
+            # Gamma <= 4 gamma_w / 3 bounds the inlet's from above; the map's bottom gives lo)
+            x_out, _ = flow_map.log_rate_bracket(rheo, 0.5 * g * a_out)
+            _, x_in = flow_map.log_rate_bracket(rheo, 0.5 * g * a_in)
+            hi = x_in + math.log(4.0 / 3.0) - log_shift
+            lo = np.full(n, -np.inf)
+        else:
+            lo = np.log(np.asarray(rheo._flow_rate(a_out, g), dtype=float) + np.zeros(n))
+            hi = np.log(np.asarray(rheo._flow_rate(a_in, g), dtype=float) + np.zeros(n))
+            unyielded = np.isfinite(hi) & ~np.isfinite(lo) & (tau_y > 0)
+            lo = np.where(unyielded, hi - _UNYIELDED_REACH, lo)     # (the outlet alone would not yield)
+        lo, hi = lo - 1e-12 * (1.0 + np.abs(lo)), hi + 1e-12 * (1.0 + np.abs(hi))
+    live = np.flatnonzero((dp > 0) & (v > 0) & np.isfinite(hi) & (hi > lo) & (np.isfinite(lo) | stress_law))
+    for degree in _FLOW_DEGREES:
+        if live.size == 0:
+            break
+        rule = lobatto_rule(degree)
+        weights = rule.matrix[rule.cumulative][-1] * 0.5              # Clenshaw-Curtis on [0, 1]
+        if np.any(tau_y[live] > 0):
+            # a yield-stress fluid: H(0+), tau_w = tau_y at every node; q = 0 where it does not exceed L
+            u = rule.nodes[:, None] * v[live]
+            with np.errstate(all="ignore"):
+                wall = engine._slope(scene.at(index[live]), u) * (a_out[live] * np.exp(u)) * 0.5
+                h0 = v[live] * (weights @ (wall / tau_y[live]))
+            rest = (tau_y[live] > 0) & ~(h0 > length[live])
+            solved[live[rest]] = True
+            live = live[~rest]
+            if live.size == 0:
+                break
+        sub = scene.at(index[live])
+        vv = v[live]
+        u = rule.nodes[:, None] * vv                                  # (nodes, P)
+        with np.errstate(all="ignore"):
+            wall = engine._slope(sub, u) * (a_out[live] * np.exp(u)) * 0.5
+        s_lo, s_hi, shift, log_l = lo[live], hi[live], log_shift[live], np.log(length[live])
+        if stress_law:
+            fmap = flow_map.flow_map(sub.rheology, None, s_hi + shift, x_lo=x_out[live] - 3.0 * vv - 1.0)
+            s_lo = fmap.y_nodes[0, 0] + 3.0 * vv - shift + 1e-12 * (1.0 + np.abs(s_hi))
+        else:
+            fmap = flow_map.flow_map(sub.rheology, s_lo + shift - 3.0 * vv - 1e-9, s_hi + shift + 1e-9)
+        s = 0.5 * (s_lo + s_hi)
+        moving = np.ones(live.size, dtype=bool)
+        vouched = np.ones(live.size, dtype=bool)
+        with np.errstate(all="ignore"):
+            for _ in range(_FLOW_ITERATIONS):
+                y = s + shift - 3.0 * u
+                tau, ok, x = fmap.wall_stress(y)
+                vouched = np.all(ok, axis=0)
+                f = wall / tau
+                h = vv * (weights @ f)
+                k = 1.0 / (4.0 * fmap.wall_rate(tau, x) / np.exp(y) - 3.0)
+                dh = -vv * (weights @ (f * k))
+                residual = np.log(h) - log_l
+                # the bracket: H decreases with q
+                s_lo = np.where(moving & (residual > 0), s, s_lo)
+                s_hi = np.where(moving & (residual < 0), s, s_hi)
+                step = residual / (dh / h)
+                nxt = s - step
+                # a step below _FLOW_STEP is the last (quadratic: its error is ~1e-18 after it)
+                done = np.abs(step) <= _FLOW_STEP
+                outside = ~done & (~np.isfinite(nxt) | (nxt <= s_lo) | (nxt >= s_hi))
+                nxt = np.where(outside, 0.5 * (s_lo + s_hi), np.clip(nxt, s_lo, s_hi))
+                s = np.where(moving & vouched, nxt, s)
+                moving &= vouched & ~done
+                if not np.any(moving):
+                    break
+            y = s + shift - 3.0 * u
+            tau, ok, _ = fmap.wall_stress(y)
+            f = wall / tau
+            coef = blocked_matmul(rule.matrix[rule.coef], f)
+            tail = vv * np.abs(coef[-3:]).sum(axis=0)
+            h = vv * (weights @ f)
+            good = ~moving & np.all(ok, axis=0) & np.all(f > 0, axis=0) & np.isfinite(tail) & \
+                (tail <= _MAPPED_RTOL * h) & (np.abs(np.log(h) - log_l) <= 1e-13)
+        q[live[good]] = np.exp(s[good])
+        solved[live[good]] = True
+        live = live[~good]
+    return q, solved

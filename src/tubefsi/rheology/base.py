@@ -64,8 +64,9 @@ class Rheology(abc.ABC):
     ``_apparent_shear_rate``         ``(wall_stress, excess=None)``: :math:`\Gamma = 4q/(\pi R^3)` by the
                                      Rabinowitsch–Mooney integral (error-controlled adaptive quadrature)
     ``_flow_rate``                   ``(radius, pressure_gradient)``: :math:`\pi R^3\Gamma(GR/2)/4`
-    ``_pressure_gradient``           ``(flow_rate, radius)``: the inverse, from a cached, error-checked
-                                     table of :math:`\ln(\tau_w - \tau_y)` against :math:`\ln\Gamma`
+    ``_pressure_gradient``           ``(flow_rate, radius)``: the inverse, from the flow map built for
+                                     the call (:mod:`~tubefsi.rheology.flow_map`), else a cached,
+                                     error-checked table of :math:`\ln(\tau_w - \tau_y)` against :math:`\ln\Gamma`
     ``_velocity``                    ``(r, radius, pressure_gradient)``:
                                      :math:`\int_r^R \dot\gamma(G\rho/2)\,d\rho` by adaptive quadrature
     ``_flow_index``                  ``(flow_rate, radius)``: :math:`\partial\ln G/\partial\ln q`, from the
@@ -244,9 +245,9 @@ class Rheology(abc.ABC):
         else:
             rate = q / rate
         rate *= 4.0 / math.pi
-        if _holds_arrays(self):     # many fluids at once: each point's wall stress from the flow map
+        if _holds_arrays(self) or flow_map.kind(self) is not None:    # the flow map, per call
             out = _mapped_wall_stress(self, rate)
-        else:
+        else:                       # a law the maps do not serve: its flow table
             out = flow_table(self).wall_stress(self, rate)
         out *= 2.0
         out /= r
@@ -362,9 +363,10 @@ def _holds_arrays(model) -> bool:
 
 
 def _mapped_wall_stress(model, rate):
-    r""":math:`\tau_w` at the apparent rates ``rate`` of a fluid with array parameters (broadcast
-    against ``rate``): from :func:`~tubefsi.rheology.flow_map.wall_stress` where it vouches for a
-    point, else from the flow table of that point's parameter set (no table is shared between sets)."""
+    r""":math:`\tau_w` at the apparent rates ``rate`` of a fluid (its array parameters broadcast
+    against ``rate``): from :func:`~tubefsi.rheology.flow_map.wall_stress`, built for the call,
+    where it vouches for a point, else from the flow table of that point's parameter set (no table
+    is shared between sets; a fluid the maps serve gets one only where its map fails)."""
     tau, ok = flow_map.wall_stress(model, rate) if flow_map.kind(model) is not None else (None, None)
     shape = np.broadcast_shapes(np.shape(rate), *(np.shape(getattr(model, n)) for n in _array_fields(type(model))))
     if tau is None:
