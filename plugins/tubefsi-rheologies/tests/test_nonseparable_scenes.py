@@ -16,8 +16,9 @@ from mpmath import mp, mpf
 import tubefsi
 from tubefsi.registry import rheologies, walls
 from tubefsi.testing.reference import rel_err
-from tubefsi.testing.reference.rheology import CarreauYasudaRef, RateLawRef, solve_flow_controlled
-from tubefsi.testing.reference.tube_laws import Linear, NeoHookean, RefWall
+from tubefsi.testing.reference.rheology import (CarreauYasudaRef, RateLawRef, solve_flow_controlled,
+                                                solve_pressure_controlled)
+from tubefsi.testing.reference.tube_laws import Linear, NeoHookean, RefWall, stretch_at_pressure
 
 TOL = 1e-12
 
@@ -150,3 +151,59 @@ def test_flow_map_vouches_on_the_newtonian_plateau():
         k = mp.quad(lambda s: ref.tau(s) ** 3, [0, g / 8, g / 2, g])
         gamma = mpf(4) / 3 * (g - k / ref.tau(g) ** 3)
         assert rel_err(rate, gamma) < 1e-14, (rate, float(gamma))
+
+
+# loaded outlets: the fluid's outlet pressure and the external pressure (transmural 400 Pa)
+OUTLET, EXTERNAL = 300.0, -100.0
+
+
+def _loaded_round_trip(name, wall_name, sets):
+    """Flow-controlled at loaded outlets, then pressure-controlled at the pressure drops found,
+    each point against the mpmath references (the outlet at the reference wall's stretch under the
+    transmural outlet pressure, the inlet at the stretch under that plus the pressure drop)."""
+    wall, tb, ref_wall, flow_rates = WALLS[wall_name]
+    params = {k: np.array([s[k] for s in sets], dtype=float) for k in sets[0]}
+    q = np.array(flow_rates[-1:] * len(sets))
+    tube = tubefsi.Tube(radius=RADIUS, thickness=tb * RADIUS, length=LENGTH)
+    fluid = rheologies[name](**params) if len(sets) > 1 else rheologies[name](**sets[0])
+    sol = tubefsi.solve(fluid, wall, tube, flow_rate=q if len(sets) > 1 else float(q[0]),
+                        outlet_pressure=OUTLET, external_pressure=EXTERNAL)
+    back = tubefsi.solve(fluid, wall, tube, pressure_drop=sol.pressure_drop,
+                         outlet_pressure=OUTLET, external_pressure=EXTERNAL)
+    transmural = mpf(OUTLET) - mpf(EXTERNAL)
+    lam_out = stretch_at_pressure(ref_wall, transmural)
+    dps, qs = np.atleast_1d(sol.pressure_drop), np.atleast_1d(back.flow_rate)
+    for i, s in enumerate(sets):
+        ref = _ref_fluid(name, s)
+        dp, _ = solve_flow_controlled(ref, ref_wall, RADIUS, LENGTH, q[i],
+                                      1 + np.atleast_1d(sol.inlet_displacement)[i] / RADIUS, outlet_stretch=lam_out)
+        assert rel_err(dps[i], dp) < TOL, ("flow-controlled", i, s)
+        lam_in = stretch_at_pressure(ref_wall, transmural + mpf(float(dps[i])))
+        flow = solve_pressure_controlled(ref, ref_wall, RADIUS, LENGTH, lam_in, lam_out, q[i] * 1.001)
+        assert rel_err(qs[i], flow) < TOL, ("pressure-controlled", i, s)
+
+
+@pytest.mark.parametrize("name, wall_name, count", [
+    ("carreau-yasuda", "thick neo-Hookean", 1), ("cross", "stiff thin linear", 1),
+    ("ellis", "thick neo-Hookean", 1), ("herschel-bulkley", "stiff thin linear", 2),
+])
+def test_loaded_outlets_flow_and_pressure_controlled_against_mpmath(name, wall_name, count):
+    """Issue 26's contract at loaded outlets (outlet 300 Pa, external -100 Pa), flow- and
+    pressure-controlled, a fluid of arrays (two parameter sets in one call) or of scalars: the
+    pressure drop of the flow-controlled solve against
+    ``tubefsi.testing.reference.rheology.solve_flow_controlled`` (the outlet at the reference
+    wall's stretch under 400 Pa), and the flow rate of the pressure-controlled solve at that drop
+    against ``solve_pressure_controlled`` (secant steps in ln q on the same identity, from 1.001
+    times the flow rate the drop came from), both to 1e-12 (the problems' condition numbers are
+    below 1). The pressure-controlled solve goes through the flow map, with no flow table."""
+    tubefsi.cache_clear()
+    _loaded_round_trip(name, wall_name, SETS[name][:count])
+    assert tubefsi.cache_info().size == 0
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("wall_name", sorted(WALLS))
+@pytest.mark.parametrize("name", sorted(SETS))
+def test_every_fluid_at_loaded_outlets_against_mpmath(name, wall_name):
+    """As above, every plugin fluid, both parameter sets, both walls."""
+    _loaded_round_trip(name, wall_name, SETS[name])

@@ -461,7 +461,7 @@ class SeparatedVariables(Coupler):
         return State(q, dp, self.strain_at(pts, v) + 0.0 * v, v)
 
     def _flow_rate_at(self, scene, v, dp, index):
-        """The flow rates of a non-separable fluid whose inlet log-stretch is ``v`` (the pressure drop
+        r"""The flow rates of a non-separable fluid whose inlet log-stretch is ``v`` (the pressure drop
         ``dp``): :func:`tubefsi.couplers._inverse.solve_flow_rate` (a bracketed root search in
         :math:`\ln q` on the coupler's error-controlled :math:`J`)."""
         return _inverse.solve_flow_rate(self, scene, v, dp, index)

@@ -306,7 +306,7 @@ class PanelMap:
 
 
 def flow_map(rheology, y_lo, y_hi, x_lo=None):
-    """The map of ``rheology`` (its array parameters one per point, along the last axis) over
+    r"""The map of ``rheology`` (its array parameters one per point, along the last axis) over
     ``[y_lo, y_hi]`` per point (``y = ln Gamma``), or None where :func:`kind` is None. ``x_lo``
     (a law given by its stress): start the map's panels there in :math:`\ln\dot\gamma_w` instead
     (``y_lo`` is then ignored; :class:`ClosedMap` needs no range)."""
