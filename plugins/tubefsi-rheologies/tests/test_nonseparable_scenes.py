@@ -16,8 +16,8 @@ from mpmath import mp, mpf
 import tubefsi
 from tubefsi.registry import rheologies, walls
 from tubefsi.testing.reference import rel_err
-from tubefsi.testing.reference.rheology import (CarreauYasudaRef, RateLawRef, solve_flow_controlled,
-                                                solve_pressure_controlled)
+from tubefsi.testing.reference.rheology import (CarreauYasudaRef, RateLawRef, section, solve_flow_controlled,
+                                                solve_pressure_controlled, velocity)
 from tubefsi.testing.reference.tube_laws import Linear, NeoHookean, RefWall, stretch_at_pressure
 
 TOL = 1e-12
@@ -207,3 +207,45 @@ def test_loaded_outlets_flow_and_pressure_controlled_against_mpmath(name, wall_n
 def test_every_fluid_at_loaded_outlets_against_mpmath(name, wall_name):
     """As above, every plugin fluid, both parameter sets, both walls."""
     _loaded_round_trip(name, wall_name, SETS[name])
+
+
+@pytest.mark.parametrize("name, wall_name", [
+    ("carreau-yasuda", "thick neo-Hookean"), ("ellis", "stiff thin linear"), ("herschel-bulkley", "thick neo-Hookean"),
+])
+def test_profiles_against_mpmath(name, wall_name):
+    """The fields along the tube of a non-separable fluid (two parameter sets in one call): at two
+    sections, the pressure, the radius and the wall shear stress against
+    ``tubefsi.testing.reference.rheology.section`` (the section's wall parameter x by Newton's
+    method on the separated identity from x to the outlet, 30 digits: R = a lambda(x), p = P(lambda),
+    tau_w = tau(x)), the velocity at half the radius (a law given by its shear rate) against
+    ``reference.rheology.velocity`` (mpmath.quad of the shear rate over the yielded annulus), and
+    the plug radius against its closed form R tau_y / tau_w (0 without a yield stress); all to
+    1e-12 (these fields' condition numbers are below 1/n, n >= 0.36)."""
+    wall, tb, ref_wall, flow_rates = WALLS[wall_name]
+    sets = SETS[name]
+    params = {k: np.array([s[k] for s in sets], dtype=float) for k in sets[0]}
+    q = np.array([flow_rates[-1]] * len(sets))
+    tube = tubefsi.Tube(radius=RADIUS, thickness=tb * RADIUS, length=LENGTH)
+    sol = tubefsi.solve(rheologies[name](**params), wall, tube, flow_rate=q)
+    z = np.array([0.25, 0.6])[:, None] * LENGTH                       # (2 sections, 2 fluids)
+    pressure, radius, stress = sol.pressure(z), sol.radius(z), sol.wall_shear_stress(z)
+    plug = sol.plug_radius(z)
+    r = 0.5 * radius
+    speed = sol.velocity(r, z) if name != "carreau-yasuda" else None
+    for k in range(z.shape[0]):
+        for i, s in enumerate(sets):
+            ref = _ref_fluid(name, s)
+            x, lam = section(ref, ref_wall, RADIUS, LENGTH - z[k, 0], q[i], radius[k, i] / RADIUS)
+            big_r, tau_w = RADIUS * lam, ref.stress(x)
+            assert rel_err(pressure[k, i], ref_wall.P(lam)) < TOL, ("pressure", k, i)
+            assert rel_err(radius[k, i], big_r) < TOL, ("radius", k, i)
+            assert rel_err(stress[k, i], tau_w) < TOL, ("wall shear stress", k, i)
+            tau_y = mpf(s.get("yield_stress", 0))
+            if tau_y > 0:
+                assert rel_err(plug[k, i], big_r * tau_y / tau_w) < TOL, ("plug radius", k, i)
+            else:
+                assert plug[k, i] == 0.0
+            if speed is not None:
+                gradient = 2 * tau_w / big_r
+                v = velocity(ref.rate, big_r, gradient, mpf(float(r[k, i])), tau_y)
+                assert rel_err(speed[k, i], v) < TOL, ("velocity", k, i)

@@ -47,7 +47,7 @@ from mpmath import mp, mpf
 
 from .quadrature import gauss_legendre, gauss_legendre_rule, geometric_breaks
 
-__all__ = ["CarreauYasudaRef", "RateLawRef", "solve_flow_controlled", "solve_pressure_controlled",
+__all__ = ["CarreauYasudaRef", "RateLawRef", "section", "solve_flow_controlled", "solve_pressure_controlled",
            "yield_pressure_drop", "velocity"]
 
 
@@ -172,27 +172,39 @@ def _length(fluid, wall, a, q, x_in, I_in, x_out, m):
     return H, phi_in, lam_in
 
 
+def section(fluid, wall, radius, to_outlet, q, stretch_guess, m=24, newton=8, outlet_stretch=1):
+    r"""``(x, lam)``: the wall parameter and the stretch of the section a length ``to_outlet``
+    upstream of the outlet (:math:`L - z`) at the flow rate ``q``: Newton's method on
+    :math:`\int_{x}^{x_{out}} P'(\lambda)\,\lambda\,(d\ln\Gamma/dx)/(3G)\,dx = L - z` (its
+    derivative is minus the integrand at :math:`x`), the outlet at the stretch ``outlet_stretch``."""
+    a, q = mpf(radius), mpf(q)
+    target = mpf(to_outlet)
+    lam_out = mpf(outlet_stretch)
+    gam_out = 4 * q / (mp.pi * (a * lam_out) ** 3)
+    x_out = fluid.at_apparent(gam_out, _guess(fluid, gam_out))
+    lam0 = mpf(stretch_guess)
+    x = fluid.at_apparent(4 * q / (mp.pi * (a * lam0) ** 3), _guess(fluid, gam_out / (lam0 / lam_out) ** 3))
+    for _ in range(newton):
+        H, phi, _ = _length(fluid, wall, a, q, x, fluid.integral(x), x_out, m)
+        x += (H - target) / phi
+        if abs(H / target - 1) < mpf(10) ** (-mp.dps + 5):
+            break
+    lam, _ = _state(fluid, wall, a, q, x, fluid.integral(x))
+    return x, lam
+
+
 def solve_flow_controlled(fluid, wall, radius, length, q, stretch_guess, m=24, newton=8, outlet_stretch=1):
     r"""(pressure drop, inlet stretch) of the flow-controlled problem; the outlet at the stretch
     ``outlet_stretch`` (1: unloaded; else where the wall's transmural pressure is the outlet's).
 
     ``fluid`` is a :class:`CarreauYasudaRef` (parameter: wall shear rate) or a :class:`RateLawRef`
-    (parameter: wall stress); the separated identity is integrated over that parameter ``x``:
+    (parameter: wall stress); the separated identity is integrated over that parameter ``x``
+    (:func:`section` at ``to_outlet = L``):
     :math:`L = \int_{x_{in}}^{x_{out}} P'(\lambda)\,\lambda\,(d\ln\Gamma/dx)/(3G)\,dx`, and
     :math:`\Delta p = P(\lambda_{in}) - P(\lambda_{out})`.
     """
-    a, L, q = mpf(radius), mpf(length), mpf(q)
     lam_out = mpf(outlet_stretch)
-    gam_out = 4 * q / (mp.pi * (a * lam_out) ** 3)
-    x_out = fluid.at_apparent(gam_out, _guess(fluid, gam_out))
-    lam0 = mpf(stretch_guess)
-    x_in = fluid.at_apparent(4 * q / (mp.pi * (a * lam0) ** 3), _guess(fluid, gam_out / (lam0 / lam_out) ** 3))
-    for _ in range(newton):
-        H, phi_in, _ = _length(fluid, wall, a, q, x_in, fluid.integral(x_in), x_out, m)
-        x_in += (H - L) / phi_in
-        if abs(H / L - 1) < mpf(10) ** (-mp.dps + 5):
-            break
-    lam_in, _ = _state(fluid, wall, a, q, x_in, fluid.integral(x_in))
+    _, lam_in = section(fluid, wall, radius, length, q, stretch_guess, m, newton, outlet_stretch)
     return wall.P(lam_in) - (wall.P(lam_out) if lam_out != 1 else 0), lam_in
 
 
