@@ -194,8 +194,6 @@ class PanelMap:
         self.pair[-1, 1] = 0.0
         # each panel's y at its middle node apart: the interpolant holds y's variation over the panel
         self.offset = np.full((MAX_PANELS, n), np.nan)
-        y_maps, k_maps = _y_maps(DEGREE), _k_maps(DEGREE)
-        terms = slice(rule.matrix.shape[0], None)                 # the rows of k_maps beyond rule.matrix
         self.y_nodes = np.full((DEGREE + 1, MAX_PANELS, n), np.nan)
         self.ok = np.isfinite(self.x0) & np.isfinite(y_hi)
         self.panels = np.zeros(n, dtype=int)
@@ -206,48 +204,76 @@ class PanelMap:
             err_k = g0 * base.error + 4.0 * _EPS * np.abs(K)
             self.ok &= np.isfinite(K) & (K > 0)
             live = np.flatnonzero(self.ok)
-            for j in range(MAX_PANELS):
-                if live.size == 0:
-                    break
-                r = _at(rheology, live)
-                x = self.x0[live] + WIDTH * (j + rule.nodes[:, None])
-                g = np.exp(x)
-                tau = self._tau(r, g)
-                cube = tau * tau * tau
-                maps = blocked_matmul(k_maps, cube * g)            # (a point's bits independent of its batch)
-                k_nodes = K[live] + (0.5 * WIDTH) * maps[rule.cumulative]
-                gamma = (4.0 / 3.0) * (g - k_nodes / cube)
-                y = np.log(gamma)
-                # the interpolant of y's variation from its middle node (the coefficients of y itself,
-                # ~35 where Gamma ~ 1e15, would carry rounding of eps |y| each: 1e-13 at a point)
-                ref = y[DEGREE // 2]
-                c_and_slope = blocked_matmul(y_maps, y - ref)
-                c = c_and_slope[:DEGREE + 1]
-                # K's error at each node: the panel's start's, the tail of the integrand's interpolant
-                # (a tail at the rounding of the values, 32 eps of their largest, is noise), and the
-                # rounding of the node's own sum, a few eps of the terms it adds up (at the panel's
-                # low nodes far below its top: a Newtonian plateau's integrand grows e^4-fold over a
-                # panel, and the top's rounding charged to the bottom node failed such fluids)
-                w_tail = np.abs(maps[rule.coef][-3:]).sum(axis=0)
-                noise = w_tail <= 32.0 * _EPS * np.max(cube * g, axis=0)
-                err_nodes = err_k[live] + np.where(noise, 0.0, (0.5 * WIDTH) * w_tail) + \
-                    2.0 * _EPS * (k_nodes + (0.5 * WIDTH) * maps[terms])
-                err_k[live] = err_nodes[-1]
-                err_y = np.max((4.0 / 3.0) * err_nodes / (cube * gamma), axis=0)
-                tail = np.abs(c[-3:]).sum(axis=0)
-                good = np.all(np.isfinite(y), axis=0) & np.all(np.diff(y, axis=0) > 0, axis=0) & \
-                    np.all(cube > 0, axis=0) & \
-                    (err_y + tail <= TOL + 32.0 * _EPS * np.max(np.abs(y), axis=0))
-                self.pair[:, 0, j, live], self.pair[:-1, 1, j, live] = c, c_and_slope[DEGREE + 1:]
-                self.offset[j, live] = ref
-                self.y_nodes[:, j, live] = y
-                K[live] = k_nodes[-1]
-                self.panels[live] = j + 1
-                self.ok[live[~good]] = False
-                if j == 0 and x_lo is None:
-                    self.ok[live[y[0] > y_lo[live]]] = False       # (cannot happen for an increasing law)
-                live = live[good & (y[-1] < y_hi[live])]
+            j = 0
+            while live.size and j < MAX_PANELS:
+                # the panels of this step, built in one batch: at least those that y <= x + ln(4/3)
+                # (Gamma <= 4 gamma_w / 3) says most live points need to reach y_hi
+                need = np.ceil((y_hi[live] - math.log(4.0 / 3.0) - self.x0[live]) / WIDTH - j + 1e-9)
+                batch = int(min(MAX_PANELS - j, max(1.0, float(np.sort(need)[(9 * (need.size - 1)) // 10]))))
+                live = self._panels(rheology, live, j, batch, K, err_k, y_lo, y_hi, x_lo is None)
+                j += batch
             self.ok[live] = False                                   # (beyond MAX_PANELS)
+
+    def _panels(self, rheology, live, j0, batch, K, err_k, y_lo, y_hi, check_bottom):
+        """Panels ``j0 .. j0 + batch - 1`` of the points ``live``, their law values in one batch (a
+        point's bits are those of building them one by one); ``K`` and ``err_k`` carried up panel
+        by panel. Returns the points still live after them (every panel good, y_hi not reached)."""
+        rule = self.rule
+        y_maps, k_maps = _y_maps(DEGREE), _k_maps(DEGREE)
+        terms = slice(rule.matrix.shape[0], None)                 # the rows of k_maps beyond rule.matrix
+        p = live.size
+        r = _at(rheology, live)
+        x = self.x0[live] + WIDTH * ((j0 + np.arange(batch))[:, None] + rule.nodes[:, None, None])  # (nodes, batch, P)
+        g = np.exp(x)
+        tau = self._tau(r, g)
+        cube = tau * tau * tau
+        values = cube * g
+        maps = blocked_matmul(k_maps, values.reshape(DEGREE + 1, batch * p)).reshape(-1, batch, p)
+        cumulative = (0.5 * WIDTH) * maps[rule.cumulative]
+        # K's error at each node: the panel's start's, the tail of the integrand's interpolant
+        # (a tail at the rounding of the values, 32 eps of their largest, is noise), and the
+        # rounding of the node's own sum, a few eps of the terms it adds up (at the panel's
+        # low nodes far below its top: a Newtonian plateau's integrand grows e^4-fold over a
+        # panel, and the top's rounding charged to the bottom node failed such fluids)
+        w_tail = np.abs(maps[rule.coef][-3:]).sum(axis=0)
+        noise = w_tail <= 32.0 * _EPS * np.max(values, axis=0)
+        own = np.where(noise, 0.0, (0.5 * WIDTH) * w_tail) + 2.0 * _EPS * ((0.5 * WIDTH) * maps[terms])
+        # K and its error at each panel's start, carried up from the last (the same sums, in the
+        # same order, as panel by panel)
+        k_nodes = np.empty(cumulative.shape)
+        err_nodes = np.empty(cumulative.shape)
+        k_start, e_start = K[live], err_k[live]
+        for b in range(batch):
+            k_nodes[:, b] = k_start + cumulative[:, b]
+            err_nodes[:, b] = e_start + own[:, b] + 2.0 * _EPS * k_nodes[:, b]
+            k_start, e_start = k_nodes[-1, b], err_nodes[-1, b]
+        gamma = (4.0 / 3.0) * (g - k_nodes / cube)
+        y = np.log(gamma)
+        # the interpolant of y's variation from its middle node (the coefficients of y itself,
+        # ~35 where Gamma ~ 1e15, would carry rounding of eps |y| each: 1e-13 at a point)
+        ref = y[DEGREE // 2]
+        c_and_slope = blocked_matmul(y_maps, (y - ref).reshape(DEGREE + 1, batch * p)).reshape(-1, batch, p)
+        c = c_and_slope[:DEGREE + 1]
+        err_y = np.max((4.0 / 3.0) * err_nodes / (cube * gamma), axis=0)
+        tail = np.abs(c[-3:]).sum(axis=0)
+        good = np.all(np.isfinite(y), axis=0) & np.all(np.diff(y, axis=0) > 0, axis=0) & \
+            np.all(cube > 0, axis=0) & (err_y + tail <= TOL + 32.0 * _EPS * np.max(np.abs(y), axis=0))
+        # each point takes its panels in order until one fails or reaches y_hi (as one by one)
+        at = np.arange(p)                                           # positions in live of the live points
+        for b in range(batch):
+            if at.size == 0:
+                break
+            j, pts = j0 + b, live[at]
+            self.pair[:, 0, j, pts], self.pair[:-1, 1, j, pts] = c[:, b, at], c_and_slope[DEGREE + 1:, b, at]
+            self.offset[j, pts] = ref[b, at]
+            self.y_nodes[:, j, pts] = y[:, b, at]
+            K[pts], err_k[pts] = k_nodes[-1, b, at], err_nodes[-1, b, at]
+            self.panels[pts] = j + 1
+            self.ok[pts[~good[b, at]]] = False
+            if j == 0 and check_bottom:
+                self.ok[pts[y[0, b, at] > y_lo[pts]]] = False       # (cannot happen for an increasing law)
+            at = at[good[b, at] & (y[-1, b, at] < y_hi[pts])]
+        return live[at]
 
     def wall_rate(self, tau, x):
         """The wall shear rate at the answers of :meth:`wall_stress`: :math:`e^x` (its natural
