@@ -608,33 +608,98 @@ def one_batch_mapped(engine, scene, target, index, q, bound):
         top = np.minimum(1.5 * target * 2.0 * rough / (radius_out * slope0), bound)
     top = np.where(np.isfinite(top) & (top > 0), top, 0.0)
     live = live[top[live] > 0]
+    rtol = max(engine._RTOL, _MAPPED_RTOL)
+    split = np.zeros(0, dtype=int)              # (tail missed at the top degree: solved in pieces)
     for degree in _MAPPED_DEGREES:
         if live.size == 0:
             break
-        ids = index[live]
-        sub = scene.at(ids)
-        fmap = flow_map.flow_map(sub.rheology, y_out[live] - 3.0 * top[live] - 1e-9, y_out[live] + 1e-9)
-        vouched = np.ones(live.size, dtype=bool)
-        y0, a = y_out[live], sub.radius * sub.outlet_stretch
-
-        def f(u, i):
-            tau, ok, _ = fmap.wall_stress(y0 - 3.0 * u)
-            vouched[:] &= np.all(ok, axis=0)
-            return engine._slope(sub, u) * (a * np.exp(u)) / (2.0 * tau)
-
+        f, vouched = _mapped_integrand(engine, scene, index[live], y_out[live], top[live])
         with np.errstate(all="ignore"):
-            x, good, short = solve_integral(f, target[live], top[live], rtol=max(engine._RTOL, _MAPPED_RTOL),
-                                            degree=degree)
+            x, good, short = solve_integral(f, target[live], top[live], rtol=rtol, degree=degree)
         good &= vouched
         v[live[good]] = x[good]
         solved[live[good]] = True
-        # short: three times the interval; a tail that missed: the next degree on the same one
+        # short: three times the interval; a tail that missed: the next degree on the same one, or
+        # (at the top degree already) the interval in pieces
         again = short & vouched
         wider = np.minimum(3.0 * top[live[again]], bound[live[again]])
         keep = wider > top[live[again]]
         top[live[again]] = wider
-        live = np.sort(np.concatenate([live[again][keep], live[~good & ~short & vouched]]))
+        missed = live[~good & ~short & vouched]
+        if degree == _MAPPED_DEGREES[-1]:
+            split = np.concatenate([split, missed])
+            missed = missed[:0]
+        live = np.sort(np.concatenate([live[again][keep], missed]))
+    for pieces in _MAPPED_PIECES:
+        if split.size == 0:
+            break
+        f, vouched = _mapped_integrand(engine, scene, index[split], y_out[split], top[split])
+        with np.errstate(all="ignore"):
+            x, good = _solve_in_pieces(f, target[split], top[split], pieces, _MAPPED_DEGREES[-1], rtol)
+        good &= vouched
+        v[split[good]] = x[good]
+        solved[split[good]] = True
+        split = split[~good & vouched]
     return v, solved
+
+
+#: A point whose interpolant's tail misses at the top degree is solved on its interval cut into this
+#: many equal pieces, in turn (:func:`_solve_in_pieces`).
+_MAPPED_PIECES = (2, 4)
+
+
+def _mapped_integrand(engine, scene, ids, y_out, top):
+    """``(f, vouched)``: the separated integrand of the points ``ids`` (a non-separable fluid, at their
+    flow rates: ``y_out`` is ln Gamma at the outlet) from a flow map built over ``[0, top]`` of each,
+    and whether the map vouched for every value ``f`` gave (updated by each call)."""
+    sub = scene.at(ids)
+    fmap = flow_map.flow_map(sub.rheology, y_out - 3.0 * top - 1e-9, y_out + 1e-9)
+    vouched = np.ones(ids.size, dtype=bool)
+    a = sub.radius * sub.outlet_stretch
+
+    def f(u, i):
+        tau, ok, _ = fmap.wall_stress(y_out - 3.0 * u)
+        vouched[:] &= np.all(ok, axis=0)
+        return engine._slope(sub, u) * (a * np.exp(u)) / (2.0 * tau)
+
+    return f, vouched
+
+
+def _solve_in_pieces(f, target, upper, pieces, degree, rtol):
+    r"""``(x, solved)``: :math:`\int_0^x f = T` on ``[0, X]`` cut into ``pieces`` equal pieces, each
+    interpolated on its own Chebyshev–Lobatto nodes (``f`` is asked for every point of the batch on
+    each piece). The integral of each piece is its interpolant's (Clenshaw–Curtis); the root lies in
+    the first piece where their running sum reaches :math:`T`, and is solved there
+    (:func:`~tubefsi.numerics.spectral.solve_integral` on that piece's values, with the target less
+    the pieces below). Accepted where the tails of the pieces up to it sum to at most
+    ``rtol`` :math:`T` and every value is positive and finite."""
+    rule = lobatto_rule(degree)
+    n = target.size
+    width = upper / pieces
+    weights = rule.matrix[rule.cumulative][-1]                   # the integral over [-1, 1]
+    below = np.zeros(n)                                           # the pieces' integrals below the root's
+    tails = np.zeros(n)
+    x, solved = np.zeros(n), np.zeros(n, dtype=bool)
+    pending = np.ones(n, dtype=bool)
+    for k in range(pieces):
+        start = k * width
+        values = f(start + rule.nodes[:, None] * width, np.arange(n))
+        coef = blocked_matmul(rule.matrix[rule.coef], values)
+        tails += np.abs(coef[-3:]).sum(axis=0) * width
+        whole = 0.5 * width * (weights @ values)
+        positive = np.all(np.isfinite(values) & (values > 0), axis=0)
+        here = pending & positive & ((below + whole >= target) | (k == pieces - 1))
+        pending &= positive
+        if np.any(here):
+            sel = np.flatnonzero(here)
+            local, good, _ = solve_integral(None, target[sel] - below[sel], width[sel], rtol=np.inf,
+                                            values=values[:, sel], degree=degree)
+            ok = good & (tails[sel] <= rtol * target[sel])
+            x[sel[ok]] = start[sel[ok]] + local[ok]
+            solved[sel[ok]] = True
+            pending[sel] = False
+        below += whole
+    return x, solved
 
 
 #: The degrees :func:`solve_flow_rate_mapped` tries, in turn, on the interval [0, v].
