@@ -281,3 +281,23 @@ def test_large_strain_scenes_against_mpmath():
         dp, stretch = solve_flow_controlled(ref, wall, row[6], row[8], row[9], 1 + sol.inlet_displacement[i] / row[6])
         assert rel_err(sol.pressure_drop[i], dp) < TOL, i
         assert rel_err(sol.inlet_displacement[i], (stretch - 1) * row[6]) < TOL, i
+
+
+def test_pressure_control_of_fluid_arrays_in_a_kinked_wall():
+    """A thin HGO wall's slope kinks where its fibres engage, which the flow map's route leaves to
+    the bracketed search of the error-controlled identity; with fluids given as arrays that search
+    raised an IndexError (the law's generic inverse takes one fluid). Now the flow rates of the
+    pressure drops that the flow-controlled solve (a different route: one batch per point) gives
+    come back to 1e-13, a Carreau-Yasuda and a Herschel-Bulkley fluid of two parameter sets each."""
+    from tubefsi.walls.hgo import ThinHGO
+
+    wall = ThinHGO(shear_modulus=1e3, fibre_stiffness=5e3, fibre_exponent=2.0, fibre_angle=0.7,
+                   thickness_convention="current")
+    tube = tubefsi.Tube(radius=5e-4, thickness=5e-5, length=2e-2)
+    q = np.array([1e-9, 2e-9])
+    for name in ("carreau-yasuda", "herschel-bulkley"):
+        params = {k: np.array([s[k] for s in SETS[name]], dtype=float) for k in SETS[name][0]}
+        fluid = rheologies[name](**params)
+        sol = tubefsi.solve(fluid, wall, tube, flow_rate=q)
+        back = tubefsi.solve(fluid, wall, tube, pressure_drop=sol.pressure_drop)
+        assert np.all(np.abs(back.flow_rate / q - 1) < 1e-13), name

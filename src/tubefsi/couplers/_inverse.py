@@ -27,6 +27,7 @@ import numpy as np
 
 from .._lazy import lazy_module
 from ..errors import ConvergenceError, InvalidParameterError, NoSteadyStateError, StretchRangeError
+from ..fields import _array_fields
 from ..numerics.kernels import EPS, blocked_matmul, rows_dot
 from ..numerics.quadrature import Integral, warn_unconverged
 from ..numerics.roots import solve_increasing
@@ -533,8 +534,18 @@ def solve_flow_rate(engine, scene, v, dp, index):
     v = np.asarray(v, dtype=float)
     dp = np.asarray(dp, dtype=float)
     g = np.where(dp == 0, 1.0, dp) / L
-    q_lo = rheo._flow_rate(a * pts.outlet_stretch + 0.0 * g, g)
-    q_hi = rheo._flow_rate(a * engine.stretch_at(pts, v), g)
+    if flow_map.kind(rheo) == "stress" and any(np.ndim(getattr(rheo, f)) for f in _array_fields(type(rheo))):
+        # fluids given by their stress, one per point: the inlet's rigid tube bounds q from above
+        # through its wall shear rate (Gamma <= 4 gamma_w / 3, the rate bracketed by bisection of
+        # the law), and the search runs down from there (the law's generic inverse takes one fluid)
+        r_in = a * engine.stretch_at(pts, v) + 0.0 * g
+        _, x_in = flow_map.log_rate_bracket(rheo, 0.5 * g * r_in)
+        with np.errstate(over="ignore"):
+            q_hi = (math.pi / 3.0) * r_in**3 * np.exp(x_in)
+        q_lo = np.zeros(q_hi.shape)
+    else:
+        q_lo = rheo._flow_rate(a * pts.outlet_stretch + 0.0 * g, g)
+        q_hi = rheo._flow_rate(a * engine.stretch_at(pts, v), g)
     flowing = (q_hi > 0) & (dp > 0)
     if np.any(np.asarray(scene.rheology.yield_stress) > 0) and np.any(flowing):
         sel = np.flatnonzero(flowing)
