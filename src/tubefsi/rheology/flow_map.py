@@ -374,7 +374,8 @@ def wall_stress(rheology, apparent_rate):
     A fluid of scalar parameters (one fluid, many rates) is served by *one* map spanning the
     rates' range (where it spans at most ``_ONE_MAP_RANGE`` in :math:`\ln\Gamma`); a fluid with
     array parameters by a map per point. Either way each value is the map's inverse at that rate,
-    checked as the map checks it."""
+    checked as the map checks it; the one map's panels start at the lowest rate asked, so a value's
+    last bits (not its accuracy) depend on the range of the call."""
     rate = np.asarray(apparent_rate, dtype=float)
     arrays = [getattr(rheology, n) for n in _array_fields(type(rheology))]
     shape = np.broadcast_shapes(rate.shape, *(np.shape(a) for a in arrays))
