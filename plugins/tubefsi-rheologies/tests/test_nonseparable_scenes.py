@@ -268,7 +268,9 @@ def test_large_strain_scenes_against_mpmath():
     """Scenes whose separated integrand a degree-32 interpolant over the whole interval cannot
     resolve (its tail missed: they went to the slower Newton route, ~4 in 1000 random scenes) are
     solved on the interval cut into pieces; their pressure drops and inlet displacements against
-    ``solve_flow_controlled`` (30 digits) to 1e-12 (condition numbers below 1)."""
+    ``solve_flow_controlled`` (30 digits) to 1e-12 (condition numbers below 1). Pressure-controlled
+    at those drops (the map's route: its bracket of q once fell short of the root at such strains,
+    the inlet's rigid tube taken at the outlet's radius), the flow rates come back."""
     cols = list(zip(*LARGE_STRAIN))
     e0, einf, lam, n, tr, mu, a, t, length, q = (np.array(c) for c in cols)
     fluid = rheologies["carreau-yasuda"](zero_shear_viscosity=e0, infinite_shear_viscosity=einf,
@@ -281,6 +283,12 @@ def test_large_strain_scenes_against_mpmath():
         dp, stretch = solve_flow_controlled(ref, wall, row[6], row[8], row[9], 1 + sol.inlet_displacement[i] / row[6])
         assert rel_err(sol.pressure_drop[i], dp) < TOL, i
         assert rel_err(sol.inlet_displacement[i], (stretch - 1) * row[6]) < TOL, i
+    # pressure-controlled at those (checked) pressure drops: the flow rates back, to 1e-12 times the
+    # condition number d ln q / d ln dp (its inverse from the solution's own derivative)
+    back = tubefsi.solve(fluid, walls["thick-neo-hookean"](shear_modulus=mu),
+                         tubefsi.Tube(radius=a, thickness=t, length=length), pressure_drop=sol.pressure_drop)
+    kappa = np.maximum(1.0, sol.pressure_drop / (q * sol.dpressure_drop_dflow_rate))
+    assert np.all(np.abs(back.flow_rate / q - 1) < TOL * kappa)
 
 
 def test_pressure_control_of_fluid_arrays_in_a_kinked_wall():
@@ -301,3 +309,18 @@ def test_pressure_control_of_fluid_arrays_in_a_kinked_wall():
         sol = tubefsi.solve(fluid, wall, tube, flow_rate=q)
         back = tubefsi.solve(fluid, wall, tube, pressure_drop=sol.pressure_drop)
         assert np.all(np.abs(back.flow_rate / q - 1) < 1e-13), name
+
+
+def test_sensitivities_of_fluid_arrays():
+    """The sensitivities of a solve of fluids given as arrays (their local flow index needs the law's
+    inverse, which took one fluid: an IndexError) equal those of each fluid solved alone (a scalar
+    fluid: the law's inverse of that fluid), to 1e-12."""
+    sets = SETS["carreau-yasuda"]
+    params = {k: np.array([s[k] for s in sets]) for k in sets[0]}
+    tube = tubefsi.Tube(radius=RADIUS, thickness=0.3 * RADIUS, length=LENGTH)
+    wall = WALLS["thick neo-Hookean"][0]
+    q = [1e-8, 2e-8]
+    batch = tubefsi.solve(rheologies["carreau-yasuda"](**params), wall, tube, flow_rate=q).dpressure_drop_dflow_rate
+    for i, s in enumerate(sets):
+        alone = tubefsi.solve(rheologies["carreau-yasuda"](**s), wall, tube, flow_rate=q[i]).dpressure_drop_dflow_rate
+        assert abs(batch[i] / alone - 1) < 1e-12

@@ -765,7 +765,7 @@ def solve_flow_rate_mapped(engine, scene, v, dp, index):
             # Gamma <= 4 gamma_w / 3 bounds the inlet's from above; the map's bottom gives lo)
             x_out, _ = flow_map.log_rate_bracket(rheo, 0.5 * g * a_out)
             _, x_in = flow_map.log_rate_bracket(rheo, 0.5 * g * a_in)
-            hi = x_in + math.log(4.0 / 3.0) - log_shift
+            hi = x_in + math.log(4.0 / 3.0) - log_shift + 3.0 * v          # (ln Gamma_in = ln q + shift - 3 v)
             lo = np.full(n, -np.inf)
         else:
             lo = np.log(np.asarray(rheo._flow_rate(a_out, g), dtype=float) + np.zeros(n))

@@ -177,6 +177,22 @@ class Rheology(abc.ABC):
         if not _overrides(self, "_stress"):
             raise TypeError(f"{type(self).__name__} must implement _stress or _shear_rate")
         t = np.asarray(stress, dtype=float)
+        if _holds_arrays(self):
+            # fluids given as arrays, one per point (broadcast against the stresses): each point's
+            # root with its own parameters (the iteration asks for subsets of the points)
+            shape = np.broadcast_shapes(t.shape, *(np.shape(getattr(self, n)) for n in _array_fields(type(self))))
+            flat = broadcast_model(self, shape)
+            tf = np.broadcast_to(t, shape).ravel()
+            tau_y = np.broadcast_to(np.asarray(self.yield_stress, dtype=float), shape).ravel()
+            live = np.flatnonzero(tf > tau_y)
+            out = np.zeros(tf.size)
+            if live.size:
+                sub = model_at(flat, live)
+                scale = np.asarray(sub._stress(np.ones(live.size)), dtype=float) - tau_y[live]
+                guess = np.where(scale > 0, (tf[live] - tau_y[live]) / np.where(scale > 0, scale, 1.0), tf[live])
+                out[live] = _solve_increasing(sub._stress, tf[live], guess, tau_y[live],
+                                              law_at=lambda idx: model_at(sub, idx)._stress)
+            return out.reshape(shape)
         tau_y = float(self.yield_stress)
         flowing = t > tau_y
         out = np.zeros(t.shape)
@@ -420,7 +436,7 @@ def _positive(x):
     return np.maximum(x, np.finfo(float).tiny)
 
 
-def _solve_increasing(law, target, guess, floor, lower=0.0, name="stress"):
+def _solve_increasing(law, target, guess, floor, lower=0.0, name="stress", law_at=None):
     r"""``x > lower`` with ``law(x) = target`` elementwise, for an increasing law with
     ``law(lower+) = floor < target``: a bracket by steps doubling in :math:`\ln(x - lower)` from
     ``guess``, geometric bisection down to a ratio of 2, then Illinois (regula falsi) steps to a
@@ -434,8 +450,9 @@ def _solve_increasing(law, target, guess, floor, lower=0.0, name="stress"):
     big, tiny = 1e300, 1e-300
 
     def f(x, idx=None):
+        fn = law if idx is None or law_at is None else law_at(idx)     # (a law of one fluid per point)
         with np.errstate(over="ignore", invalid="ignore"):
-            v = np.asarray(law(lower + x), dtype=float) - (t if idx is None else t[idx])
+            v = np.asarray(fn(lower + x), dtype=float) - (t if idx is None else t[idx])
         return np.where(np.isnan(v), np.inf, v)
 
     d = np.clip(np.broadcast_to(np.asarray(guess, dtype=float), shape).ravel() - lower, tiny, big)
