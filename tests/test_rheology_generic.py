@@ -333,8 +333,9 @@ def test_two_kinks_are_integrated_to_the_tolerance(tw):
 @pytest.mark.parametrize("law", [CarreauLike(), NewtonianBelow(), KinkedPowerLaw(),
                                  NewtonianBelow(eta0=1.0, index=1.8, tau_c=0.3)], ids=repr)
 def test_table_against_direct_integrals_over_many_decades(law):
-    """tau_w = G R / 2 from the table at the reference flow rate of 40 decades of wall stress,
-    within TOL plus the rounding of the logarithms: the piecewise laws against their elementary
+    """tau_w = G R / 2 from ``pressure_gradient`` (the flow map where it serves the law) and from the
+    table itself at the reference flow rate of 40 decades of wall stress, within TOL plus the
+    rounding of the logarithms: the piecewise laws against their elementary
     Gamma (801 wall stresses), the Carreau law against mpmath (101 wall shear rates).
 
     Work, once 801 wall stresses across the 40 decades have been served: the table holds fixed
@@ -352,10 +353,13 @@ def test_table_against_direct_integrals_over_many_decades(law):
     else:
         tw, gamma = dense, law.exact_rate(dense)
         kinks = 1
-    err = wall_stress_error(law, tw, gamma, radius)
+    err = wall_stress_error(law, tw, gamma, radius)           # (the flow map, for a law it serves)
     bound = allowed(tw, gamma)
     assert np.all(err <= bound), float(np.max(err / bound))
-    law.pressure_gradient(law.flow_rate(radius, 2.0 * dense / radius), radius)
+    q = 0.25 * math.pi * radius**3 * np.asarray(gamma)
+    err = rel(0.5 * _tabulated_gradient(law, q, radius) * radius, tw)     # the table itself
+    assert np.all(err <= bound), float(np.max(err / bound))
+    _tabulated_gradient(law, law.flow_rate(radius, 2.0 * dense / radius), radius)
     p = np.log(law.shear_rate(dense)) if isinstance(law, (CarreauLike, KinkedPowerLaw)) else np.log(dense)
     spanned = math.floor(p.max()) - math.floor(p.min()) + 1
     table = flow_table(law)
