@@ -27,7 +27,7 @@ import numpy as np
 
 from .._lazy import lazy_module
 from ..errors import ConvergenceError, InvalidParameterError, NoSteadyStateError, StretchRangeError
-from ..fields import _array_fields
+from ..fields import _array_fields, _replace
 from ..numerics.kernels import EPS, blocked_matmul, rows_dot
 from ..numerics.quadrature import Integral, warn_unconverged
 from ..numerics.roots import solve_increasing
@@ -717,6 +717,16 @@ def _solve_in_pieces(f, target, upper, pieces, degree, rtol):
 _FLOW_DEGREES = (24, 48)
 #: Its Newton iteration in ln q: at most this many steps, the last one below ``_FLOW_STEP``.
 _FLOW_ITERATIONS, _FLOW_STEP = 40, 1e-9
+#: The width (in ln of the wall shear rate) of the bisection that bounds the rigid tubes' rates.
+_BRACKET_WIDTH = 0.05
+
+
+def _twice(model, n):
+    """``model`` with its array parameters (one per point, ``n``) repeated for two sets of points."""
+    arrays = {f: np.broadcast_to(v, (n,)) for f in _array_fields(type(model)) if np.ndim(v := getattr(model, f))}
+    return _replace(model, {f: np.concatenate([v, v]) for f, v in arrays.items()}) if arrays else model
+
+
 #: Where the outlet alone would not yield a yield-stress fluid, the search starts this far below the
 #: inlet's bound in ln q (a flow rate e^-60 of it: below that, the adaptive route decides).
 _UNYIELDED_REACH = 60.0
@@ -734,9 +744,10 @@ def solve_flow_rate_mapped(engine, scene, v, dp, index):
     Newton's method on :math:`\ln H(\ln q) = \ln L` uses
     :math:`dH/d\ln q = -\int_0^v (c/\tau_w)\,k\,du`, :math:`k = d\ln\tau_w/d\ln\Gamma =
     \Gamma/(4\dot\gamma_w - 3\Gamma)` (the Rabinowitsch–Mooney identity), kept inside the
-    bracket (bisection where a step leaves it). A point is solved only where the map vouches for
-    every node and the tail of the interpolant of the integrand at the answer meets the
-    tolerance, :math:`v\sum_{k=n-2}^n|c_k| \le 5\cdot10^{-14} L`; the others are left to
+    bracket (bisection where a step leaves it); a step below 1e-9 is the last (quadratic: the
+    answer is 1e-18 from the root after it). A point is solved only where the map vouches for
+    every node and the tail of the interpolant of the integrand at that last evaluation (1e-9 from
+    the answer) meets the tolerance, :math:`v\sum_{k=n-2}^n|c_k| \le 5\cdot10^{-14} L`; the others are left to
     :func:`solve_flow_rate`. A yield-stress fluid that the pressure drop cannot yield all along
     the tube (:math:`H(0^+) \le L`, :math:`\tau_w = \tau_y` at every node) has ``q = 0``."""
     v = np.asarray(v, dtype=float).ravel()
@@ -763,8 +774,9 @@ def solve_flow_rate_mapped(engine, scene, v, dp, index):
         if stress_law:
             # (in the law's own variable: x_out below the outlet's wall shear rate starts the map,
             # Gamma <= 4 gamma_w / 3 bounds the inlet's from above; the map's bottom gives lo)
-            x_out, _ = flow_map.log_rate_bracket(rheo, 0.5 * g * a_out)
-            _, x_in = flow_map.log_rate_bracket(rheo, 0.5 * g * a_in)
+            lower, upper = flow_map.log_rate_bracket(_twice(rheo, n), np.concatenate([0.5 * g * a_out, 0.5 * g * a_in]),
+                                                     width=_BRACKET_WIDTH)
+            x_out, x_in = lower[:n], upper[n:]
             hi = x_in + math.log(4.0 / 3.0) - log_shift + 3.0 * v          # (ln Gamma_in = ln q + shift - 3 v)
             lo = np.full(n, -np.inf)
         else:
@@ -803,7 +815,9 @@ def solve_flow_rate_mapped(engine, scene, v, dp, index):
             fmap = flow_map.flow_map(sub.rheology, s_lo + shift - 3.0 * vv - 1e-9, s_hi + shift + 1e-9)
         s = 0.5 * (s_lo + s_hi)
         moving = np.ones(live.size, dtype=bool)
-        vouched = np.ones(live.size, dtype=bool)
+        # the integrand values of each point's last evaluation, 1e-9 from its answer at most: its
+        # interpolant's tail is the answer's check (no evaluation more)
+        last = np.full(u.shape, np.nan)
         with np.errstate(all="ignore"):
             for _ in range(_FLOW_ITERATIONS):
                 y = s + shift - 3.0 * u
@@ -823,18 +837,14 @@ def solve_flow_rate_mapped(engine, scene, v, dp, index):
                 done = np.abs(step) <= _FLOW_STEP
                 outside = ~done & (~np.isfinite(nxt) | (nxt <= s_lo) | (nxt >= s_hi))
                 nxt = np.where(outside, 0.5 * (s_lo + s_hi), np.clip(nxt, s_lo, s_hi))
+                last[:, moving] = np.where(vouched, f, np.nan)[:, moving]
                 s = np.where(moving & vouched, nxt, s)
                 moving &= vouched & ~done
                 if not np.any(moving):
                     break
-            y = s + shift - 3.0 * u
-            tau, ok, _ = fmap.wall_stress(y)
-            f = wall / tau
-            coef = blocked_matmul(rule.matrix[rule.coef], f)
+            coef = blocked_matmul(rule.matrix[rule.coef], np.where(np.isfinite(last), last, 0.0))
             tail = vv * np.abs(coef[-3:]).sum(axis=0)
-            h = vv * (weights @ f)
-            good = ~moving & np.all(ok, axis=0) & np.all(f > 0, axis=0) & np.isfinite(tail) & \
-                (tail <= _MAPPED_RTOL * h) & (np.abs(np.log(h) - log_l) <= 1e-13)
+            good = ~moving & np.all(np.isfinite(last) & (last > 0), axis=0) & (tail <= _MAPPED_RTOL * length[live])
         q[live[good]] = np.exp(s[good])
         solved[live[good]] = True
         live = live[~good]
