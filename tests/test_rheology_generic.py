@@ -333,8 +333,9 @@ def test_two_kinks_are_integrated_to_the_tolerance(tw):
 @pytest.mark.parametrize("law", [CarreauLike(), NewtonianBelow(), KinkedPowerLaw(),
                                  NewtonianBelow(eta0=1.0, index=1.8, tau_c=0.3)], ids=repr)
 def test_table_against_direct_integrals_over_many_decades(law):
-    """tau_w = G R / 2 from the table at the reference flow rate of 40 decades of wall stress,
-    within TOL plus the rounding of the logarithms: the piecewise laws against their elementary
+    """tau_w = G R / 2 from ``pressure_gradient`` (the flow map where it serves the law) and from the
+    table itself at the reference flow rate of 40 decades of wall stress, within TOL plus the
+    rounding of the logarithms: the piecewise laws against their elementary
     Gamma (801 wall stresses), the Carreau law against mpmath (101 wall shear rates).
 
     Work, once 801 wall stresses across the 40 decades have been served: the table holds fixed
@@ -352,10 +353,13 @@ def test_table_against_direct_integrals_over_many_decades(law):
     else:
         tw, gamma = dense, law.exact_rate(dense)
         kinks = 1
-    err = wall_stress_error(law, tw, gamma, radius)
+    err = wall_stress_error(law, tw, gamma, radius)           # (the flow map, for a law it serves)
     bound = allowed(tw, gamma)
     assert np.all(err <= bound), float(np.max(err / bound))
-    law.pressure_gradient(law.flow_rate(radius, 2.0 * dense / radius), radius)
+    q = 0.25 * math.pi * radius**3 * np.asarray(gamma)
+    err = rel(0.5 * _tabulated_gradient(law, q, radius) * radius, tw)     # the table itself
+    assert np.all(err <= bound), float(np.max(err / bound))
+    _tabulated_gradient(law, law.flow_rate(radius, 2.0 * dense / radius), radius)
     p = np.log(law.shear_rate(dense)) if isinstance(law, (CarreauLike, KinkedPowerLaw)) else np.log(dense)
     spanned = math.floor(p.max()) - math.floor(p.min()) + 1
     table = flow_table(law)
@@ -586,9 +590,17 @@ def test_an_answer_does_not_depend_on_the_tables_history(law, natural, js, span)
     assert np.array_equal(increasing, swept)
 
 
+def _tabulated_gradient(law, q, radius):
+    """G(q, R) from the law's flow table itself (a fluid the flow maps serve reaches its table only
+    where its map fails: the table is exercised directly)."""
+    rate = 4.0 * np.asarray(q, dtype=float) / (math.pi * radius**3)
+    return 2.0 * flow_table(law).wall_stress(law, rate) / radius
+
+
 def test_a_fluid_whose_parameters_differ_gets_its_own_table():
-    """Two fluids of one class with different parameters, in either order: each its own G, to TOL
-    against its mpmath reference, the same bits in both orders; an equal fluid shares a table."""
+    """Two fluids of one class with different parameters, in either order: each its own G from its
+    flow table, to TOL against its mpmath reference, the same bits in both orders; an equal fluid
+    shares a table."""
     radius = 1e-3
     rates = np.geomspace(1e-3, 1e5, 9)
     laws = [CarreauLike(), CarreauLike(eta0=0.56, lam=0.5, index=0.7)]
@@ -598,14 +610,14 @@ def test_a_fluid_whose_parameters_differ_gets_its_own_table():
         tubefsi.cache_clear()
         for i in order:
             tw, gamma = refs[i]
-            g = laws[i].pressure_gradient(0.25 * math.pi * radius**3 * gamma, radius)
+            g = _tabulated_gradient(laws[i], 0.25 * math.pi * radius**3 * gamma, radius)
             assert np.all(rel(0.5 * g * radius, tw) <= allowed(tw, gamma))
             if i in answers:
                 assert np.array_equal(g, answers[i])
             answers[i] = g
         assert tubefsi.cache_info().size == 2
     assert not np.array_equal(answers[0], answers[1])
-    CarreauLike().pressure_gradient(1e-9, radius)                # equal to laws[0]: its table
+    _tabulated_gradient(CarreauLike(), 1e-9, radius)            # equal to laws[0]: its table
     assert tubefsi.cache_info().size == 2
 
 

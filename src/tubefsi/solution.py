@@ -323,6 +323,27 @@ class Solution:
         big_r = self._undeformed(z) * (1.0 + strain)
         return self._out(0.5 * self.rheology.pressure_gradient(q, big_r) * big_r, z)
 
+    def plug_radius(self, z: float | ArrayLike) -> float | np.ndarray:
+        r"""Radius of the unyielded plug :math:`r_p(z)` (m) of a yield-stress fluid at axial position
+        ``z``: where the shear stress :math:`\tau(r) = \tau_w r/R` stays below the yield stress
+        :math:`\tau_y` the fluid moves rigidly, so
+
+        .. math::
+
+            r_p(z) = \min\Bigl(R(z), \frac{\tau_y}{\tau_w(z)}R(z)\Bigr) = \min\Bigl(R(z), \frac{2\tau_y}{G(z)}\Bigr),
+
+        the whole section (:math:`R`) where the fluid is at rest, and 0 for a fluid without a yield
+        stress (``docs/results.md``, section "Fields along the tube")."""
+        strain, _, q = self._profile(z)
+        big_r = self._undeformed(z) * (1.0 + strain)
+        tau_y = np.asarray(self.rheology.yield_stress, dtype=float)
+        if not np.any(tau_y > 0):
+            return self._out(np.zeros(np.shape(big_r)) + 0.0 * big_r, z)
+        g = self.rheology.pressure_gradient(q, big_r)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            plug = np.where(g > 0, np.minimum(big_r, 2.0 * tau_y / np.where(g > 0, g, 1.0)), big_r)
+        return self._out(np.where(tau_y > 0, plug, 0.0) + 0.0 * big_r, z)
+
     def velocity(self, r: float | ArrayLike, z: float | ArrayLike) -> float | np.ndarray:
         """Axial velocity v(r, z) (m/s) at radial position ``r`` in [0, R(z)] (m)."""
         r_arr = as_array("r", r, "[0, R(z)] (m)", lambda a: a >= 0)

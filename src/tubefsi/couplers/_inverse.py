@@ -27,17 +27,19 @@ import numpy as np
 
 from .._lazy import lazy_module
 from ..errors import ConvergenceError, InvalidParameterError, NoSteadyStateError, StretchRangeError
-from ..numerics.kernels import EPS, rows_dot
+from ..fields import _array_fields, _replace
+from ..numerics.kernels import EPS, blocked_matmul, rows_dot
 from ..numerics.quadrature import Integral, warn_unconverged
 from ..numerics.roots import solve_increasing
-from ..numerics.spectral import CHEBYSHEV_DEGREE, solve_integral
+from ..numerics.spectral import CHEBYSHEV_DEGREE, lobatto_rule, solve_integral
 from ..rheology import flow_map
 
 optimize = lazy_module("scipy.optimize", globals(), "optimize")
 elementwise = lazy_module("scipy.optimize.elementwise", globals(), "elementwise")
 
 __all__ = ["MAX_LOG_STRETCH", "newton", "one_batch", "inlet_log_stretch", "solve_flow_rate", "j_infinity",
-           "beyond_limit", "clearly_beyond", "max_flow_rate", "classify_runaway", "log_stretch_cap"]
+           "beyond_limit", "clearly_beyond", "max_flow_rate", "classify_runaway", "log_stretch_cap",
+           "one_batch_mapped", "solve_flow_rate_mapped"]
 
 #: Largest inlet stretch (relative to the outlet) a solve may reach: ln(1e15). Not a physical
 #: limit (``max_flow_rate`` is the one limit): beyond it ``StretchRangeError``.
@@ -532,10 +534,20 @@ def solve_flow_rate(engine, scene, v, dp, index):
     v = np.asarray(v, dtype=float)
     dp = np.asarray(dp, dtype=float)
     g = np.where(dp == 0, 1.0, dp) / L
-    q_lo = rheo._flow_rate(a * pts.outlet_stretch + 0.0 * g, g)
-    q_hi = rheo._flow_rate(a * engine.stretch_at(pts, v), g)
+    if flow_map.kind(rheo) == "stress" and any(np.ndim(getattr(rheo, f)) for f in _array_fields(type(rheo))):
+        # fluids given by their stress, one per point: the inlet's rigid tube bounds q from above
+        # through its wall shear rate (Gamma <= 4 gamma_w / 3, the rate bracketed by bisection of
+        # the law), and the search runs down from there (the law's generic inverse takes one fluid)
+        r_in = a * engine.stretch_at(pts, v) + 0.0 * g
+        _, x_in = flow_map.log_rate_bracket(rheo, 0.5 * g * r_in)
+        with np.errstate(over="ignore"):
+            q_hi = (math.pi / 3.0) * r_in**3 * np.exp(x_in)
+        q_lo = np.zeros(q_hi.shape)
+    else:
+        q_lo = rheo._flow_rate(a * pts.outlet_stretch + 0.0 * g, g)
+        q_hi = rheo._flow_rate(a * engine.stretch_at(pts, v), g)
     flowing = (q_hi > 0) & (dp > 0)
-    if scene.rheology.yield_stress > 0 and np.any(flowing):
+    if np.any(np.asarray(scene.rheology.yield_stress) > 0) and np.any(flowing):
         sel = np.flatnonzero(flowing)
         flowing[sel] = engine._J(scene, v[sel], index[sel], np.zeros(sel.size)).value > _pick(L + 0.0 * v, sel)
     q = np.zeros(v.shape)
@@ -607,30 +619,233 @@ def one_batch_mapped(engine, scene, target, index, q, bound):
         top = np.minimum(1.5 * target * 2.0 * rough / (radius_out * slope0), bound)
     top = np.where(np.isfinite(top) & (top > 0), top, 0.0)
     live = live[top[live] > 0]
+    rtol = max(engine._RTOL, _MAPPED_RTOL)
+    split = np.zeros(0, dtype=int)              # (tail missed at the top degree: solved in pieces)
     for degree in _MAPPED_DEGREES:
         if live.size == 0:
             break
-        ids = index[live]
-        sub = scene.at(ids)
-        fmap = flow_map.flow_map(sub.rheology, y_out[live] - 3.0 * top[live] - 1e-9, y_out[live] + 1e-9)
-        vouched = np.ones(live.size, dtype=bool)
-        y0, a = y_out[live], sub.radius * sub.outlet_stretch
-
-        def f(u, i):
-            tau, ok, _ = fmap.wall_stress(y0 - 3.0 * u)
-            vouched[:] &= np.all(ok, axis=0)
-            return engine._slope(sub, u) * (a * np.exp(u)) / (2.0 * tau)
-
+        f, vouched = _mapped_integrand(engine, scene, index[live], y_out[live], top[live])
         with np.errstate(all="ignore"):
-            x, good, short = solve_integral(f, target[live], top[live], rtol=max(engine._RTOL, _MAPPED_RTOL),
-                                            degree=degree)
+            x, good, short = solve_integral(f, target[live], top[live], rtol=rtol, degree=degree)
         good &= vouched
         v[live[good]] = x[good]
         solved[live[good]] = True
-        # short: three times the interval; a tail that missed: the next degree on the same one
+        # short: three times the interval; a tail that missed: the next degree on the same one, or
+        # (at the top degree already) the interval in pieces
         again = short & vouched
         wider = np.minimum(3.0 * top[live[again]], bound[live[again]])
         keep = wider > top[live[again]]
         top[live[again]] = wider
-        live = np.sort(np.concatenate([live[again][keep], live[~good & ~short & vouched]]))
+        missed = live[~good & ~short & vouched]
+        if degree == _MAPPED_DEGREES[-1]:
+            split = np.concatenate([split, missed])
+            missed = missed[:0]
+        live = np.sort(np.concatenate([live[again][keep], missed]))
+    for pieces in _MAPPED_PIECES:
+        if split.size == 0:
+            break
+        f, vouched = _mapped_integrand(engine, scene, index[split], y_out[split], top[split])
+        with np.errstate(all="ignore"):
+            x, good = _solve_in_pieces(f, target[split], top[split], pieces, _MAPPED_DEGREES[-1], rtol)
+        good &= vouched
+        v[split[good]] = x[good]
+        solved[split[good]] = True
+        split = split[~good & vouched]
     return v, solved
+
+
+#: A point whose interpolant's tail misses at the top degree is solved on its interval cut into this
+#: many equal pieces, in turn (:func:`_solve_in_pieces`).
+_MAPPED_PIECES = (2, 4)
+
+
+def _mapped_integrand(engine, scene, ids, y_out, top):
+    """``(f, vouched)``: the separated integrand of the points ``ids`` (a non-separable fluid, at their
+    flow rates: ``y_out`` is ln Gamma at the outlet) from a flow map built over ``[0, top]`` of each,
+    and whether the map vouched for every value ``f`` gave (updated by each call)."""
+    sub = scene.at(ids)
+    fmap = flow_map.flow_map(sub.rheology, y_out - 3.0 * top - 1e-9, y_out + 1e-9)
+    vouched = np.ones(ids.size, dtype=bool)
+    a = sub.radius * sub.outlet_stretch
+
+    def f(u, i):
+        tau, ok, _ = fmap.wall_stress(y_out - 3.0 * u)
+        vouched[:] &= np.all(ok, axis=0)
+        return engine._slope(sub, u) * (a * np.exp(u)) / (2.0 * tau)
+
+    return f, vouched
+
+
+def _solve_in_pieces(f, target, upper, pieces, degree, rtol):
+    r"""``(x, solved)``: :math:`\int_0^x f = T` on ``[0, X]`` cut into ``pieces`` equal pieces, each
+    interpolated on its own Chebyshev–Lobatto nodes (``f`` is asked for every point of the batch on
+    each piece). The integral of each piece is its interpolant's (Clenshaw–Curtis); the root lies in
+    the first piece where their running sum reaches :math:`T`, and is solved there
+    (:func:`~tubefsi.numerics.spectral.solve_integral` on that piece's values, with the target less
+    the pieces below). Accepted where the tails of the pieces up to it sum to at most
+    ``rtol`` :math:`T` and every value is positive and finite."""
+    rule = lobatto_rule(degree)
+    n = target.size
+    width = upper / pieces
+    weights = rule.matrix[rule.cumulative][-1]                   # the integral over [-1, 1]
+    below = np.zeros(n)                                           # the pieces' integrals below the root's
+    tails = np.zeros(n)
+    x, solved = np.zeros(n), np.zeros(n, dtype=bool)
+    pending = np.ones(n, dtype=bool)
+    for k in range(pieces):
+        start = k * width
+        values = f(start + rule.nodes[:, None] * width, np.arange(n))
+        coef = blocked_matmul(rule.matrix[rule.coef], values)
+        tails += np.abs(coef[-3:]).sum(axis=0) * width
+        whole = 0.5 * width * (weights @ values)
+        positive = np.all(np.isfinite(values) & (values > 0), axis=0)
+        here = pending & positive & ((below + whole >= target) | (k == pieces - 1))
+        pending &= positive
+        if np.any(here):
+            sel = np.flatnonzero(here)
+            local, good, _ = solve_integral(None, target[sel] - below[sel], width[sel], rtol=np.inf,
+                                            values=values[:, sel], degree=degree)
+            ok = good & (tails[sel] <= rtol * target[sel])
+            x[sel[ok]] = start[sel[ok]] + local[ok]
+            solved[sel[ok]] = True
+            pending[sel] = False
+        below += whole
+    return x, solved
+
+
+#: The degrees :func:`solve_flow_rate_mapped` tries, in turn, on the interval [0, v].
+_FLOW_DEGREES = (24, 48)
+#: Its Newton iteration in ln q: at most this many steps, the last one below ``_FLOW_STEP``.
+_FLOW_ITERATIONS, _FLOW_STEP = 40, 1e-9
+#: The width (in ln of the wall shear rate) of the bisection that bounds the rigid tubes' rates.
+_BRACKET_WIDTH = 0.05
+
+
+def _twice(model, n):
+    """``model`` with its array parameters (one per point, ``n``) repeated for two sets of points."""
+    arrays = {f: np.broadcast_to(v, (n,)) for f in _array_fields(type(model)) if np.ndim(v := getattr(model, f))}
+    return _replace(model, {f: np.concatenate([v, v]) for f, v in arrays.items()}) if arrays else model
+
+
+#: Where the outlet alone would not yield a yield-stress fluid, the search starts this far below the
+#: inlet's bound in ln q (a flow rate e^-60 of it: below that, the adaptive route decides).
+_UNYIELDED_REACH = 60.0
+
+
+def solve_flow_rate_mapped(engine, scene, v, dp, index):
+    r"""``(q, solved)``: the flow rate of a non-separable fluid at a given inlet log-stretch ``v``
+    (the pressure-controlled problem), from the flow map of its law, for every point at once.
+
+    With :math:`v` known the separated identity is :math:`H(q) = \int_0^v c(u)/\tau_w(\Gamma(q, u))\,du
+    = L`, :math:`c = sP'(s)\,a s/2` (the wall's part, fixed) and
+    :math:`\ln\Gamma = \ln(4q/\pi) - 3\ln(a\lambda_{out}) - 3u`. On the Chebyshev–Lobatto nodes of
+    :math:`[0, v]` the map (:mod:`~tubefsi.rheology.flow_map`, built once over the range of
+    :math:`\ln\Gamma` that the bracket of :func:`solve_flow_rate` spans) gives :math:`\tau_w`, and
+    Newton's method on :math:`\ln H(\ln q) = \ln L` uses
+    :math:`dH/d\ln q = -\int_0^v (c/\tau_w)\,k\,du`, :math:`k = d\ln\tau_w/d\ln\Gamma =
+    \Gamma/(4\dot\gamma_w - 3\Gamma)` (the Rabinowitsch–Mooney identity), kept inside the
+    bracket (bisection where a step leaves it); a step below 1e-9 is the last (quadratic: the
+    answer is 1e-18 from the root after it). A point is solved only where the map vouches for
+    every node and the tail of the interpolant of the integrand at that last evaluation (1e-9 from
+    the answer) meets the tolerance, :math:`v\sum_{k=n-2}^n|c_k| \le 5\cdot10^{-14} L`; the others are left to
+    :func:`solve_flow_rate`. A yield-stress fluid that the pressure drop cannot yield all along
+    the tube (:math:`H(0^+) \le L`, :math:`\tau_w = \tau_y` at every node) has ``q = 0``."""
+    v = np.asarray(v, dtype=float).ravel()
+    dp = np.asarray(dp, dtype=float).ravel()
+    index = np.asarray(index).ravel()
+    n = v.size
+    q = np.zeros(n)
+    solved = np.zeros(n, dtype=bool)
+    if flow_map.kind(scene.rheology) is None or engine._coarse or n == 0:
+        return q, solved
+    pts = scene.at(index)
+    if pts.wall._slope_kinks(pts.tb):          # (a kinked tube law: the adaptive route splits it)
+        return q, solved
+    a, L, rheo = pts.radius, pts.length, pts.rheology
+    a_out = a * pts.outlet_stretch + np.zeros(n)
+    length = np.asarray(L, dtype=float) + np.zeros(n)
+    tau_y = np.asarray(rheo.yield_stress, dtype=float) + np.zeros(n)
+    log_shift = math.log(4.0 / math.pi) - 3.0 * np.log(a_out)       # ln Gamma at u = 0 is ln q + this
+    a_in = a * engine.stretch_at(pts, v) + np.zeros(n)
+    g = np.where(dp > 0, dp, 1.0) / length
+    stress_law = flow_map.kind(scene.rheology) == "stress"
+    # the bracket in ln q: rigid tubes of the outlet's and the inlet's radii under the mean gradient
+    with np.errstate(all="ignore"):
+        if stress_law:
+            # (in the law's own variable: x_out below the outlet's wall shear rate starts the map,
+            # Gamma <= 4 gamma_w / 3 bounds the inlet's from above; the map's bottom gives lo)
+            lower, upper = flow_map.log_rate_bracket(_twice(rheo, n), np.concatenate([0.5 * g * a_out, 0.5 * g * a_in]),
+                                                     width=_BRACKET_WIDTH)
+            x_out, x_in = lower[:n], upper[n:]
+            hi = x_in + math.log(4.0 / 3.0) - log_shift + 3.0 * v          # (ln Gamma_in = ln q + shift - 3 v)
+            lo = np.full(n, -np.inf)
+        else:
+            lo = np.log(np.asarray(rheo._flow_rate(a_out, g), dtype=float) + np.zeros(n))
+            hi = np.log(np.asarray(rheo._flow_rate(a_in, g), dtype=float) + np.zeros(n))
+            unyielded = np.isfinite(hi) & ~np.isfinite(lo) & (tau_y > 0)
+            lo = np.where(unyielded, hi - _UNYIELDED_REACH, lo)     # (the outlet alone would not yield)
+        lo, hi = lo - 1e-12 * (1.0 + np.abs(lo)), hi + 1e-12 * (1.0 + np.abs(hi))
+    live = np.flatnonzero((dp > 0) & (v > 0) & np.isfinite(hi) & (hi > lo) & (np.isfinite(lo) | stress_law))
+    for degree in _FLOW_DEGREES:
+        if live.size == 0:
+            break
+        rule = lobatto_rule(degree)
+        weights = rule.matrix[rule.cumulative][-1] * 0.5              # Clenshaw-Curtis on [0, 1]
+        if np.any(tau_y[live] > 0):
+            # a yield-stress fluid: H(0+), tau_w = tau_y at every node; q = 0 where it does not exceed L
+            u = rule.nodes[:, None] * v[live]
+            with np.errstate(all="ignore"):
+                wall = engine._slope(scene.at(index[live]), u) * (a_out[live] * np.exp(u)) * 0.5
+                h0 = v[live] * (weights @ (wall / tau_y[live]))
+            rest = (tau_y[live] > 0) & ~(h0 > length[live])
+            solved[live[rest]] = True
+            live = live[~rest]
+            if live.size == 0:
+                break
+        sub = scene.at(index[live])
+        vv = v[live]
+        u = rule.nodes[:, None] * vv                                  # (nodes, P)
+        with np.errstate(all="ignore"):
+            wall = engine._slope(sub, u) * (a_out[live] * np.exp(u)) * 0.5
+        s_lo, s_hi, shift, log_l = lo[live], hi[live], log_shift[live], np.log(length[live])
+        if stress_law:
+            fmap = flow_map.flow_map(sub.rheology, None, s_hi + shift, x_lo=x_out[live] - 3.0 * vv - 1.0)
+            s_lo = fmap.y_nodes[0, 0] + 3.0 * vv - shift + 1e-12 * (1.0 + np.abs(s_hi))
+        else:
+            fmap = flow_map.flow_map(sub.rheology, s_lo + shift - 3.0 * vv - 1e-9, s_hi + shift + 1e-9)
+        s = 0.5 * (s_lo + s_hi)
+        moving = np.ones(live.size, dtype=bool)
+        # the integrand values of each point's last evaluation, 1e-9 from its answer at most: its
+        # interpolant's tail is the answer's check (no evaluation more)
+        last = np.full(u.shape, np.nan)
+        with np.errstate(all="ignore"):
+            for _ in range(_FLOW_ITERATIONS):
+                y = s + shift - 3.0 * u
+                tau, ok, x = fmap.wall_stress(y)
+                vouched = np.all(ok, axis=0)
+                f = wall / tau
+                h = vv * (weights @ f)
+                k = 1.0 / (4.0 * fmap.wall_rate(tau, x) / np.exp(y) - 3.0)
+                dh = -vv * (weights @ (f * k))
+                residual = np.log(h) - log_l
+                # the bracket: H decreases with q
+                s_lo = np.where(moving & (residual > 0), s, s_lo)
+                s_hi = np.where(moving & (residual < 0), s, s_hi)
+                step = residual / (dh / h)
+                nxt = s - step
+                # a step below _FLOW_STEP is the last (quadratic: its error is ~1e-18 after it)
+                done = np.abs(step) <= _FLOW_STEP
+                outside = ~done & (~np.isfinite(nxt) | (nxt <= s_lo) | (nxt >= s_hi))
+                nxt = np.where(outside, 0.5 * (s_lo + s_hi), np.clip(nxt, s_lo, s_hi))
+                last[:, moving] = np.where(vouched, f, np.nan)[:, moving]
+                s = np.where(moving & vouched, nxt, s)
+                moving &= vouched & ~done
+                if not np.any(moving):
+                    break
+            coef = blocked_matmul(rule.matrix[rule.coef], np.where(np.isfinite(last), last, 0.0))
+            tail = vv * np.abs(coef[-3:]).sum(axis=0)
+            good = ~moving & np.all(np.isfinite(last) & (last > 0), axis=0) & (tail <= _MAPPED_RTOL * length[live])
+        q[live[good]] = np.exp(s[good])
+        solved[live[good]] = True
+        live = live[~good]
+    return q, solved

@@ -133,3 +133,13 @@ class Quadrature(SeparatedVariables):
             v[rest], ok[rest], part = super()._solve_J(scene, target[rest], index[rest], qq, up)
             final = final.replaced(rest, part)
         return v, ok, final
+
+    def _flow_rate_at(self, scene, v, dp, index):
+        """The flow rates of a non-separable fluid at the inlet log-stretches ``v``: from the flow map
+        of its law (:func:`tubefsi.couplers._inverse.solve_flow_rate_mapped`, every point at once),
+        the bracketed search of the engine for the points it cannot vouch for."""
+        q, solved = _inverse.solve_flow_rate_mapped(self, scene, v, dp, index)
+        rest = np.flatnonzero(~solved)
+        if rest.size:
+            q[rest] = super()._flow_rate_at(scene, np.asarray(v)[rest], np.asarray(dp)[rest], np.asarray(index)[rest])
+        return q

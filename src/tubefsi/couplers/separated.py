@@ -457,8 +457,14 @@ class SeparatedVariables(Coupler):
             if scene.rheology.separable:
                 q[sub] = self._flow_from_log_stretch(scene, v[sub], sub)
             else:
-                q[sub] = _inverse.solve_flow_rate(self, scene, v[sub], dp[sub], sub)
+                q[sub] = self._flow_rate_at(scene, v[sub], dp[sub], sub)
         return State(q, dp, self.strain_at(pts, v) + 0.0 * v, v)
+
+    def _flow_rate_at(self, scene, v, dp, index):
+        r"""The flow rates of a non-separable fluid whose inlet log-stretch is ``v`` (the pressure drop
+        ``dp``): :func:`tubefsi.couplers._inverse.solve_flow_rate` (a bracketed root search in
+        :math:`\ln q` on the coupler's error-controlled :math:`J`)."""
+        return _inverse.solve_flow_rate(self, scene, v, dp, index)
 
     def _flow_from_log_stretch(self, scene, v, index):
         """The flow rates whose inlet log-stretch is ``v`` (separable): :math:`\\phi^{-1}(J(v)/L)`."""

@@ -64,8 +64,9 @@ class Rheology(abc.ABC):
     ``_apparent_shear_rate``         ``(wall_stress, excess=None)``: :math:`\Gamma = 4q/(\pi R^3)` by the
                                      Rabinowitsch–Mooney integral (error-controlled adaptive quadrature)
     ``_flow_rate``                   ``(radius, pressure_gradient)``: :math:`\pi R^3\Gamma(GR/2)/4`
-    ``_pressure_gradient``           ``(flow_rate, radius)``: the inverse, from a cached, error-checked
-                                     table of :math:`\ln(\tau_w - \tau_y)` against :math:`\ln\Gamma`
+    ``_pressure_gradient``           ``(flow_rate, radius)``: the inverse, from the flow map built for
+                                     the call (:mod:`~tubefsi.rheology.flow_map`), else a cached,
+                                     error-checked table of :math:`\ln(\tau_w - \tau_y)` against :math:`\ln\Gamma`
     ``_velocity``                    ``(r, radius, pressure_gradient)``:
                                      :math:`\int_r^R \dot\gamma(G\rho/2)\,d\rho` by adaptive quadrature
     ``_flow_index``                  ``(flow_rate, radius)``: :math:`\partial\ln G/\partial\ln q`, from the
@@ -176,6 +177,22 @@ class Rheology(abc.ABC):
         if not _overrides(self, "_stress"):
             raise TypeError(f"{type(self).__name__} must implement _stress or _shear_rate")
         t = np.asarray(stress, dtype=float)
+        if _holds_arrays(self):
+            # fluids given as arrays, one per point (broadcast against the stresses): each point's
+            # root with its own parameters (the iteration asks for subsets of the points)
+            shape = np.broadcast_shapes(t.shape, *(np.shape(getattr(self, n)) for n in _array_fields(type(self))))
+            flat = broadcast_model(self, shape)
+            tf = np.broadcast_to(t, shape).ravel()
+            tau_y = np.broadcast_to(np.asarray(self.yield_stress, dtype=float), shape).ravel()
+            live = np.flatnonzero(tf > tau_y)
+            out = np.zeros(tf.size)
+            if live.size:
+                sub = model_at(flat, live)
+                scale = np.asarray(sub._stress(np.ones(live.size)), dtype=float) - tau_y[live]
+                guess = np.where(scale > 0, (tf[live] - tau_y[live]) / np.where(scale > 0, scale, 1.0), tf[live])
+                out[live] = _solve_increasing(sub._stress, tf[live], guess, tau_y[live],
+                                              law_at=lambda idx: model_at(sub, idx)._stress)
+            return out.reshape(shape)
         tau_y = float(self.yield_stress)
         flowing = t > tau_y
         out = np.zeros(t.shape)
@@ -244,9 +261,9 @@ class Rheology(abc.ABC):
         else:
             rate = q / rate
         rate *= 4.0 / math.pi
-        if _holds_arrays(self):     # many fluids at once: each point's wall stress from the flow map
+        if _holds_arrays(self) or flow_map.kind(self) is not None:    # the flow map, per call
             out = _mapped_wall_stress(self, rate)
-        else:
+        else:                       # a law the maps do not serve: its flow table
             out = flow_table(self).wall_stress(self, rate)
         out *= 2.0
         out /= r
@@ -362,9 +379,10 @@ def _holds_arrays(model) -> bool:
 
 
 def _mapped_wall_stress(model, rate):
-    r""":math:`\tau_w` at the apparent rates ``rate`` of a fluid with array parameters (broadcast
-    against ``rate``): from :func:`~tubefsi.rheology.flow_map.wall_stress` where it vouches for a
-    point, else from the flow table of that point's parameter set (no table is shared between sets)."""
+    r""":math:`\tau_w` at the apparent rates ``rate`` of a fluid (its array parameters broadcast
+    against ``rate``): from :func:`~tubefsi.rheology.flow_map.wall_stress`, built for the call,
+    where it vouches for a point, else from the flow table of that point's parameter set (no table
+    is shared between sets; a fluid the maps serve gets one only where its map fails)."""
     tau, ok = flow_map.wall_stress(model, rate) if flow_map.kind(model) is not None else (None, None)
     shape = np.broadcast_shapes(np.shape(rate), *(np.shape(getattr(model, n)) for n in _array_fields(type(model))))
     if tau is None:
@@ -418,7 +436,7 @@ def _positive(x):
     return np.maximum(x, np.finfo(float).tiny)
 
 
-def _solve_increasing(law, target, guess, floor, lower=0.0, name="stress"):
+def _solve_increasing(law, target, guess, floor, lower=0.0, name="stress", law_at=None):
     r"""``x > lower`` with ``law(x) = target`` elementwise, for an increasing law with
     ``law(lower+) = floor < target``: a bracket by steps doubling in :math:`\ln(x - lower)` from
     ``guess``, geometric bisection down to a ratio of 2, then Illinois (regula falsi) steps to a
@@ -432,8 +450,9 @@ def _solve_increasing(law, target, guess, floor, lower=0.0, name="stress"):
     big, tiny = 1e300, 1e-300
 
     def f(x, idx=None):
+        fn = law if idx is None or law_at is None else law_at(idx)     # (a law of one fluid per point)
         with np.errstate(over="ignore", invalid="ignore"):
-            v = np.asarray(law(lower + x), dtype=float) - (t if idx is None else t[idx])
+            v = np.asarray(fn(lower + x), dtype=float) - (t if idx is None else t[idx])
         return np.where(np.isnan(v), np.inf, v)
 
     d = np.clip(np.broadcast_to(np.asarray(guess, dtype=float), shape).ravel() - lower, tiny, big)

@@ -39,7 +39,7 @@ from ..numerics.kernels import blocked_matmul
 from ..numerics.quadrature import unit_integral
 from ..numerics.spectral import clenshaw, lobatto_rule
 
-__all__ = ["kind", "ClosedMap", "PanelMap", "flow_map", "wall_stress"]
+__all__ = ["kind", "ClosedMap", "PanelMap", "flow_map", "wall_stress", "log_rate_bracket"]
 
 _EPS = float(np.finfo(float).eps)
 #: Degree and width (in ln of the wall shear rate) of a panel of :class:`PanelMap`.
@@ -49,6 +49,9 @@ MAX_PANELS = 24
 #: Tolerance of a map, in ln Gamma (so in ln tau_w: the flow index, <= 1 for these fluids, times it),
 #: above the rounding of ln Gamma's own values.
 TOL = 1e-14
+#: :meth:`PanelMap.wall_stress` answers at most this many values at once (its gathers hold ~75
+#: arrays of their size: memory bounded whatever the call).
+_CHUNK = 4096
 #: Newton iterations of :class:`ClosedMap` (steps clipped to 3 in ln(tau_w - tau_y)).
 _NEWTON = 60
 
@@ -162,27 +165,37 @@ class ClosedMap:
         tau, ok = tau_flat.reshape(y.shape), ok_flat.reshape(y.shape)
         return tau, ok, x_flat.reshape(y.shape)
 
+    def wall_rate(self, tau, x):
+        """The wall shear rate at the wall stresses ``tau`` that :meth:`wall_stress` gave (shape
+        ``(..., P)``): the law's own shear rate there."""
+        tau = np.asarray(tau, dtype=float)
+        with np.errstate(all="ignore"):       # (the law's parameters: one per point, the last axis)
+            return np.asarray(self.rheology._shear_rate(np.maximum(tau, np.finfo(float).tiny)), dtype=float) + 0.0 * tau
+
 
 class PanelMap:
     r""":math:`y(x)` on unit panels in :math:`x = \ln\dot\gamma_w` covering :math:`[y_{lo}, y_{hi}]`
     per point (module docstring); :meth:`wall_stress` inverts it."""
 
-    def __init__(self, rheology, y_lo, y_hi):
+    def __init__(self, rheology, y_lo, y_hi, x_lo=None):
         self.rheology = rheology
         y_lo, y_hi = np.asarray(y_lo, dtype=float), np.asarray(y_hi, dtype=float)
-        n = y_lo.size
+        n = y_hi.size
         rule = lobatto_rule(DEGREE)
         self.rule = rule
-        # gamma_w >= 3 Gamma / 4 for an increasing law (K >= 0): x(y_lo) >= y_lo + ln(3/4)
-        self.x0 = y_lo + math.log(0.75) - 0.01
+        # gamma_w >= 3 Gamma / 4 for an increasing law (K >= 0): x(y_lo) >= y_lo + ln(3/4); or the
+        # caller's start in x (the map then covers what lies above it)
+        self.x0 = y_lo + math.log(0.75) - 0.01 if x_lo is None else np.asarray(x_lo, dtype=float) + np.zeros(n)
+        if x_lo is not None:
+            y_lo = np.full(n, -np.inf)
         # Chebyshev coefficients of y per panel ([:, 0]) and of its derivative ([:, 1], the top one zero),
         # stacked for one Clenshaw pass of both
         self.pair = np.full((DEGREE + 1, 2, MAX_PANELS, n), np.nan)
         self.pair[-1, 1] = 0.0
-        y_maps, k_maps = _y_maps(DEGREE), _k_maps(DEGREE)
-        terms = slice(rule.matrix.shape[0], None)                 # the rows of k_maps beyond rule.matrix
+        # each panel's y at its middle node apart: the interpolant holds y's variation over the panel
+        self.offset = np.full((MAX_PANELS, n), np.nan)
         self.y_nodes = np.full((DEGREE + 1, MAX_PANELS, n), np.nan)
-        self.ok = np.isfinite(y_lo) & np.isfinite(y_hi)
+        self.ok = np.isfinite(self.x0) & np.isfinite(y_hi)
         self.panels = np.zeros(n, dtype=int)
         with np.errstate(all="ignore"):
             g0 = np.exp(self.x0)
@@ -191,55 +204,100 @@ class PanelMap:
             err_k = g0 * base.error + 4.0 * _EPS * np.abs(K)
             self.ok &= np.isfinite(K) & (K > 0)
             live = np.flatnonzero(self.ok)
-            for j in range(MAX_PANELS):
-                if live.size == 0:
-                    break
-                r = _at(rheology, live)
-                x = self.x0[live] + WIDTH * (j + rule.nodes[:, None])
-                g = np.exp(x)
-                tau = self._tau(r, g)
-                cube = tau * tau * tau
-                maps = blocked_matmul(k_maps, cube * g)            # (a point's bits independent of its batch)
-                k_nodes = K[live] + (0.5 * WIDTH) * maps[rule.cumulative]
-                gamma = (4.0 / 3.0) * (g - k_nodes / cube)
-                y = np.log(gamma)
-                c_and_slope = blocked_matmul(y_maps, y)
-                c = c_and_slope[:DEGREE + 1]
-                # K's error at each node: the panel's start's, the tail of the integrand's interpolant
-                # (a tail at the rounding of the values, 32 eps of their largest, is noise), and the
-                # rounding of the node's own sum, a few eps of the terms it adds up (at the panel's
-                # low nodes far below its top: a Newtonian plateau's integrand grows e^4-fold over a
-                # panel, and the top's rounding charged to the bottom node failed such fluids)
-                w_tail = np.abs(maps[rule.coef][-3:]).sum(axis=0)
-                noise = w_tail <= 32.0 * _EPS * np.max(cube * g, axis=0)
-                err_nodes = err_k[live] + np.where(noise, 0.0, (0.5 * WIDTH) * w_tail) + \
-                    2.0 * _EPS * (k_nodes + (0.5 * WIDTH) * maps[terms])
-                err_k[live] = err_nodes[-1]
-                err_y = np.max((4.0 / 3.0) * err_nodes / (cube * gamma), axis=0)
-                tail = np.abs(c[-3:]).sum(axis=0)
-                good = np.all(np.isfinite(y), axis=0) & np.all(np.diff(y, axis=0) > 0, axis=0) & \
-                    np.all(cube > 0, axis=0) & \
-                    (err_y + tail <= TOL + 32.0 * _EPS * np.max(np.abs(y), axis=0))
-                self.pair[:, 0, j, live], self.pair[:-1, 1, j, live] = c, c_and_slope[DEGREE + 1:]
-                self.y_nodes[:, j, live] = y
-                K[live] = k_nodes[-1]
-                self.panels[live] = j + 1
-                self.ok[live[~good]] = False
-                if j == 0:
-                    self.ok[live[y[0] > y_lo[live]]] = False       # (cannot happen for an increasing law)
-                live = live[good & (y[-1] < y_hi[live])]
+            j = 0
+            while live.size and j < MAX_PANELS:
+                # the panels of this step, built in one batch: at least those that y <= x + ln(4/3)
+                # (Gamma <= 4 gamma_w / 3) says most live points need to reach y_hi
+                need = np.ceil((y_hi[live] - math.log(4.0 / 3.0) - self.x0[live]) / WIDTH - j + 1e-9)
+                batch = int(min(MAX_PANELS - j, max(1.0, float(np.sort(need)[(9 * (need.size - 1)) // 10]))))
+                live = self._panels(rheology, live, j, batch, K, err_k, y_lo, y_hi, x_lo is None)
+                j += batch
             self.ok[live] = False                                   # (beyond MAX_PANELS)
+
+    def _panels(self, rheology, live, j0, batch, K, err_k, y_lo, y_hi, check_bottom):
+        """Panels ``j0 .. j0 + batch - 1`` of the points ``live``, their law values in one batch (a
+        point's bits are those of building them one by one); ``K`` and ``err_k`` carried up panel
+        by panel. Returns the points still live after them (every panel good, y_hi not reached)."""
+        rule = self.rule
+        y_maps, k_maps = _y_maps(DEGREE), _k_maps(DEGREE)
+        terms = slice(rule.matrix.shape[0], None)                 # the rows of k_maps beyond rule.matrix
+        p = live.size
+        r = _at(rheology, live)
+        x = self.x0[live] + WIDTH * ((j0 + np.arange(batch))[:, None] + rule.nodes[:, None, None])  # (nodes, batch, P)
+        g = np.exp(x)
+        tau = self._tau(r, g)
+        cube = tau * tau * tau
+        values = cube * g
+        maps = blocked_matmul(k_maps, values.reshape(DEGREE + 1, batch * p)).reshape(-1, batch, p)
+        cumulative = (0.5 * WIDTH) * maps[rule.cumulative]
+        # K's error at each node: the panel's start's, the tail of the integrand's interpolant
+        # (a tail at the rounding of the values, 32 eps of their largest, is noise), and the
+        # rounding of the node's own sum, a few eps of the terms it adds up (at the panel's
+        # low nodes far below its top: a Newtonian plateau's integrand grows e^4-fold over a
+        # panel, and the top's rounding charged to the bottom node failed such fluids)
+        w_tail = np.abs(maps[rule.coef][-3:]).sum(axis=0)
+        noise = w_tail <= 32.0 * _EPS * np.max(values, axis=0)
+        own = np.where(noise, 0.0, (0.5 * WIDTH) * w_tail) + 2.0 * _EPS * ((0.5 * WIDTH) * maps[terms])
+        # K and its error at each panel's start, carried up from the last (the same sums, in the
+        # same order, as panel by panel)
+        k_nodes = np.empty(cumulative.shape)
+        err_nodes = np.empty(cumulative.shape)
+        k_start, e_start = K[live], err_k[live]
+        for b in range(batch):
+            k_nodes[:, b] = k_start + cumulative[:, b]
+            err_nodes[:, b] = e_start + own[:, b] + 2.0 * _EPS * k_nodes[:, b]
+            k_start, e_start = k_nodes[-1, b], err_nodes[-1, b]
+        gamma = (4.0 / 3.0) * (g - k_nodes / cube)
+        y = np.log(gamma)
+        # the interpolant of y's variation from its middle node (the coefficients of y itself,
+        # ~35 where Gamma ~ 1e15, would carry rounding of eps |y| each: 1e-13 at a point)
+        ref = y[DEGREE // 2]
+        c_and_slope = blocked_matmul(y_maps, (y - ref).reshape(DEGREE + 1, batch * p)).reshape(-1, batch, p)
+        c = c_and_slope[:DEGREE + 1]
+        err_y = np.max((4.0 / 3.0) * err_nodes / (cube * gamma), axis=0)
+        tail = np.abs(c[-3:]).sum(axis=0)
+        good = np.all(np.isfinite(y), axis=0) & np.all(np.diff(y, axis=0) > 0, axis=0) & \
+            np.all(cube > 0, axis=0) & (err_y + tail <= TOL + 32.0 * _EPS * np.max(np.abs(y), axis=0))
+        # each point takes its panels in order until one fails or reaches y_hi (as one by one)
+        at = np.arange(p)                                           # positions in live of the live points
+        for b in range(batch):
+            if at.size == 0:
+                break
+            j, pts = j0 + b, live[at]
+            self.pair[:, 0, j, pts], self.pair[:-1, 1, j, pts] = c[:, b, at], c_and_slope[DEGREE + 1:, b, at]
+            self.offset[j, pts] = ref[b, at]
+            self.y_nodes[:, j, pts] = y[:, b, at]
+            K[pts], err_k[pts] = k_nodes[-1, b, at], err_nodes[-1, b, at]
+            self.panels[pts] = j + 1
+            self.ok[pts[~good[b, at]]] = False
+            if j == 0 and check_bottom:
+                self.ok[pts[y[0, b, at] > y_lo[pts]]] = False       # (cannot happen for an increasing law)
+            at = at[good[b, at] & (y[-1, b, at] < y_hi[pts])]
+        return live[at]
+
+    def wall_rate(self, tau, x):
+        """The wall shear rate at the answers of :meth:`wall_stress`: :math:`e^x` (its natural
+        variable)."""
+        return np.exp(x)
 
     @staticmethod
     def _tau(rheo, g):
         return np.asarray(rheo._stress(np.maximum(g, np.finfo(float).tiny)), dtype=float)
 
     def wall_stress(self, y, x=None):
-        """``(tau_w, ok, x)`` at ``y = ln Gamma`` (shape ``(..., P)``, points along the last axis)."""
+        """``(tau_w, ok, x)`` at ``y = ln Gamma`` (shape ``(..., P)``, points along the last axis), in
+        chunks of at most ``_CHUNK`` values (each value's answer is its own: the same bits)."""
         y = np.asarray(y, dtype=float)
-        shape = y.shape
         n = self.x0.size
         y2 = y.reshape(-1, n)
+        rows = max(1, _CHUNK // n)
+        if y2.shape[0] <= rows:
+            return self._wall_stress(y2, y.shape)
+        parts = [self._wall_stress(y2[i:i + rows], y2[i:i + rows].shape) for i in range(0, y2.shape[0], rows)]
+        return tuple(np.concatenate([p[k] for p in parts]).reshape(y.shape) for k in range(3))
+
+    def _wall_stress(self, y2, shape):
+        n = self.x0.size
         cols = np.broadcast_to(np.arange(n), y2.shape)
         # the panel of each target: the count of panels whose top is below it
         tops = self.y_nodes[-1]                                     # (MAX_PANELS, P)
@@ -255,6 +313,7 @@ class PanelMap:
             ta, tb = t_nodes[k - 1], t_nodes[k]
             t = np.where(yb > ya, ta + (tb - ta) * (y2 - ya) / (yb - ya), ta)
             pair = self.pair[:, :, j, cols]                          # (DEGREE + 1, 2, rows, P)
+            y2 = y2 - self.offset[j, cols]                           # (exact within a factor 2: Sterbenz)
             # Newton on the interpolant, quadratic: after a step below 1e-9 the error is ~1e-18 and
             # that point stops (its iterations do not depend on its neighbours')
             moving = inside.copy()
@@ -272,29 +331,71 @@ class PanelMap:
         return tau.reshape(shape), inside.reshape(shape), x.reshape(shape)
 
 
-def flow_map(rheology, y_lo, y_hi):
-    """The map of ``rheology`` (its array parameters one per point, along the last axis) over
-    ``[y_lo, y_hi]`` per point (``y = ln Gamma``), or None where :func:`kind` is None."""
+def flow_map(rheology, y_lo, y_hi, x_lo=None):
+    r"""The map of ``rheology`` (its array parameters one per point, along the last axis) over
+    ``[y_lo, y_hi]`` per point (``y = ln Gamma``), or None where :func:`kind` is None. ``x_lo``
+    (a law given by its stress): start the map's panels there in :math:`\ln\dot\gamma_w` instead
+    (``y_lo`` is then ignored; :class:`ClosedMap` needs no range)."""
     which = kind(rheology)
     if which is None:
         return None
-    y_lo = np.atleast_1d(np.asarray(y_lo, dtype=float))
     y_hi = np.atleast_1d(np.asarray(y_hi, dtype=float))
-    model = _points(rheology, y_lo.size)
-    return ClosedMap(model, y_lo, y_hi) if which == "closed" else PanelMap(model, y_lo, y_hi)
+    y_lo = np.broadcast_to(np.asarray(np.nan if y_lo is None else y_lo, dtype=float), y_hi.shape)
+    model = _points(rheology, y_hi.size)
+    return ClosedMap(model, y_lo, y_hi) if which == "closed" else PanelMap(model, y_lo, y_hi, x_lo)
+
+
+def log_rate_bracket(rheology, stress, width=1e-3):
+    r"""``(x_lo, x_hi)`` with :math:`\tau(e^{x_{lo}}) \le` ``stress`` :math:`\le \tau(e^{x_{hi}})`,
+    :math:`x_{hi} - x_{lo} \le` ``width``, per point (a law given by its stress, increasing; its
+    array parameters one per point): bisection in :math:`x = \ln\dot\gamma` over the doubles'
+    range. A bracket, not a root: for the start of a map."""
+    t = np.atleast_1d(np.asarray(stress, dtype=float))
+    rheology = _points(rheology, t.size)
+    lo, hi = np.full(t.shape, math.log(np.finfo(float).tiny)), np.full(t.shape, math.log(np.finfo(float).max) - 1.0)
+    with np.errstate(all="ignore"):
+        while np.any(hi - lo > width):
+            mid = 0.5 * (lo + hi)
+            below = np.asarray(rheology._stress(np.exp(mid)), dtype=float) + 0.0 * t <= t
+            lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
+    return lo, hi
+
+
+#: A fluid of scalar parameters is served by one map over the range of the apparent rates asked
+#: for where that range spans at most this much of ln Gamma (a map covers e^24 of the wall shear rate).
+_ONE_MAP_RANGE = 16.0
 
 
 def wall_stress(rheology, apparent_rate):
     r""":math:`\tau_w` at each apparent wall shear rate (any shape; the fluid's array parameters
-    broadcast against it), each point on its own; ``(tau_w, ok)``."""
+    broadcast against it), each point on its own; ``(tau_w, ok)``. At a zero rate, the limit
+    :math:`\Gamma \to 0^+`: :math:`\tau_w = \tau_y` (0 without a yield stress).
+
+    A fluid of scalar parameters (one fluid, many rates) is served by *one* map spanning the
+    rates' range (where it spans at most ``_ONE_MAP_RANGE`` in :math:`\ln\Gamma`); a fluid with
+    array parameters by a map per point. Either way each value is the map's inverse at that rate,
+    checked as the map checks it; the one map's panels start at the lowest rate asked, so a value's
+    last bits (not its accuracy) depend on the range of the call."""
     rate = np.asarray(apparent_rate, dtype=float)
     arrays = [getattr(rheology, n) for n in _array_fields(type(rheology))]
     shape = np.broadcast_shapes(rate.shape, *(np.shape(a) for a in arrays))
     flat_rate = np.broadcast_to(rate, shape).ravel()
-    model = _replace(rheology, {n: np.broadcast_to(getattr(rheology, n), shape).ravel()
-                                for n in _array_fields(type(rheology)) if isinstance(getattr(rheology, n), np.ndarray)})
-    with np.errstate(divide="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore"):
         y = np.log(flat_rate)
-    m = flow_map(model, y, y)
-    tau, ok, _ = m.wall_stress(y[None])
-    return tau[0].reshape(shape), ok[0].reshape(shape)
+    one = not any(np.ndim(a) for a in arrays)
+    finite = np.isfinite(y)
+    if one and np.any(finite) and float(np.ptp(y[finite])) <= _ONE_MAP_RANGE:
+        m = flow_map(rheology, [float(np.min(y[finite]))], [float(np.max(y[finite]))])
+        tau, ok, _ = m.wall_stress(y[:, None])
+        tau, ok = tau[:, 0], ok[:, 0]
+    else:
+        model = _replace(rheology, {n: np.broadcast_to(getattr(rheology, n), shape).ravel()
+                                    for n in _array_fields(type(rheology)) if isinstance(getattr(rheology, n), np.ndarray)})
+        m = flow_map(model, y, y)
+        tau, ok, _ = m.wall_stress(y[None])
+        tau, ok = tau[0], ok[0]
+    zero = flat_rate == 0.0
+    if np.any(zero):
+        tau_y = np.broadcast_to(np.asarray(rheology.yield_stress, dtype=float), shape).ravel()
+        tau, ok = np.where(zero, tau_y, tau), ok | zero
+    return tau.reshape(shape), ok.reshape(shape)

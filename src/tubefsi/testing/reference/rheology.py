@@ -47,7 +47,8 @@ from mpmath import mp, mpf
 
 from .quadrature import gauss_legendre, gauss_legendre_rule, geometric_breaks
 
-__all__ = ["CarreauYasudaRef", "RateLawRef", "solve_flow_controlled", "yield_pressure_drop", "velocity"]
+__all__ = ["CarreauYasudaRef", "RateLawRef", "section", "solve_flow_controlled", "solve_pressure_controlled",
+           "yield_pressure_drop", "velocity"]
 
 
 class CarreauYasudaRef:
@@ -141,44 +142,100 @@ class RateLawRef(CarreauYasudaRef):
         return (4 * self.rate(x) - 3 * gam) / (x * gam)
 
 
-def solve_flow_controlled(fluid, wall, radius, length, q, stretch_guess, m=24, newton=8):
-    r"""(pressure drop, inlet stretch) of the flow-controlled problem, outlet pressure 0.
+def _state(fluid, wall, a, q, x, I):
+    """(stretch, integrand of the length) at the wall parameter ``x`` (``I`` its integral)."""
+    gam = 4 * I / fluid.stress(x) ** 3
+    R = (4 * q / (mp.pi * gam)) ** (mpf(1) / 3)
+    lam = R / a
+    G = 2 * fluid.stress(x) / R
+    return lam, wall.dP(lam) * lam / 3 * fluid.dlog_apparent(x, gam) / G
 
-    ``fluid`` is a :class:`CarreauYasudaRef` (parameter: wall shear rate) or a :class:`RateLawRef`
-    (parameter: wall stress); the separated identity is integrated over that parameter ``x``:
-    :math:`L = \int_{x_{in}}^{x_{out}} P'(\lambda)\,\lambda\,(d\ln\Gamma/dx)/(3G)\,dx`.
-    """
-    a, L, q = mpf(radius), mpf(length), mpf(q)
-    gam_out = 4 * q / (mp.pi * a**3)
-    x_out = fluid.at_apparent(gam_out, _guess(fluid, gam_out))
+
+def _length(fluid, wall, a, q, x_in, I_in, x_out, m):
+    r""":math:`H = \int_{x_{in}}^{x_{out}} P'(\lambda)\lambda\,(d\ln\Gamma/dx)/(3G)\,dx` (the tube length
+    that carries ``q`` between those wall parameters) and the integrand at ``x_in``."""
 
     def state(x, I):
-        gam = 4 * I / fluid.stress(x) ** 3
-        R = (4 * q / (mp.pi * gam)) ** (mpf(1) / 3)
-        lam = R / a
-        G = 2 * fluid.stress(x) / R
-        return lam, wall.dP(lam) * lam / 3 * fluid.dlog_apparent(x, gam) / G
+        return _state(fluid, wall, a, q, x, I)
 
-    lam0 = mpf(stretch_guess)
-    x_in = fluid.at_apparent(gam_out / lam0**3, _guess(fluid, gam_out / lam0**3))
     nodes, weights = gauss_legendre_rule(m)
+    pieces = [fluid.lower + d for d in geometric_breaks(x_in - fluid.lower, x_out - fluid.lower)]
+    H = mpf(0)
+    for lo, hi in zip(pieces[:-1], pieces[1:]):
+        c, w = (lo + hi) / 2, (hi - lo) / 2
+        xs = [c + w * x for x in nodes]
+        order = sorted(range(m), key=lambda i: xs[i])
+        Is = fluid.cumulative(x_in, I_in, [xs[i] for i in order])
+        vals = {i: state(xs[i], I)[1] for i, I in zip(order, Is)}
+        H += w * mp.fsum(weights[i] * vals[i] for i in range(m))
+    lam_in, phi_in = state(x_in, I_in)
+    return H, phi_in, lam_in
+
+
+def section(fluid, wall, radius, to_outlet, q, stretch_guess, m=24, newton=8, outlet_stretch=1):
+    r"""``(x, lam)``: the wall parameter and the stretch of the section a length ``to_outlet``
+    upstream of the outlet (:math:`L - z`) at the flow rate ``q``: Newton's method on
+    :math:`\int_{x}^{x_{out}} P'(\lambda)\,\lambda\,(d\ln\Gamma/dx)/(3G)\,dx = L - z` (its
+    derivative is minus the integrand at :math:`x`), the outlet at the stretch ``outlet_stretch``."""
+    a, q = mpf(radius), mpf(q)
+    target = mpf(to_outlet)
+    lam_out = mpf(outlet_stretch)
+    gam_out = 4 * q / (mp.pi * (a * lam_out) ** 3)
+    x_out = fluid.at_apparent(gam_out, _guess(fluid, gam_out))
+    lam0 = mpf(stretch_guess)
+    x = fluid.at_apparent(4 * q / (mp.pi * (a * lam0) ** 3), _guess(fluid, gam_out / (lam0 / lam_out) ** 3))
     for _ in range(newton):
-        I_in = fluid.integral(x_in)
-        pieces = [fluid.lower + d for d in geometric_breaks(x_in - fluid.lower, x_out - fluid.lower)]
-        H = mpf(0)
-        for lo, hi in zip(pieces[:-1], pieces[1:]):
-            c, w = (lo + hi) / 2, (hi - lo) / 2
-            xs = [c + w * x for x in nodes]
-            order = sorted(range(m), key=lambda i: xs[i])
-            Is = fluid.cumulative(x_in, I_in, [xs[i] for i in order])
-            vals = {i: state(xs[i], I)[1] for i, I in zip(order, Is)}
-            H += w * mp.fsum(weights[i] * vals[i] for i in range(m))
-        lam_in, phi_in = state(x_in, I_in)
-        x_in += (H - L) / phi_in
-        if abs(H / L - 1) < mpf(10) ** (-mp.dps + 5):
+        H, phi, _ = _length(fluid, wall, a, q, x, fluid.integral(x), x_out, m)
+        x += (H - target) / phi
+        if abs(H / target - 1) < mpf(10) ** (-mp.dps + 5):
             break
-    lam_in, _ = state(x_in, fluid.integral(x_in))
-    return wall.P(lam_in), lam_in
+    lam, _ = _state(fluid, wall, a, q, x, fluid.integral(x))
+    return x, lam
+
+
+def solve_flow_controlled(fluid, wall, radius, length, q, stretch_guess, m=24, newton=8, outlet_stretch=1):
+    r"""(pressure drop, inlet stretch) of the flow-controlled problem; the outlet at the stretch
+    ``outlet_stretch`` (1: unloaded; else where the wall's transmural pressure is the outlet's).
+
+    ``fluid`` is a :class:`CarreauYasudaRef` (parameter: wall shear rate) or a :class:`RateLawRef`
+    (parameter: wall stress); the separated identity is integrated over that parameter ``x``
+    (:func:`section` at ``to_outlet = L``):
+    :math:`L = \int_{x_{in}}^{x_{out}} P'(\lambda)\,\lambda\,(d\ln\Gamma/dx)/(3G)\,dx`, and
+    :math:`\Delta p = P(\lambda_{in}) - P(\lambda_{out})`.
+    """
+    lam_out = mpf(outlet_stretch)
+    _, lam_in = section(fluid, wall, radius, length, q, stretch_guess, m, newton, outlet_stretch)
+    return wall.P(lam_in) - (wall.P(lam_out) if lam_out != 1 else 0), lam_in
+
+
+def solve_pressure_controlled(fluid, wall, radius, length, inlet_stretch, outlet_stretch, q_guess, m=24):
+    r"""The flow rate between the inlet and outlet stretches (the wall's stretches at the inlet's and
+    the outlet's transmural pressures): the root of :math:`\ln H(q) = \ln L` in :math:`\ln q`
+    (secant steps from ``q_guess`` and :math:`e^{10^{-3}}` times it, to the working precision), :math:`H` the
+    length of :func:`solve_flow_controlled`'s identity between the wall parameters of the two
+    stretches at that flow rate."""
+    a, L = mpf(radius), mpf(length)
+    lam_in, lam_out = mpf(inlet_stretch), mpf(outlet_stretch)
+    last = {}
+
+    def log_excess(log_q):
+        q = mp.exp(log_q)
+        gam_out = 4 * q / (mp.pi * (a * lam_out) ** 3)
+        gam_in = 4 * q / (mp.pi * (a * lam_in) ** 3)
+        # each wall parameter from the last one found (a start only: Newton to the working precision)
+        x_out = fluid.at_apparent(gam_out, last.get("out", _guess(fluid, gam_out)))
+        x_in = fluid.at_apparent(gam_in, last.get("in", _guess(fluid, gam_in)))
+        last["out"], last["in"] = x_out, x_in
+        return mp.log(_length(fluid, wall, a, q, x_in, fluid.integral(x_in), x_out, m)[0]) - mp.log(L)
+
+    s0, s1 = mp.log(mpf(q_guess)), mp.log(mpf(q_guess)) + mpf("1e-3")
+    f0, f1 = log_excess(s0), log_excess(s1)
+    for _ in range(30):
+        s0, s1, f0 = s1, s1 - f1 * (s1 - s0) / (f1 - f0), f1
+        if abs(s1 - s0) < mpf(10) ** (-mp.dps + 6):
+            return mp.exp(s1)
+        f1 = log_excess(s1)
+    raise ArithmeticError("no convergence")
 
 
 def _guess(fluid, gam):
