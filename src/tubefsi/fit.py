@@ -49,11 +49,17 @@ class FitResult:
     message: str
 
     def __str__(self) -> str:
-        lines = [f"{'parameter':28s} {'value':>14s} {'std. error':>12s}"]
-        for name, value in self.parameters.items():
-            lines.append(f"{name:28s} {value:14.6g} {self.standard_errors[name]:12.3g}")
-        rms = float(np.sqrt(np.mean(self.residuals**2)))
-        return "\n".join(lines) + f"\nrms relative residual {rms:.3g} ({self.message})"
+        return _summary(self, "relative")
+
+
+def _summary(result, residual_kind) -> str:
+    """The table of a fit's parameters and standard errors, then its rms residual (``FitResult``,
+    ``NetworkFitResult``)."""
+    lines = [f"{'parameter':28s} {'value':>14s} {'std. error':>12s}"]
+    for name, value in result.parameters.items():
+        lines.append(f"{name:28s} {value:14.6g} {result.standard_errors[name]:12.3g}")
+    rms = float(np.sqrt(np.mean(result.residuals**2)))
+    return "\n".join(lines) + f"\nrms {residual_kind} residual {rms:.3g} ({result.message})"
 
 
 #: How far (a factor) a parameter fitted through its logarithm may move from its starting value.

@@ -37,7 +37,7 @@ from scipy.sparse import linalg as spla
 from ._validation import as_array
 from .errors import ConvergenceError, InvalidParameterError, TubefsiError
 from .fields import _array_fields
-from .fit import SEARCH_FACTOR, _covariance, _warn_if_unsupported
+from .fit import SEARCH_FACTOR, _covariance, _summary, _warn_if_unsupported
 from .network_groups import _Groups
 from .network_solution import NetworkSolution, _hashable
 
@@ -59,11 +59,7 @@ class NetworkFitResult:
     message: str
 
     def __str__(self) -> str:
-        lines = [f"{'parameter':28s} {'value':>14s} {'std. error':>12s}"]
-        for name, value in self.parameters.items():
-            lines.append(f"{name:28s} {value:14.6g} {self.standard_errors[name]:12.3g}")
-        rms = float(np.sqrt(np.mean(self.residuals**2)))
-        return "\n".join(lines) + f"\nrms weighted residual {rms:.3g} ({self.message})"
+        return _summary(self, "weighted")
 
 
 def _scale_field(wall, label):
