@@ -33,6 +33,7 @@ __all__ = [
     "advise", "Advice", "Diagnostics", "ModelValidityWarning", "fit", "FitResult", "Network", "NetworkSolution",
     "TubefsiError", "InvalidParameterError", "KeywordError", "NoSteadyStateError", "ConvergenceError", "AccuracyWarning",
     "StretchRangeError", "BucklingError", "FitWarning", "Profile", "sampled", "Problem", "cache_clear", "cache_info",
+    "evolve", "Transient", "Chamber",
 ]
 
 __version__ = "0.1.0"
@@ -46,6 +47,7 @@ _LAZY = {
     "advise": "advise", "Advice": "advise", "Diagnostics": "advise",
     "fit": "fit", "FitResult": "fit",
     "Network": "network", "NetworkSolution": "network",
+    "evolve": "evolve", "Transient": "evolve", "Chamber": "evolve",
 }
 
 
@@ -53,6 +55,7 @@ if _typing.TYPE_CHECKING:      # never run: tells type checkers what the lazy na
     from . import dimensionless, fields, registry
     from .advise import Advice, Diagnostics, advise
     from .couplers.tables import cache_clear, cache_info
+    from .evolve import Chamber, Transient, evolve
     from .fit import FitResult, fit
     from .geometry import Tube
     from .network import Network, NetworkSolution
@@ -78,7 +81,7 @@ def __dir__():
 
 
 #: submodules that share their name with the function they define: the package attribute is the function
-_FUNCTIONS = ("solve", "advise", "fit")
+_FUNCTIONS = ("solve", "advise", "fit", "evolve")
 
 
 class _Package(_types.ModuleType):
