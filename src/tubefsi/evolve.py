@@ -39,7 +39,8 @@ import numpy as np
 
 from ._keywords import checked_keywords
 from ._lazy import lazy_module
-from .errors import AccuracyWarning, InvalidParameterError, ModelValidityWarning, NoSteadyStateError, warn_user
+from .errors import (AccuracyWarning, ConvergenceError, InvalidParameterError, ModelValidityWarning, NoSteadyStateError,
+                     warn_user)
 from .geometry import Tube
 from .scene import resolve
 from .solution import Solution
@@ -527,7 +528,6 @@ def _run(system: _System, times, y0, rtol, method):
         res = integrate.solve_ivp(system.rhs, span, y0, method=method, t_eval=times, rtol=rtol, atol=atol,
                                   jac_sparsity=system.sparsity())
         if res.status != 0 or res.y.shape[1] != times.size:
-            from .errors import ConvergenceError
             raise ConvergenceError(f"the time integration stopped: {res.message}")
         ys, nfev = res.y, res.nfev
     return _fields(system, times, ys), nfev
