@@ -174,14 +174,23 @@ class _System:
     def stretch(self, s):
         return np.sqrt(1.0 + s)
 
-    def cell_pressure(self, lam):
-        return self.wall.pressure(lam, self.tb) + self.external
+    def cell_pressure(self, s):
+        r"""The cells' pressure :math:`P(\lambda) + p_e` at area strain ``s``, from the wall's strain
+        hook at :math:`\lambda - 1 = s/(1 + \sqrt{1+s})` (no rounding of :math:`1 + \varepsilon`: full
+        accuracy at tiny strains); a stretch outside the wall's range gets the public method's error."""
+        strain = s / (1.0 + np.sqrt(1.0 + s))
+        with np.errstate(all="ignore"):
+            p = self.wall._pressure_at_strain(strain, self.tb)
+        if not np.all(np.isfinite(p)):
+            self.wall.pressure(1.0 + strain, self.tb)        # raises the typed error
+            raise InvalidParameterError("stretch", "stretches the wall holds", float(np.max(1.0 + strain)))
+        return p + self.external
 
     def fluxes(self, t, s, p_chamber=None):
         """``(p, lam, q)``: cell pressures and stretches and the ``n + 1`` face flow rates, for
         states ``s`` of shape ``(..., n)`` at times ``t`` (broadcast with ``s[..., 0]``)."""
         lam = self.stretch(s)
-        p = self.cell_pressure(lam)
+        p = self.cell_pressure(s)
         lead = p.shape[:-1]
         t = np.broadcast_to(np.asarray(t, dtype=float), lead)
         if self.inlet_kind == "pressure":
@@ -217,7 +226,9 @@ class _System:
         out[-2], out[-1] = q[0], q[-1]
         return out
 
-    def sparsity(self):
+    def pattern(self):
+        """``(rows, cols)`` of the Jacobian's nonzero entries: the cells' tridiagonal band, the
+        chamber's coupling to the last cell, the counters' to the end cells."""
         n, m = self.n, self.size
         rows, cols = [], []
         for d in (-1, 0, 1):
@@ -229,8 +240,32 @@ class _System:
             extra += [(n, n - 1), (n, n), (n - 1, n), (m - 1, n)]
         rows.append(np.array([r for r, _ in extra]))
         cols.append(np.array([c for _, c in extra]))
-        r, c = np.concatenate(rows), np.concatenate(cols)
-        return sparse.csr_matrix((np.ones(r.size), (r, c)), shape=(m, m))
+        return np.concatenate(rows), np.concatenate(cols)
+
+    def jacobian(self, t, y, s_scale):
+        r"""The Jacobian by forward differences, the cells in three groups (columns ``j = g mod 3``
+        touch disjoint rows) and the chamber's pressure apart: four or five right-hand sides. The
+        steps, :math:`\max(10^{-6}\max(|s_j|, s_{scale}), 10^{-9})`, stay well above the rounding
+        of the stretch :math:`\sqrt{1+s}` at tiny strains; the counters' columns are zero."""
+        n, m = self.n, self.size
+        rows, cols = self.pattern()
+        f0 = self.rhs(t, y)
+        h = np.zeros(m)
+        h[:n] = 1e-7 * np.maximum(np.abs(y[:n]), s_scale)
+        group = np.where(cols < n, cols % 3, 3)
+        if self.outlet_kind == "chamber":
+            h[n] = 1e-7 * max(abs(float(y[n])), self.pressure_scale)
+        vals = np.zeros(rows.size)
+        for g in range(4 if self.outlet_kind == "chamber" else 3):
+            mask = group == g
+            if not np.any(mask):
+                continue
+            step = np.zeros(m)
+            picked = np.unique(cols[mask])
+            step[picked] = h[picked]
+            df = self.rhs(t, y + step) - f0
+            vals[mask] = df[rows[mask]] / h[cols[mask]]
+        return sparse.csc_matrix((vals, (rows, cols)), shape=(m, m))
 
     def initial_state(self, initial, t0):
         """The state at ``t0``: at rest at ``initial`` (a pressure, Pa) or from a steady Solution."""
@@ -515,18 +550,21 @@ def _limits(values):
 def _run(system: _System, times, y0, rtol, method):
     """One integration: ``(Transient fields dict, rhs evaluations)``."""
     n = system.n
-    atol = np.full(system.size, 1e300)           # the volume counters are not error-controlled
     s_scale = max(float(np.max(np.abs(y0[:n]))), _area_strain_scale(system))
-    atol[:n] = rtol * s_scale
+    atol = np.full(system.size, rtol * s_scale)
+    # the volume counters: to the tolerance of the stored volume's change
+    volume_scale = math.pi * system.radius**2 * system.length * s_scale
     if system.outlet_kind == "chamber":
         atol[n] = rtol * system.pressure_scale
+        volume_scale += float(system.outlet.compliance_at(y0[n], system.pressure_scale)) * system.pressure_scale
+    atol[-2:] = rtol * volume_scale
     span = (float(times[0]), float(times[-1]))
     if span[1] == span[0]:
         ys = y0[:, None]
         nfev = 0
     else:
         res = integrate.solve_ivp(system.rhs, span, y0, method=method, t_eval=times, rtol=rtol, atol=atol,
-                                  jac_sparsity=system.sparsity())
+                                  jac=lambda t, y: system.jacobian(t, y, s_scale))
         if res.status != 0 or res.y.shape[1] != times.size:
             raise ConvergenceError(f"the time integration stopped: {res.message}")
         ys, nfev = res.y, res.nfev
