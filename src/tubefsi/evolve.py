@@ -603,7 +603,8 @@ def _fields(system, times, ys):
         stored = stored + system.outlet.volume_at(chamber)
     v_in, v_out = ys[-2], ys[-1]
     change = stored - stored[0]
-    balance = change - (v_in - v_out)
+    # (the chamber is part of the store: what leaves the tube into it stays)
+    balance = change - (v_in - (0.0 if chamber is not None else v_out))
     scale = max(float(np.max(np.abs(change))), float(np.max(np.abs(v_in))), np.finfo(float).tiny)
     return dict(pressure_nodes=pressure, radius_nodes=system.radius * stretch, flow_faces=q, stored=stored,
                 volume_in=v_in, volume_out=v_out, chamber_pressure=chamber,
