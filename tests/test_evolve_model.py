@@ -1,0 +1,97 @@
+"""The steps of the transient model (docs/theory.md, section "Transients"), checked numerically,
+and the long-time limit of tubefsi.evolve against tubefsi.solve for every kind of wall and fluid."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import tubefsi
+
+TB = 0.3
+
+
+@pytest.mark.parametrize("name", ["thin-linear", "thick-neo-hookean", "thick-mooney-rivlin", "thin-ogden"])
+def test_compliance_identity(name):
+    """C = dA/dp = 2 pi a^2 lambda / P'(lambda): a central difference of A(p) = pi a^2 lambda(p)^2
+    from wall.strain against the tube law's slope wall.stiffness."""
+    cls = tubefsi.registry.walls[name]
+    wall = cls(**cls._examples[0])
+    a = 1e-4
+    lam = np.array([1.01, 1.1, 1.3])
+    p = wall.pressure(lam, TB)
+    h = 1e-5 * p
+
+    def area(q):
+        return math.pi * a**2 * (1.0 + wall.strain(q, TB)) ** 2
+
+    difference = (area(p + h) - area(p - h)) / (2 * h)
+    closed = 2 * math.pi * a**2 * lam / wall.stiffness(lam, TB)
+    np.testing.assert_allclose(difference, closed, rtol=1e-6)
+
+
+def test_signed_flow_function():
+    """Q(-G, R) = -Q(G, R): a reversed gradient gives the reversed flow (the relaxation of an
+    inflated tube empties it through the inlet)."""
+    tube = tubefsi.Tube(radius=1e-4, thickness=3e-5, length=1e-2)
+    fluid = tubefsi.registry.rheologies["power-law"](consistency=0.017, index=0.7)
+    wall = tubefsi.registry.walls["thick-neo-hookean"](shear_modulus=2e4)
+    r = tubefsi.evolve(fluid, wall, tube, np.linspace(0, 0.05, 6), inlet_pressure=0.0, initial=2e3,
+                       outlet="closed", cells=16, error_control=False, rtol=1e-8)
+    assert np.all(r.inlet_flow_rate[1:] < 0)                 # it empties through the inlet
+    assert np.all(np.diff(r.stored_volume()) < 0)
+    # the released volume: pi a^2 L (lambda(2 kPa)^2 - 1), lambda from the wall's tube law
+    lam = 1.0 + wall.strain(2e3, tube.reduced_thickness)
+    released = math.pi * tube.radius**2 * tube.length * (lam**2 - 1.0)
+    assert -(r.volume_in[-1] - r.volume_in[0]) == pytest.approx(released, rel=2e-2)   # nearly empty at 0.05 s
+
+
+WALLS = {
+    "thin": ("thin-neo-hookean", {"shear_modulus": 2e4}),
+    "thick": ("thick-neo-hookean", {"shear_modulus": 2e4}),
+    "mooney-rivlin": ("thick-mooney-rivlin", None),
+    "linear": ("thin-linear", {"youngs_modulus": 6e4, "poisson_ratio": 0.5}),
+    "plugin": ("thick-gent", None),
+}
+FLUIDS = {
+    "power-law": ("power-law", {"consistency": 0.017, "index": 0.7}),
+    "newtonian": ("newtonian", {"viscosity": 3.5e-3}),
+    "carreau": ("carreau", None),
+}
+
+
+def _model(registry, name, kwargs):
+    cls = registry[name]
+    return cls(**(kwargs if kwargs is not None else cls._examples[0]))
+
+
+def _cases():
+    for w in WALLS:
+        for f in FLUIDS:
+            slow = f == "carreau" or (w, f) not in {("thick", "power-law"), ("linear", "newtonian"),
+                                                   ("mooney-rivlin", "power-law")}
+            yield pytest.param(w, f, marks=[pytest.mark.slow] if slow else [], id=f"{w}-{f}")
+
+
+@pytest.mark.parametrize("wall_kind, fluid_kind", list(_cases()))
+def test_long_time_limit_against_solve(wall_kind, fluid_kind):
+    """The steady flow rate of the transient on 16, 32, 64 cells, extrapolated through
+    q_n = q + c2 h^2 + c3 h^3, against tubefsi.solve (the steady couplers: a different algorithm)."""
+    wall = _model(tubefsi.registry.walls, *WALLS[wall_kind])
+    fluid = _model(tubefsi.registry.rheologies, *FLUIDS[fluid_kind])
+    tube = tubefsi.Tube(radius=1e-4, thickness=3e-5, length=1e-2)
+    p_in = 0.1 * float(wall.small_strain_modulus(tube.reduced_thickness))     # ~10 % strain
+    steady = tubefsi.solve(fluid, wall, tube, pressure_drop=p_in)
+    # the slowest mode decays as exp(-pi^2 D t / L^2), D ~ dQ/dG / C: end at 60 of its time scales
+    g = p_in / tube.length
+    conductance = float(fluid.flow_rate(tube.radius, g)) / g
+    compliance = 2 * math.pi * tube.radius**2 / float(wall.small_strain_modulus(tube.reduced_thickness))
+    t_end = 60 * tube.length**2 * compliance / (math.pi**2 * conductance)
+    values = [tubefsi.evolve(fluid, wall, tube, [0.0, t_end], inlet_pressure=p_in, cells=n, rtol=1e-11,
+                             error_control=False).inlet_flow_rate[-1] for n in (16, 32, 64)]
+    h = np.array([1.0, 0.5, 0.25])
+    q = np.linalg.solve(np.column_stack([np.ones(3), h**2, h**3]), np.array(values))[0]
+    assert abs(values[-1] - steady.flow_rate) / steady.flow_rate < 1e-3
+    assert abs(q - steady.flow_rate) / steady.flow_rate < 1e-7
