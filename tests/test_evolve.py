@@ -219,3 +219,20 @@ def test_outputs(tmp_path):
     assert isinstance(ds, xr.Dataset)
     assert ds["pressure"].dims == ("time", "z")
     np.testing.assert_array_equal(ds["inlet_pressure"].values, r.inlet_pressure)
+
+
+def test_cli_evolve(tmp_path, capsys):
+    """``tubefsi evolve`` writes the histories of the same call as CSV, and a figure."""
+    from tubefsi.cli import main
+
+    status = main(["evolve", "--rheology", "newtonian:viscosity=1e-3", "--wall",
+                   "thin-linear:youngs_modulus=1e6,poisson_ratio=0.5,end_condition=open",
+                   "--tube", "radius=1e-4,thickness=1e-5,length=1e-2", "--inlet-pressure", "1e-3",
+                   "--outlet", "closed", "--t-end", "4e-3", "--steps", "5", "--rtol", "1e-2",
+                   "--output", str(tmp_path / "h.csv"), "--plot", str(tmp_path / "h.png")])
+    assert status == 0
+    table = np.loadtxt(tmp_path / "h.csv", delimiter=",", skiprows=1)
+    tube, fluid, wall, _, _ = _linear_setup()
+    r = tubefsi.evolve(fluid, wall, tube, np.linspace(0.0, 4e-3, 5), inlet_pressure=1e-3, outlet="closed", rtol=1e-2)
+    np.testing.assert_array_equal(table[:, 1], r.inlet_flow_rate)
+    assert (tmp_path / "h.png").stat().st_size > 0

@@ -498,7 +498,8 @@ class Transient:
 
     def plot(self, times=None, *, fig=None):
         """Pressure and radius along the tube at ``times`` (default: six output times) and the inlet
-        flow rate against time; returns the figure."""
+        and outlet flow rates against time (after the first output time: the flow at the instant
+        of a step is singular); returns the figure."""
         import matplotlib.pyplot as plt
 
         fig = fig or plt.figure(figsize=(10, 3.2), layout="constrained")
@@ -510,8 +511,9 @@ class Transient:
         ax_p.set(xlabel="z (mm)", ylabel="pressure (Pa)")
         ax_r.set(xlabel="z (mm)", ylabel="radius (µm)")
         ax_p.legend(fontsize="small")
-        ax_q.plot(self.times, self.inlet_flow_rate, label="inlet")
-        ax_q.plot(self.times, self.outlet_flow_rate, "--", label="outlet")
+        shown = slice(1, None) if self.times.size > 1 else slice(None)   # (a step's start is singular)
+        ax_q.plot(self.times[shown], self.inlet_flow_rate[shown], label="inlet")
+        ax_q.plot(self.times[shown], self.outlet_flow_rate[shown], "--", label="outlet")
         ax_q.set(xlabel="t (s)", ylabel="flow rate (m$^3$/s)")
         ax_q.legend(fontsize="small")
         return fig
