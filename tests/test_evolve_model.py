@@ -7,8 +7,11 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import tubefsi
+from tubefsi.testing.profiles import scaled
 
 TB = 0.3
 
@@ -95,3 +98,39 @@ def test_long_time_limit_against_solve(wall_kind, fluid_kind):
     q = np.linalg.solve(np.column_stack([np.ones(3), h**2, h**3]), np.array(values))[0]
     assert abs(values[-1] - steady.flow_rate) / steady.flow_rate < 1e-3
     assert abs(q - steady.flow_rate) / steady.flow_rate < 1e-7
+
+
+def test_accuracy_warning_states_the_estimate(monkeypatch):
+    """Where the refinement reaches its limits (here the cells, capped at 64 for the test) the
+    finest run comes back with an AccuracyWarning stating the estimate, which the result reports."""
+    import importlib
+
+    monkeypatch.setattr(importlib.import_module("tubefsi.evolve"), "MAX_CELLS", 64)
+    tube = tubefsi.Tube(radius=1e-4, thickness=3e-5, length=1e-2)
+    fluid = tubefsi.registry.rheologies["newtonian"](viscosity=1e-3)
+    wall = tubefsi.registry.walls["thick-neo-hookean"](shear_modulus=2e4)
+    with pytest.warns(tubefsi.AccuracyWarning, match="estimated relative error") as caught:
+        r = tubefsi.evolve(fluid, wall, tube, np.linspace(0, 0.01, 6), inlet_pressure=1e3, rtol=1e-7)
+    assert r.cells == 64
+    assert r.error_estimate > 1e-7
+    assert f"{r.error_estimate:.2g}" in str(caught[0].message)
+
+
+@settings(deadline=None, max_examples=scaled(6))
+@given(modulus=st.floats(5e3, 1e5), index=st.floats(0.5, 1.2), rate=st.floats(1e-12, 1e-10),
+       closed=st.booleans())
+def test_pump_conserves_mass(modulus, index, rate, closed):
+    """Contract: a pump's stored volume grows by exactly what it delivered minus what left
+    (the unknowns are the cells' areas: to the integrator's Newton tolerance), for any fluid
+    index, wall modulus, flow rate and outlet."""
+    tube = tubefsi.Tube(radius=1e-4, thickness=3e-5, length=1e-2)
+    fluid = tubefsi.registry.rheologies["power-law"](consistency=0.017, index=index)
+    wall = tubefsi.registry.walls["thick-neo-hookean"](shear_modulus=modulus)
+    times = np.linspace(0.0, 0.01, 6)
+    r = tubefsi.evolve(fluid, wall, tube, times, inlet_flow_rate=rate, outlet="closed" if closed else "open",
+                       cells=16, rtol=1e-6, error_control=False)
+    np.testing.assert_allclose(r.inlet_flow_rate, rate, rtol=0, atol=0)
+    delivered = rate * times - (r.volume_out - r.volume_out[0])
+    stored = r.stored_volume() - r.stored_volume()[0]
+    assert np.max(np.abs(stored - delivered)) <= 1e-6 * rate * times[-1]
+    assert r.mass_error <= 1e-6

@@ -699,7 +699,7 @@ def evolve(rheology, wall, tube: Tube, times, *, inlet_pressure=None, inlet_flow
         e_time = _difference(_monitored(system, fine), _monitored(system, sharp))
         if e_space + e_time <= rtol:
             return _result(fine_sys, times, sharp, fine_sys.n, 0.1 * tol, e_space, e_time, total, density)
-        grow_space = e_space > 0.5 * rtol and 4 * fine_sys.n <= MAX_CELLS
+        grow_space = e_space > 0.5 * rtol and 2 * fine_sys.n <= MAX_CELLS
         grow_time = e_time > 0.5 * rtol and tol > _MIN_RTOL
         if not (grow_space or grow_time):
             warn_user(f"evolve: the estimated relative error of the inlet history, {e_space + e_time:.2g} "
