@@ -23,10 +23,12 @@ second order in :math:`\Delta z`. Time: :func:`scipy.integrate.solve_ivp` (``BDF
 ``Radau``) with the banded sparsity of the Jacobian (three right-hand sides per Jacobian).
 
 **Error control.** The inlet history (the flow rate for a pressure inlet, the pressure for a pump)
-is computed on ``n`` and ``2n`` cells (space estimate :math:`|h_{2n} - h_n|/3`, second order) and
-at the integrator tolerance and a tenth of it (time estimate); the cells are doubled and the
-tolerance cut until their sum, relative to the history's largest value, meets ``rtol``, else an
-:class:`~tubefsi.AccuracyWarning` states the estimate. The finest run is the result.
+is computed on ``n`` and ``2n`` cells at the integrator tolerance :math:`\tau/10` (space estimate
+:math:`|h_{2n} - h_n|/3`, second order) and on ``n`` cells at :math:`\tau` (time estimate
+:math:`|h_{n,\tau} - h_{n,\tau/10}|`, conservative for the reported run at :math:`\tau/10`); the cells
+grow and the tolerance falls until their sum, relative to the history's largest value, meets
+``rtol``, else an :class:`~tubefsi.AccuracyWarning` states the estimate. The run on ``2n`` cells is
+the result.
 """
 
 from __future__ import annotations
@@ -687,37 +689,39 @@ def evolve(rheology, wall, tube: Tube, times, *, inlet_pressure=None, inlet_flow
         return _result(system, times, fields, n, rtol, math.nan, math.nan, nfev, density)
     tol = 0.1 * rtol
     total = 0
-    coarse, nfev = _run(system, times, y0_of(system), tol, method)
-    total += nfev
+    loose = sharp = None           # the coarse grid at tol and at tol/10
     while True:
+        if loose is None:
+            loose, nfev = _run(system, times, y0_of(system), tol, method)
+            total += nfev
+        if sharp is None:
+            sharp, nfev = _run(system, times, y0_of(system), 0.1 * tol, method)
+            total += nfev
         fine_sys = attrs.evolve(system, n=2 * system.n)
-        fine, nfev = _run(fine_sys, times, y0_of(fine_sys), tol, method)
+        fine, nfev = _run(fine_sys, times, y0_of(fine_sys), 0.1 * tol, method)
         total += nfev
-        sharp, nfev = _run(fine_sys, times, y0_of(fine_sys), 0.1 * tol, method)
-        total += nfev
-        e_space = _difference(_monitored(system, coarse), _monitored(system, fine)) / 3.0
-        e_time = _difference(_monitored(system, fine), _monitored(system, sharp))
+        # space: the two grids at the same tolerance (second order); time: the coarse grid at two
+        # tolerances (the reported run has the tighter one: the estimate is conservative)
+        e_space = _difference(_monitored(system, sharp), _monitored(system, fine)) / 3.0
+        e_time = _difference(_monitored(system, loose), _monitored(system, sharp))
         if e_space + e_time <= rtol:
-            return _result(fine_sys, times, sharp, fine_sys.n, 0.1 * tol, e_space, e_time, total, density)
+            return _result(fine_sys, times, fine, fine_sys.n, 0.1 * tol, e_space, e_time, total, density)
         grow_space = e_space > 0.5 * rtol and 2 * fine_sys.n <= MAX_CELLS
         grow_time = e_time > 0.5 * rtol and tol > _MIN_RTOL
         if not (grow_space or grow_time):
             warn_user(f"evolve: the estimated relative error of the inlet history, {e_space + e_time:.2g} "
                       f"(space {e_space:.2g} at {fine_sys.n} cells, time {e_time:.2g}), misses rtol = {rtol:g}",
                       AccuracyWarning)
-            return _result(fine_sys, times, sharp, fine_sys.n, 0.1 * tol, e_space, e_time, total, density)
-        if grow_time:
-            tol = max(0.1 * tol, _MIN_RTOL)
+            return _result(fine_sys, times, fine, fine_sys.n, 0.1 * tol, e_space, e_time, total, density)
         if grow_space:
             # second order: the cells for the target, from the estimate, as a power of two
             factor = math.sqrt(e_space / (0.4 * rtol))
             k = max(1, math.ceil(math.log2(factor)))
             system = attrs.evolve(system, n=min(fine_sys.n * 2 ** (k - 1), MAX_CELLS // 2))
-            coarse, nfev = _run(system, times, y0_of(system), tol, method)
-            total += nfev
-        else:                # the same cells at the new tolerance
-            coarse, nfev = _run(system, times, y0_of(system), tol, method)
-            total += nfev
+            loose = sharp = None
+        if grow_time:
+            tol = max(0.1 * tol, _MIN_RTOL)
+            loose, sharp = (sharp if not grow_space else None), None      # the old tol/10 run is the new tol run
 
 
 def _result(system, times, fields, cells, tol, e_space, e_time, total, density):
