@@ -197,6 +197,13 @@ def test_bad_input_names_the_parameter(kwargs, name):
         tubefsi.evolve(fluid, wall, tube, [0.0, 1e-3], **kwargs)
 
 
+def test_array_parameters_are_refused():
+    tube, fluid, _, _, _ = _linear_setup()
+    wall = tubefsi.registry.walls["thin-linear"](youngs_modulus=[1e6, 2e6], poisson_ratio=0.5)
+    with pytest.raises(tubefsi.InvalidParameterError, match="youngs_modulus"):
+        tubefsi.evolve(fluid, wall, tube, [0.0, 1e-3], inlet_pressure=1.0)
+
+
 def test_bad_times():
     tube, fluid, wall, _, _ = _linear_setup()
     with pytest.raises(tubefsi.InvalidParameterError, match="times"):

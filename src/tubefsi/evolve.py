@@ -743,6 +743,12 @@ def _setup(rheo, wall, tube, times, inlet_pressure, inlet_flow_rate, outlet_pres
     if tube.graded or any(np.ndim(v) for v in (tube.radius, tube.thickness, tube.length)):
         raise InvalidParameterError("tube", "a uniform tube of scalar radius, thickness and length", tube,
                                     "graded tubes and arrays of tubes are not supported by evolve")
+    for kind, model in (("rheology", rheo), ("wall", wall)):
+        arrays = [f.name for f in attrs.fields(type(model)) if np.ndim(getattr(model, f.name)) > 0] \
+            if attrs.has(type(model)) else []
+        if arrays:
+            raise InvalidParameterError(kind, "a model of scalar parameters", model,
+                                        f"{arrays[0]} is an array: evolve one scene per call")
     times = np.asarray(times, dtype=float).ravel()
     if times.size == 0 or not np.all(np.isfinite(times)) or np.any(np.diff(times) <= 0):
         raise InvalidParameterError("times", "a non-empty array of finite, increasing times (s)", times)
