@@ -134,3 +134,53 @@ def test_pump_conserves_mass(modulus, index, rate, closed):
     stored = r.stored_volume() - r.stored_volume()[0]
     assert np.max(np.abs(stored - delivered)) <= 1e-6 * rate * times[-1]
     assert r.mass_error <= 1e-6
+
+
+def test_self_similar_nonlinear_wall():
+    r"""A Newtonian fluid in a thick neo-Hookean tube (strain up to 15 %) behind a pressure step,
+    on a tube long enough to be semi-infinite at the times used: :math:`\lambda = \Lambda(\eta)`,
+    :math:`\eta = z/\sqrt t`, with
+
+    .. math:: g' = -\pi a^2\eta\Lambda\Lambda', \qquad \Lambda' = g/(K(\Lambda)P'(\Lambda)),
+
+    :math:`K = \pi a^4\Lambda^4/(8\mu)`, :math:`\Lambda(0) = \lambda(p_{in})`, :math:`\Lambda(\infty) = 1`:
+    shooting on :math:`g(0)` (bisection on whether the DOP853 solution, rtol 1e-12, crosses
+    :math:`\Lambda = 1`). Then :math:`q(0, t)\sqrt t = -g(0)` and :math:`p(z, t) = P(\Lambda(z/\sqrt t))`."""
+    from scipy.integrate import solve_ivp
+
+    a, tb, mu = 1e-4, 0.3, 1e-3
+    wall = tubefsi.registry.walls["thick-neo-hookean"](shear_modulus=2e4)
+    fluid = tubefsi.registry.rheologies["newtonian"](viscosity=mu)
+    p_in = 3e3
+    lam_in = 1.0 + float(wall.strain(p_in, tb))
+
+    def rhs(eta, y):
+        lam, g = y
+        dlam = g / (math.pi * (a * lam) ** 4 / (8 * mu) * float(wall.stiffness(max(lam, 1.0), tb)))
+        return [dlam, -math.pi * a * a * eta * lam * dlam]
+
+    def crossed(eta, y):
+        return y[0] - 1.0
+
+    crossed.terminal = True
+
+    def shoot(g0):
+        return solve_ivp(rhs, (0.0, 1.0), [lam_in, g0], method="DOP853", rtol=1e-12, atol=1e-16,
+                         events=crossed, dense_output=True)
+
+    steep, shallow = -1e-8, -1e-14
+    for _ in range(45):
+        mid = -math.sqrt(steep * shallow)
+        steep, shallow = (mid, shallow) if shoot(mid).status == 1 else (steep, mid)
+    g0 = 0.5 * (steep + shallow)
+    profile = shoot(shallow)
+
+    tube = tubefsi.Tube(radius=a, thickness=tb * a, length=0.1)     # eta(L) >= 1 at t <= 0.01 s
+    times = np.linspace(0.0, 0.01, 11)
+    r = tubefsi.evolve(fluid, wall, tube, times, inlet_pressure=p_in, outlet="closed", rtol=1e-4)
+    error = np.max(np.abs(r.inlet_flow_rate[1:] * np.sqrt(times[1:]) / -g0 - 1.0))
+    assert error < 1e-4
+    assert error < 3 * r.error_estimate
+    z = np.array([0.005, 0.01, 0.02, 0.04])
+    expected = wall.pressure(profile.sol(z / math.sqrt(times[-1]))[0], tb)
+    np.testing.assert_allclose(r.pressure(z, times[-1]), expected, rtol=0, atol=1e-4 * p_in)
