@@ -296,28 +296,29 @@ class Transient:
     linearly in z and in t (exact at the nodes and the output times, to the error estimate)."""
 
     #: The output times (s).
-    times: np.ndarray
+    times: np.ndarray = attrs.field(repr=False)
     #: The nodes (m): 0, the cell centres, L.
-    z: np.ndarray
+    z: np.ndarray = attrs.field(repr=False)
     #: The cell faces (m).
-    z_faces: np.ndarray
+    z_faces: np.ndarray = attrs.field(repr=False)
     #: Pressure at the nodes (Pa), shape ``(len(times), len(z))``.
-    pressure_nodes: np.ndarray
+    pressure_nodes: np.ndarray = attrs.field(repr=False)
     #: Radius at the nodes (m).
-    radius_nodes: np.ndarray
+    radius_nodes: np.ndarray = attrs.field(repr=False)
     #: Flow rate at the faces (m^3/s), shape ``(len(times), len(z_faces))``.
-    flow_faces: np.ndarray
+    flow_faces: np.ndarray = attrs.field(repr=False)
     #: Volume in the tube and the chamber (m^3) at the output times.
-    stored: np.ndarray
+    stored: np.ndarray = attrs.field(repr=False)
     #: Volume that entered and left (m^3) since ``times[0]``.
-    volume_in: np.ndarray
-    volume_out: np.ndarray
+    volume_in: np.ndarray = attrs.field(repr=False)
+    volume_out: np.ndarray = attrs.field(repr=False)
     #: Pressure in the outlet chamber (Pa; None without one).
-    chamber_pressure: np.ndarray | None
+    chamber_pressure: np.ndarray | None = attrs.field(repr=False)
     #: The number of cells and the integrator's relative tolerance of the reported run.
     cells: int
     integrator_rtol: float
-    #: The a-posteriori relative error estimates of the inlet history: space and time.
+    #: The a-posteriori relative error estimates of the inlet history: space and time (``inf``:
+    #: not estimated, ``error_control=False``).
     space_error: float
     time_error: float
     #: The largest :math:`|\Delta V_{stored} - \int (q_{in} - q_{out})dt|` relative to the
@@ -686,7 +687,7 @@ def evolve(rheology, wall, tube: Tube, times, *, inlet_pressure=None, inlet_flow
     n = system.n
     if not error_control:
         fields, nfev = _run(system, times, y0_of(system), rtol, method)
-        return _result(system, times, fields, n, rtol, math.nan, math.nan, nfev, density)
+        return _result(system, times, fields, n, rtol, math.inf, math.inf, nfev, density)
     tol = 0.1 * rtol
     total = 0
     loose = sharp = None           # the coarse grid at tol and at tol/10
