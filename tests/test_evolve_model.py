@@ -184,3 +184,18 @@ def test_self_similar_nonlinear_wall():
     z = np.array([0.005, 0.01, 0.02, 0.04])
     expected = wall.pressure(profile.sol(z / math.sqrt(times[-1]))[0], tb)
     np.testing.assert_allclose(r.pressure(z, times[-1]), expected, rtol=0, atol=1e-4 * p_in)
+
+
+def test_outlet_and_external_pressure_reach_solve():
+    """Gauge outlet pressure 1 kPa, 0.5 kPa outside, 3 kPa at the inlet: the long-time flow of 64
+    cells is solve's (same outlet and external pressures) to the discretization, and ``steady()``
+    is that solve."""
+    tube = tubefsi.Tube(radius=1e-4, thickness=3e-5, length=1e-2)
+    fluid = tubefsi.registry.rheologies["power-law"](consistency=0.017, index=0.7)
+    wall = tubefsi.registry.walls["thick-neo-hookean"](shear_modulus=2e4)
+    reference = tubefsi.solve(fluid, wall, tube, pressure_drop=2e3, outlet_pressure=1e3, external_pressure=500.0)
+    r = tubefsi.evolve(fluid, wall, tube, [0.0, 1.0], inlet_pressure=3e3, outlet_pressure=1e3, external_pressure=500.0,
+                       cells=64, rtol=1e-9, error_control=False)
+    assert r.inlet_flow_rate[-1] == pytest.approx(reference.flow_rate, rel=1e-3)
+    assert r.steady().flow_rate == reference.flow_rate
+    assert r.radius(0.0, 1.0) == pytest.approx(reference.inlet_radius, rel=1e-9)

@@ -415,7 +415,7 @@ class Transient:
                                          "without bound", name="the inlet flow rate")
             return None
         tube = Tube(radius=sy.radius, thickness=sy.tb * sy.radius, length=sy.length)
-        common = dict(outlet_pressure=outlet - sy.external, external_pressure=sy.external)
+        common = dict(outlet_pressure=outlet, external_pressure=sy.external)   # (gauge pressures)
         if sy.inlet_kind == "pressure":
             drop = inlet - outlet
             if drop < 0:
