@@ -20,7 +20,8 @@ natural hook of every registered wall: no inversion of the tube law in the loop)
 through a face is :math:`Q(-(p_{i+1} - p_i)/\Delta z, a\bar\lambda)` with the mean stretch of
 the two cells (at a boundary: the half cell to the boundary pressure, the stretch of the cell),
 second order in :math:`\Delta z`. Time: :func:`scipy.integrate.solve_ivp` (``BDF`` or
-``Radau``) with the banded sparsity of the Jacobian (three right-hand sides per Jacobian).
+``Radau``) with a sparse (tridiagonal plus the chamber and the volume counters) Jacobian by
+grouped forward differences: four right-hand sides per Jacobian (five with a chamber).
 
 **Error control.** The inlet history (the flow rate for a pressure inlet, the pressure for a pump)
 is computed on ``n`` and ``2n`` cells at the integrator tolerance :math:`\tau/10` (space estimate
