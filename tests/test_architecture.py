@@ -28,7 +28,7 @@ LAYERS = [
     {"tubefsi.solve"},
     {"tubefsi.advise", "tubefsi.fit", "tubefsi.dimensionless", "tubefsi.network", "tubefsi.network_solution",
      "tubefsi.network_io", "tubefsi.datasets",
-     "tubefsi.network_groups", "tubefsi.network_solver", "tubefsi.network_fit"},
+     "tubefsi.network_groups", "tubefsi.network_solver", "tubefsi.network_fit", "tubefsi.evolve"},
     {"tubefsi.fem"},
     {"tubefsi.chapter", "tubefsi.plotting"},
     {"tubefsi.cli", "tubefsi.testing", "tubefsi"},

@@ -35,6 +35,7 @@ __all__ = [
     "TubefsiError", "InvalidParameterError", "KeywordError", "NoSteadyStateError", "ConvergenceError", "AccuracyWarning",
     "StretchRangeError", "BucklingError", "FitWarning", "Profile", "sampled", "Problem", "cache_clear", "cache_info",
     "read_network_table", "write_network_table", "datasets",
+    "evolve", "Transient", "Chamber",
 ]
 
 __version__ = "0.1.0"
@@ -49,6 +50,7 @@ _LAZY = {
     "fit": "fit", "FitResult": "fit",
     "Network": "network", "NetworkSolution": "network", "NetworkFitResult": "network_fit",
     "read_network_table": "network_io", "write_network_table": "network_io", "datasets": None,
+    "evolve": "evolve", "Transient": "evolve", "Chamber": "evolve",
 }
 
 
@@ -56,6 +58,7 @@ if _typing.TYPE_CHECKING:      # never run: tells type checkers what the lazy na
     from . import dimensionless, fields, registry
     from .advise import Advice, Diagnostics, advise
     from .couplers.tables import cache_clear, cache_info
+    from .evolve import Chamber, Transient, evolve
     from .fit import FitResult, fit
     from .geometry import Tube
     from .network import Network, NetworkSolution
@@ -84,7 +87,7 @@ def __dir__():
 
 
 #: submodules that share their name with the function they define: the package attribute is the function
-_FUNCTIONS = ("solve", "advise", "fit")
+_FUNCTIONS = ("solve", "advise", "fit", "evolve")
 
 
 class _Package(_types.ModuleType):

@@ -331,6 +331,27 @@ def _parser() -> argparse.ArgumentParser:
                    help="fluid density (kg/m^3): warn where the reduced Reynolds number is not small")
     p.set_defaults(run=_cmd_solve)
 
+    p = sub.add_parser("evolve", help="a transient (inflation, settling) as CSV, netCDF and a figure",
+                       description="Integrate the transient flow through a soft tube (docs/transients.md).")
+    p.add_argument("--rheology", required=True, metavar="NAME[:k=v,...]")
+    p.add_argument("--wall", required=True, metavar="NAME[:k=v,...]")
+    p.add_argument("--tube", required=True, metavar="radius=..,thickness=..,length..", help="uniform tube (m)")
+    inlet = p.add_mutually_exclusive_group(required=True)
+    inlet.add_argument("--inlet-pressure", type=float, metavar="P", help="a pressure step at the inlet (Pa)")
+    inlet.add_argument("--inlet-flow-rate", type=float, metavar="Q", help="a pump at the inlet (m^3/s)")
+    p.add_argument("--outlet", choices=("open", "closed"), default="open", help="open (default) or a dead end")
+    p.add_argument("--chamber", metavar="V0,C", help="a linear chamber V = V0 + C p at the outlet (m^3, m^3/Pa)")
+    p.add_argument("--outlet-pressure", type=float, default=0.0, metavar="P", help="open outlet's pressure (Pa)")
+    p.add_argument("--external-pressure", type=float, default=0.0, metavar="PE", help="pressure outside (Pa)")
+    p.add_argument("--t-end", type=float, required=True, metavar="T", help="last time (s)")
+    p.add_argument("--steps", type=int, default=101, metavar="N", help="output times from 0 to T (default 101)")
+    p.add_argument("--rtol", type=float, default=1e-4, help="relative accuracy of the inlet history (default 1e-4)")
+    p.add_argument("--density", type=float, metavar="RHO", help="fluid density (kg/m^3): warn where inertia counts")
+    p.add_argument("--output", metavar="FILE", type=_path, help="the histories as CSV (default: standard output)")
+    p.add_argument("--netcdf", metavar="FILE", type=_path, help="also the fields as netCDF (needs xarray)")
+    p.add_argument("--plot", metavar="FILE", type=_path, help="also a figure (PNG, SVG, PDF, ...)")
+    p.set_defaults(run=_cmd_evolve)
+
     p = sub.add_parser("reproduce", help="the chapter's figures, as printed and consistent (PNG and CSV)")
     p.add_argument("out", nargs="?", default="chapter-figures", metavar="OUTDIR", type=_path,
                    help="output directory (default: ./chapter-figures)")
@@ -702,6 +723,31 @@ def _cmd_network(args, out) -> int:
     return 0
 
 
+def _cmd_evolve(args, out) -> int:
+    from .evolve import Chamber, evolve
+
+    fluid = _build("rheology", registry.rheologies, args.rheology)
+    wall = _build("wall", registry.walls, args.wall)
+    tube = _tube(args.tube, "--tube")
+    outlet = args.outlet
+    if args.chamber is not None:
+        values = _load_values("--chamber", args.chamber)
+        if np.ndim(values) != 1 or len(values) != 2:
+            raise UsageError(f"--chamber takes V0,C (m^3, m^3/Pa), got {args.chamber!r}")
+        outlet = Chamber.linear(float(values[0]), float(values[1]))
+    if not (args.t_end > 0 and args.steps >= 2):
+        raise UsageError("--t-end must be > 0 and --steps >= 2")
+    result = evolve(fluid, wall, tube, np.linspace(0.0, args.t_end, args.steps), inlet_pressure=args.inlet_pressure,
+                    inlet_flow_rate=args.inlet_flow_rate, outlet=outlet, outlet_pressure=args.outlet_pressure,
+                    external_pressure=args.external_pressure, rtol=args.rtol, density=args.density)
+    result.to_csv(args.output if args.output is not None else out)
+    if args.netcdf is not None:
+        result.to_xarray().to_netcdf(args.netcdf)
+    if args.plot is not None:
+        result.plot().savefig(args.plot, dpi=130)
+    return 0
+
+
 def _cmd_reproduce(args, out) -> int:
     from .chapter import reproduce_chapter
 
@@ -790,7 +836,7 @@ def main(argv=None) -> int:
     except SystemExit as exc:  # --help, --version
         return exc.code if isinstance(exc.code, int) else 0
     if args.command is None:
-        return _error("a command is required: list, solve, curve, network, advise or reproduce "
+        return _error("a command is required: list, solve, curve, network, advise, evolve or reproduce "
                       "(see 'tubefsi --help')")
     try:
         with warnings.catch_warnings(record=True) as caught:

@@ -1,0 +1,68 @@
+r"""Cost of ``tubefsi.evolve``: a soft actuator inflating through its supply tube.
+
+Run ``python benchmarks/transient.py`` (a minute or two on two cores; ``--quick``: the loosest
+tolerances only). The scene: a thick neo-Hookean tube (a = 0.25 mm, t = 0.1 mm, L = 5 cm,
+mu = 100 kPa), a power-law fluid (m = 0.017 Pa s^n, n = 0.7), a linear chamber at the end
+(V0 = 0.1 ml, C = 10 ul/kPa), a 20 kPa step at the inlet, 41 output times over 2 s.
+
+Printed:
+
+* the **work–precision table**: for each requested ``rtol``, the wall time of the
+  error-controlled call, its right-hand-side evaluations, the cells and integrator tolerance it
+  settled on, its own error estimate and the true error of the inlet-flow history against a
+  reference run (error control at 1e-7, whose own estimate is printed);
+* **cost against cells**: one run at a fixed integrator tolerance for 64 ... 1024 cells, the time
+  per cell relative to the 64-cell run (a same-process baseline): flat means linear cost.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+import tubefsi
+
+
+def scene():
+    tube = tubefsi.Tube(radius=2.5e-4, thickness=1e-4, length=0.05)
+    fluid = tubefsi.registry.rheologies["power-law"](consistency=0.017, index=0.7)
+    wall = tubefsi.registry.walls["thick-neo-hookean"](shear_modulus=1e5)
+    chamber = tubefsi.Chamber.linear(1e-7, 1e-11)
+    return fluid, wall, tube, dict(inlet_pressure=2e4, outlet=chamber)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true")
+    args = parser.parse_args(argv)
+    fluid, wall, tube, bc = scene()
+    times = np.linspace(0.0, 2.0, 41)
+    ref_tol = 1e-4 if args.quick else 1e-7
+    reference = tubefsi.evolve(fluid, wall, tube, times, rtol=ref_tol, **bc)
+    q_ref = reference.inlet_flow_rate[1:]
+    print(f"reference: rtol {ref_tol:g}, {reference.cells} cells, estimate {reference.error_estimate:.2g}")
+    print(f"{'rtol':>8} {'time (s)':>9} {'rhs evals':>10} {'cells':>6} {'int. rtol':>10} {'estimate':>9} "
+          f"{'true error':>10} {'t90 (s)':>9}")
+    for rtol in ((1e-2, 1e-3) if args.quick else (1e-2, 1e-3, 1e-4, 1e-5, 1e-6)):
+        start = time.perf_counter()
+        r = tubefsi.evolve(fluid, wall, tube, times, rtol=rtol, **bc)
+        elapsed = time.perf_counter() - start
+        error = np.max(np.abs(r.inlet_flow_rate[1:] - q_ref)) / np.max(np.abs(q_ref))
+        print(f"{rtol:8.0e} {elapsed:9.3f} {r.evaluations:10d} {r.cells:6d} {r.integrator_rtol:10.0e} "
+              f"{r.error_estimate:9.2g} {error:10.2g} {r.settling_time(0.9):9.4f}")
+    print("\ncost against cells (integrator rtol 1e-6, no error control)")
+    print(f"{'cells':>6} {'time (s)':>9} {'rhs evals':>10} {'us/(cell*eval)':>15} {'ratio to 64':>12}")
+    base = None
+    for n in ((64, 128) if args.quick else (64, 128, 256, 512, 1024)):
+        start = time.perf_counter()
+        r = tubefsi.evolve(fluid, wall, tube, times, rtol=1e-6, cells=n, error_control=False, **bc)
+        elapsed = time.perf_counter() - start
+        per = elapsed / (n * r.evaluations) * 1e6
+        base = base or per
+        print(f"{n:6d} {elapsed:9.3f} {r.evaluations:10d} {per:15.3f} {per / base:12.2f}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,836 @@
+r"""Transients: :func:`evolve` integrates the inflation, settling and relaxation of a soft tube.
+
+The model (``docs/theory.md``, section "Transients"): lubrication flow with the wall in
+quasi-static equilibrium and no fluid inertia,
+
+.. math::
+
+    \frac{\partial A}{\partial t} + \frac{\partial q}{\partial z} = 0, \qquad
+    A = \pi a^2 \lambda(p - p_e)^2, \qquad q = Q\Bigl(-\frac{\partial p}{\partial z}, a\lambda\Bigr),
+
+with :math:`Q(G, R)` the rheology's tube flow function (:meth:`Rheology.flow_rate`, signed with
+:math:`G`) and :math:`\lambda(p)` the wall's tube law (:meth:`WallModel.pressure` is its inverse
+:math:`P(\lambda)`). Eliminating :math:`A` gives the nonlinear diffusion equation
+:math:`C(p)\,\partial_t p = \partial_z Q(-\partial_z p, R(p))`, :math:`C = dA/dp`.
+
+**Discretization.** ``n`` equal finite volumes; the unknowns are the cell averages of the area
+strain :math:`s = A/(\pi a^2) - 1` (the conserved quantity: the discrete volume changes exactly by
+the boundary fluxes), the pressure of a cell is the wall's :math:`P(\sqrt{1+s}) + p_e` (the
+natural hook of every registered wall: no inversion of the tube law in the loop), the flux
+through a face is :math:`Q(-(p_{i+1} - p_i)/\Delta z, a\bar\lambda)` with the mean stretch of
+the two cells (at a boundary: the half cell to the boundary pressure, the stretch of the cell),
+second order in :math:`\Delta z`. Time: :func:`scipy.integrate.solve_ivp` (``BDF`` or
+``Radau``) with a sparse (tridiagonal plus the chamber and the volume counters) Jacobian by
+grouped forward differences: four right-hand sides per Jacobian (five with a chamber).
+
+**Error control.** The inlet history (the flow rate for a pressure inlet, the pressure for a pump)
+is computed on ``n`` and ``2n`` cells at the integrator tolerance :math:`\tau/10` (space estimate
+:math:`|h_{2n} - h_n|/3`, second order) and on ``n`` cells at :math:`\tau` (time estimate
+:math:`|h_{n,\tau} - h_{n,\tau/10}|`, conservative for the reported run at :math:`\tau/10`); the cells
+grow and the tolerance falls until their sum, relative to the history's largest value, meets
+``rtol``, else an :class:`~tubefsi.AccuracyWarning` states the estimate. The run on ``2n`` cells is
+the result.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Callable
+
+import attrs
+import numpy as np
+
+from ._keywords import checked_keywords
+from ._lazy import lazy_module
+from .errors import (AccuracyWarning, ConvergenceError, InvalidParameterError, ModelValidityWarning, NoSteadyStateError,
+                     warn_user)
+from .geometry import Tube
+from .scene import resolve
+from .solution import Solution
+from .solve import solve
+from .validity import REDUCED_REYNOLDS
+
+integrate = lazy_module("scipy.integrate", globals(), "integrate")
+sparse = lazy_module("scipy.sparse", globals(), "sparse")
+
+__all__ = ["evolve", "Transient", "Chamber", "WOMERSLEY", "MAX_CELLS"]
+
+#: Largest Womersley number :math:`a\sqrt{\rho/(\mu t_c)}` for the flow to be quasi-steady.
+WOMERSLEY = 0.5
+#: The most cells the error control refines to.
+MAX_CELLS = 4096
+#: The smallest integrator tolerance the error control goes down to.
+_MIN_RTOL = 1e-12
+
+
+# ---------------------------------------------------------------------------------------- chamber
+@attrs.frozen
+class Chamber:
+    r"""A lumped chamber at the outlet (a soft actuator, a reservoir): its volume :math:`V(p)`
+    (m^3) at the fluid's gauge pressure :math:`p` (Pa), filled by the outlet flow,
+    :math:`dV/dt = q(L, t)`.
+
+    Parameters
+    ----------
+    volume : callable
+        :math:`V(p)`, increasing (a measured or modelled pressure–volume curve).
+    compliance : callable, optional
+        :math:`dV/dp` (m^3/Pa). Without it, a fourth-order central difference of ``volume``
+        at a step of 1e-3 of the problem's pressure scale.
+    """
+
+    volume: Callable = attrs.field()
+    compliance: Callable | None = None
+
+    @volume.validator
+    def _callable(self, attribute, value):
+        if not callable(value):
+            raise InvalidParameterError("volume", "a callable V(p) (m^3)", value)
+
+    @classmethod
+    def linear(cls, volume: float, compliance: float) -> Chamber:
+        r"""The linear chamber :math:`V = V_0 + C p` (``volume`` :math:`V_0` m^3, ``compliance`` :math:`C` m^3/Pa)."""
+        v0 = float(volume)
+        c = float(compliance)
+        if not (math.isfinite(c) and c > 0):
+            raise InvalidParameterError("compliance", "(0, inf) m^3/Pa", compliance)
+        if not (math.isfinite(v0) and v0 >= 0):
+            raise InvalidParameterError("volume", "[0, inf) m^3", volume)
+        return cls(volume=lambda p: v0 + c * np.asarray(p, dtype=float), compliance=lambda p: c + 0.0 * np.asarray(p))
+
+    def volume_at(self, p):
+        """:math:`V(p)` (m^3), elementwise."""
+        return _elementwise(self.volume, p, "volume")
+
+    def compliance_at(self, p, scale: float = 1.0):
+        """:math:`dV/dp` (m^3/Pa), elementwise (a difference of ``volume`` at steps ``1e-3 scale``
+        where no ``compliance`` is given)."""
+        if self.compliance is not None:
+            c = _elementwise(self.compliance, p, "compliance")
+        else:
+            h = 1e-3 * scale
+            p = np.asarray(p, dtype=float)
+            c = (8.0 * (self.volume_at(p + h) - self.volume_at(p - h))
+                 - (self.volume_at(p + 2 * h) - self.volume_at(p - 2 * h))) / (12.0 * h)
+        if not np.all(np.asarray(c) > 0):
+            raise InvalidParameterError("chamber compliance", "dV/dp > 0 (an increasing V(p))", float(np.min(c)))
+        return c
+
+
+def _elementwise(function, t, name):
+    """``function`` at the array ``t``: called on the array, or point by point where it does not
+    broadcast (a function written for one number); a float array of the shape of ``t``."""
+    t = np.asarray(t, dtype=float)
+    try:
+        out = np.asarray(function(t), dtype=float)
+        if out.shape != t.shape:
+            out = np.broadcast_to(out, t.shape).astype(float)
+    except (TypeError, ValueError):
+        out = np.array([float(function(float(x))) for x in t.ravel()]).reshape(t.shape)
+    if not np.all(np.isfinite(out)):
+        raise InvalidParameterError(name, "finite values", float(t.ravel()[np.argmin(np.isfinite(out).ravel())]),
+                                    f"{name} is not finite there")
+    return out
+
+
+def _boundary(name, value):
+    """A boundary value as a function of time (a number: constant)."""
+    if callable(value):
+        return value
+    v = float(np.asarray(value, dtype=float)) if np.ndim(value) == 0 else None
+    if v is None or not math.isfinite(v):
+        raise InvalidParameterError(name, "a finite number or a callable of t", value)
+    return lambda t: v + 0.0 * np.asarray(t, dtype=float)
+
+
+# ------------------------------------------------------------------------------ discrete system
+@attrs.frozen
+class _System:
+    """The semi-discrete system on ``n`` cells: the state is ``[s_1..s_n, (p_chamber), V_in, V_out]``
+    with :math:`s = A/(\\pi a^2) - 1`, ``V_in``, ``V_out`` the volumes that entered and left."""
+
+    rheology: object
+    wall: object
+    radius: float
+    tb: float
+    length: float
+    external: float
+    n: int
+    inlet_kind: str          # "pressure" or "flow"
+    inlet: Callable
+    outlet_kind: str         # "pressure", "closed" or "chamber"
+    outlet: object           # callable p(t), None, or Chamber
+    pressure_scale: float
+
+    @property
+    def dz(self) -> float:
+        return self.length / self.n
+
+    @property
+    def size(self) -> int:
+        return self.n + (1 if self.outlet_kind == "chamber" else 0) + 2
+
+    @property
+    def z(self):
+        return (np.arange(self.n) + 0.5) * self.dz
+
+    def stretch(self, s):
+        return np.sqrt(1.0 + s)
+
+    def cell_pressure(self, s):
+        r"""The cells' pressure :math:`P(\lambda) + p_e` at area strain ``s``, from the wall's strain
+        hook at :math:`\lambda - 1 = s/(1 + \sqrt{1+s})` (no rounding of :math:`1 + \varepsilon`: full
+        accuracy at tiny strains); a stretch outside the wall's range gets the public method's error."""
+        strain = s / (1.0 + np.sqrt(1.0 + s))
+        with np.errstate(all="ignore"):
+            p = self.wall._pressure_at_strain(strain, self.tb)
+        if not np.all(np.isfinite(p)):
+            self.wall.pressure(1.0 + strain, self.tb)        # raises the typed error
+            raise InvalidParameterError("stretch", "stretches the wall holds", float(np.max(1.0 + strain)))
+        return p + self.external
+
+    def fluxes(self, t, s, p_chamber=None):
+        """``(p, lam, q)``: cell pressures and stretches and the ``n + 1`` face flow rates, for
+        states ``s`` of shape ``(..., n)`` at times ``t`` (broadcast with ``s[..., 0]``)."""
+        lam = self.stretch(s)
+        p = self.cell_pressure(s)
+        lead = p.shape[:-1]
+        t = np.broadcast_to(np.asarray(t, dtype=float), lead)
+        if self.inlet_kind == "pressure":
+            p0 = _elementwise(self.inlet, t, "inlet_pressure")
+        else:
+            p0 = p[..., 0]
+        if self.outlet_kind == "pressure":
+            pl = _elementwise(self.outlet, t, "outlet_pressure")
+        elif self.outlet_kind == "chamber":
+            pl = np.broadcast_to(p_chamber, lead)
+        else:
+            pl = p[..., -1]
+        P = np.concatenate([np.asarray(p0)[..., None], p, np.asarray(pl)[..., None]], axis=-1)
+        h = np.full(self.n + 1, self.dz)
+        h[0] = h[-1] = 0.5 * self.dz
+        G = -np.diff(P, axis=-1) / h
+        lam_f = np.concatenate([lam[..., :1], 0.5 * (lam[..., :-1] + lam[..., 1:]), lam[..., -1:]], axis=-1)
+        q = np.sign(G) * self.rheology.flow_rate(self.radius * lam_f, np.abs(G))
+        if self.inlet_kind == "flow":
+            q[..., 0] = _elementwise(self.inlet, t, "inlet_flow_rate")
+        if self.outlet_kind == "closed":
+            q[..., -1] = 0.0
+        return p, lam, q
+
+    def rhs(self, t, y):
+        n = self.n
+        chamber = self.outlet_kind == "chamber"
+        p, lam, q = self.fluxes(t, y[:n], y[n] if chamber else None)
+        out = np.empty(self.size)
+        out[:n] = (q[:-1] - q[1:]) / (math.pi * self.radius**2 * self.dz)
+        if chamber:
+            out[n] = q[-1] / self.outlet.compliance_at(y[n], self.pressure_scale)
+        out[-2], out[-1] = q[0], q[-1]
+        return out
+
+    def pattern(self):
+        """``(rows, cols)`` of the Jacobian's nonzero entries: the cells' tridiagonal band, the
+        chamber's coupling to the last cell, the counters' to the end cells."""
+        n, m = self.n, self.size
+        rows, cols = [], []
+        for d in (-1, 0, 1):
+            i = np.arange(max(0, -d), min(n, n - d))
+            rows.append(i)
+            cols.append(i + d)
+        extra = [(m - 2, 0), (m - 1, n - 1)]
+        if self.outlet_kind == "chamber":
+            extra += [(n, n - 1), (n, n), (n - 1, n), (m - 1, n)]
+        rows.append(np.array([r for r, _ in extra]))
+        cols.append(np.array([c for _, c in extra]))
+        return np.concatenate(rows), np.concatenate(cols)
+
+    def jacobian(self, t, y, s_scale):
+        r"""The Jacobian by forward differences, the cells in three groups (columns ``j = g mod 3``
+        touch disjoint rows) and the chamber's pressure apart: four or five right-hand sides. The
+        steps, :math:`\max(10^{-6}\max(|s_j|, s_{scale}), 10^{-9})`, stay well above the rounding
+        of the stretch :math:`\sqrt{1+s}` at tiny strains; the counters' columns are zero."""
+        n, m = self.n, self.size
+        rows, cols = self.pattern()
+        f0 = self.rhs(t, y)
+        h = np.zeros(m)
+        h[:n] = 1e-7 * np.maximum(np.abs(y[:n]), s_scale)
+        group = np.where(cols < n, cols % 3, 3)
+        if self.outlet_kind == "chamber":
+            h[n] = 1e-7 * max(abs(float(y[n])), self.pressure_scale)
+        vals = np.zeros(rows.size)
+        for g in range(4 if self.outlet_kind == "chamber" else 3):
+            mask = group == g
+            if not np.any(mask):
+                continue
+            step = np.zeros(m)
+            picked = np.unique(cols[mask])
+            step[picked] = h[picked]
+            df = self.rhs(t, y + step) - f0
+            vals[mask] = df[rows[mask]] / h[cols[mask]]
+        return sparse.csc_matrix((vals, (rows, cols)), shape=(m, m))
+
+    def initial_state(self, initial, t0):
+        """The state at ``t0``: at rest at ``initial`` (a pressure, Pa) or from a steady Solution."""
+        n = self.n
+        y = np.zeros(self.size)
+        if isinstance(initial, Solution):
+            lam = np.asarray(initial.radius(self.z), dtype=float) / self.radius
+            p_end = float(initial.pressure(self.length))
+        else:
+            p0 = float(initial)
+            lam = np.full(n, 1.0 + float(self.wall.strain(p0 - self.external, self.tb)))
+            p_end = p0
+        y[:n] = lam * lam - 1.0
+        if self.outlet_kind == "chamber":
+            y[n] = p_end
+        return y
+
+
+# ------------------------------------------------------------------------------------ the result
+@attrs.frozen(kw_only=True)
+class Transient:
+    r"""The transient of :func:`evolve`: the fields at the output ``times`` and the boundary histories.
+
+    Fields are stored at the nodes ``z`` (the inlet, the cell centres, the outlet) and the flow
+    rate at the cell faces; :meth:`pressure`, :meth:`radius` and :meth:`flow_rate` interpolate
+    linearly in z and in t (exact at the nodes and the output times, to the error estimate)."""
+
+    #: The output times (s).
+    times: np.ndarray = attrs.field(repr=False)
+    #: The nodes (m): 0, the cell centres, L.
+    z: np.ndarray = attrs.field(repr=False)
+    #: The cell faces (m).
+    z_faces: np.ndarray = attrs.field(repr=False)
+    #: Pressure at the nodes (Pa), shape ``(len(times), len(z))``.
+    pressure_nodes: np.ndarray = attrs.field(repr=False)
+    #: Radius at the nodes (m).
+    radius_nodes: np.ndarray = attrs.field(repr=False)
+    #: Flow rate at the faces (m^3/s), shape ``(len(times), len(z_faces))``.
+    flow_faces: np.ndarray = attrs.field(repr=False)
+    #: Volume in the tube and the chamber (m^3) at the output times.
+    stored: np.ndarray = attrs.field(repr=False)
+    #: Volume that entered and left (m^3) since ``times[0]``.
+    volume_in: np.ndarray = attrs.field(repr=False)
+    volume_out: np.ndarray = attrs.field(repr=False)
+    #: Pressure in the outlet chamber (Pa; None without one).
+    chamber_pressure: np.ndarray | None = attrs.field(repr=False)
+    #: The number of cells and the integrator's relative tolerance of the reported run.
+    cells: int
+    integrator_rtol: float
+    #: The a-posteriori relative error estimates of the inlet history: space and time (``inf``:
+    #: not estimated, ``error_control=False``).
+    space_error: float
+    time_error: float
+    #: The largest :math:`|\Delta V_{stored} - \int (q_{in} - q_{out})dt|` relative to the
+    #: largest stored-volume change: the mass balance of the reported run.
+    mass_error: float
+    #: Right-hand-side evaluations of every run of the error control.
+    evaluations: int
+    _system: _System = attrs.field(repr=False, alias="system")
+    _final: tuple = attrs.field(repr=False, alias="final")   # (inlet value, outlet value) at the last time
+
+    # -------------------------------------------------------------- histories
+    @property
+    def inlet_flow_rate(self) -> np.ndarray:
+        """:math:`q(0, t)` (m^3/s) at the output times."""
+        return self.flow_faces[:, 0]
+
+    @property
+    def outlet_flow_rate(self) -> np.ndarray:
+        """:math:`q(L, t)` (m^3/s) at the output times."""
+        return self.flow_faces[:, -1]
+
+    @property
+    def inlet_pressure(self) -> np.ndarray:
+        """:math:`p(0, t)` (Pa) at the output times."""
+        return self.pressure_nodes[:, 0]
+
+    @property
+    def outlet_pressure(self) -> np.ndarray:
+        """:math:`p(L, t)` (Pa) at the output times."""
+        return self.pressure_nodes[:, -1]
+
+    @property
+    def error_estimate(self) -> float:
+        """The estimated relative error of the inlet history (space plus time)."""
+        return self.space_error + self.time_error
+
+    # -------------------------------------------------------------- fields
+    def _interp(self, nodes, values, z, t):
+        z, t = np.broadcast_arrays(np.asarray(z, dtype=float), np.asarray(t, dtype=float))
+        if np.any((z < 0) | (z > nodes[-1])) or not np.all(np.isfinite(z)):
+            bad = z[(z < 0) | (z > nodes[-1]) | ~np.isfinite(z)].flat[0]
+            raise InvalidParameterError("z", f"[0, L] (m), L = {nodes[-1]:g}", float(bad))
+        if np.any((t < self.times[0]) | (t > self.times[-1])) or not np.all(np.isfinite(t)):
+            bad = t[(t < self.times[0]) | (t > self.times[-1]) | ~np.isfinite(t)].flat[0]
+            raise InvalidParameterError("t", f"[{self.times[0]:g}, {self.times[-1]:g}] (s), the output times' span",
+                                        float(bad))
+        jz = np.clip(np.searchsorted(nodes, z, side="right") - 1, 0, nodes.size - 2)
+        wz = (z - nodes[jz]) / (nodes[jz + 1] - nodes[jz])
+        if self.times.size == 1:
+            jt, wt = np.zeros(t.shape, dtype=int), np.zeros(t.shape)
+        else:
+            jt = np.clip(np.searchsorted(self.times, t, side="right") - 1, 0, self.times.size - 2)
+            wt = (t - self.times[jt]) / (self.times[jt + 1] - self.times[jt])
+        j1 = jt + (self.times.size > 1)
+        at0 = values[jt, jz] * (1 - wz) + values[jt, jz + 1] * wz
+        at1 = values[j1, jz] * (1 - wz) + values[j1, jz + 1] * wz
+        out = at0 * (1 - wt) + at1 * wt
+        return float(out) if out.ndim == 0 else out
+
+    def pressure(self, z, t):
+        """Pressure :math:`p(z, t)` (Pa); ``z`` and ``t`` broadcast."""
+        return self._interp(self.z, self.pressure_nodes, z, t)
+
+    def radius(self, z, t):
+        """Deformed radius :math:`R(z, t)` (m); ``z`` and ``t`` broadcast."""
+        return self._interp(self.z, self.radius_nodes, z, t)
+
+    def flow_rate(self, z, t):
+        """Flow rate :math:`q(z, t)` (m^3/s); ``z`` and ``t`` broadcast."""
+        return self._interp(self.z_faces, self.flow_faces, z, t)
+
+    def stored_volume(self, t=None):
+        """Fluid volume in the tube (and the chamber) (m^3), at the output times or at ``t``
+        (linear interpolation)."""
+        if t is None:
+            return self.stored
+        t = np.asarray(t, dtype=float)
+        if np.any((t < self.times[0]) | (t > self.times[-1])):
+            raise InvalidParameterError("t", f"[{self.times[0]:g}, {self.times[-1]:g}] (s)",
+                                        float(t[(t < self.times[0]) | (t > self.times[-1])].flat[0]))
+        out = np.interp(t, self.times, self.stored)
+        return float(out) if out.ndim == 0 else out
+
+    # -------------------------------------------------------------- the steady state
+    def steady(self) -> Solution | None:
+        """The steady state of the boundary values at the last output time: a :class:`Solution`
+        for an open outlet, None for a closed end or a chamber (then the pressure is uniform,
+        the inlet pressure). Raises NoSteadyStateError for a pump into a closed end or a chamber."""
+        sy = self._system
+        inlet, outlet = self._final
+        if sy.outlet_kind != "pressure":
+            if sy.inlet_kind == "flow" and inlet != 0.0:
+                raise NoSteadyStateError("flow_rate", 0.0, inlet, "a pump into a closed end or a chamber fills it "
+                                         "without bound", name="the inlet flow rate")
+            return None
+        tube = Tube(radius=sy.radius, thickness=sy.tb * sy.radius, length=sy.length)
+        common = dict(outlet_pressure=outlet, external_pressure=sy.external)   # (gauge pressures)
+        if sy.inlet_kind == "pressure":
+            drop = inlet - outlet
+            if drop < 0:
+                raise InvalidParameterError("inlet_pressure", "a final inlet pressure >= the outlet pressure "
+                                            "(for the steady state)", inlet)
+            return solve(sy.rheology, sy.wall, tube, pressure_drop=drop, **common)
+        if inlet < 0:
+            raise InvalidParameterError("inlet_flow_rate", "a final flow rate >= 0 (for the steady state)", inlet)
+        return solve(sy.rheology, sy.wall, tube, flow_rate=inlet, **common)
+
+    def steady_volume(self) -> float:
+        """The stored volume of :meth:`steady` (m^3): :math:`\\int_0^L \\pi R^2 dz` by 64-point
+        Gauss–Legendre quadrature of the steady profile (plus the chamber's volume)."""
+        sy = self._system
+        inlet, _ = self._final
+        sol = self.steady()
+        if sol is None:
+            lam = 1.0 + float(sy.wall.strain(inlet - sy.external, sy.tb))
+            chamber = float(sy.outlet.volume_at(inlet)) if sy.outlet_kind == "chamber" else 0.0
+            return math.pi * (sy.radius * lam) ** 2 * sy.length + chamber
+        x, w = np.polynomial.legendre.leggauss(64)
+        z = 0.5 * sy.length * (x + 1.0)
+        return float(0.5 * sy.length * np.sum(w * math.pi * np.asarray(sol.radius(z)) ** 2))
+
+    def settling_time(self, fraction: float = 0.9) -> float:
+        r"""The time (s, from ``times[0]``) after which the stored volume stays within
+        ``(1 - fraction)`` of its change to the steady state, :math:`|V(t) - V_\infty| \le
+        (1 - f)|V_\infty - V(t_0)|` (linear interpolation between output times); ``inf`` if that
+        is not reached by the last output time. The steady state is that of the boundary values at
+        the last output time (:meth:`steady`)."""
+        f = float(fraction)
+        if not (0.0 < f < 1.0):
+            raise InvalidParameterError("fraction", "(0, 1)", fraction)
+        v_inf = self.steady_volume()
+        dev = np.abs(self.stored - v_inf)
+        band = (1.0 - f) * abs(v_inf - self.stored[0])
+        if band == 0.0:
+            return 0.0
+        outside = np.flatnonzero(dev > band)
+        if outside.size == 0:
+            return 0.0
+        k = int(outside[-1])
+        if k == self.times.size - 1:
+            return math.inf
+        d0, d1 = dev[k], dev[k + 1]
+        w = (d0 - band) / (d0 - d1) if d0 != d1 else 1.0
+        return float(self.times[k] + w * (self.times[k + 1] - self.times[k]) - self.times[0])
+
+    # -------------------------------------------------------------- output
+    def to_xarray(self):
+        """An :class:`xarray.Dataset` with dimensions ``time`` and ``z`` (the nodes): ``pressure``,
+        ``radius``, ``flow_rate`` (interpolated to the nodes) and the histories over ``time``."""
+        try:
+            import xarray as xr
+        except ImportError:
+            raise ImportError("Transient.to_xarray needs xarray: pip install tubefsi[xarray]") from None
+        flow = np.stack([np.interp(self.z, self.z_faces, row) for row in self.flow_faces]) \
+            if self.times.size else np.zeros((0, self.z.size))
+        data = {
+            "pressure": (("time", "z"), self.pressure_nodes, {"units": "Pa"}),
+            "radius": (("time", "z"), self.radius_nodes, {"units": "m"}),
+            "flow_rate": (("time", "z"), flow, {"units": "m^3/s"}),
+            "inlet_flow_rate": ("time", self.inlet_flow_rate, {"units": "m^3/s"}),
+            "outlet_flow_rate": ("time", self.outlet_flow_rate, {"units": "m^3/s"}),
+            "inlet_pressure": ("time", self.inlet_pressure, {"units": "Pa"}),
+            "stored_volume": ("time", self.stored, {"units": "m^3"}),
+        }
+        return xr.Dataset(data, coords={"time": ("time", self.times, {"units": "s"}), "z": ("z", self.z, {"units": "m"})},
+                          attrs={"cells": self.cells, "error_estimate": self.error_estimate,
+                                 "mass_error": self.mass_error})
+
+    def to_csv(self, path) -> None:
+        """Write the histories (time, inlet/outlet flow rate, inlet/outlet pressure, stored volume) as CSV."""
+        header = "time_s,inlet_flow_rate_m3_s,outlet_flow_rate_m3_s,inlet_pressure_Pa,outlet_pressure_Pa,stored_volume_m3"
+        table = np.column_stack([self.times, self.inlet_flow_rate, self.outlet_flow_rate, self.inlet_pressure,
+                                 self.outlet_pressure, self.stored])
+        np.savetxt(path, table, delimiter=",", header=header, comments="", fmt="%.17g")
+
+    def _shown_times(self, times, count=6):
+        if times is None:
+            return self.times[np.unique(np.linspace(0, self.times.size - 1, min(count, self.times.size)).astype(int))]
+        return np.atleast_1d(np.asarray(times, dtype=float))
+
+    def plot(self, times=None, *, fig=None):
+        """Pressure and radius along the tube at ``times`` (default: six output times) and the inlet
+        and outlet flow rates against time (after the first output time: the flow at the instant
+        of a step is singular); returns the figure."""
+        import matplotlib.pyplot as plt
+
+        fig = fig or plt.figure(figsize=(10, 3.2), layout="constrained")
+        ax_p, ax_r, ax_q = fig.subplots(1, 3)
+        z_mm = 1e3 * self.z
+        for t in self._shown_times(times):
+            ax_p.plot(z_mm, self.pressure(self.z, t), label=f"t = {t:.3g} s")
+            ax_r.plot(z_mm, 1e6 * self.radius(self.z, t))
+        ax_p.set(xlabel="z (mm)", ylabel="pressure (Pa)")
+        ax_r.set(xlabel="z (mm)", ylabel="radius (µm)")
+        ax_p.legend(fontsize="small")
+        shown = slice(1, None) if self.times.size > 1 else slice(None)   # (a step's start is singular)
+        ax_q.plot(self.times[shown], self.inlet_flow_rate[shown], label="inlet")
+        ax_q.plot(self.times[shown], self.outlet_flow_rate[shown], "--", label="outlet")
+        ax_q.set(xlabel="t (s)", ylabel="flow rate (m$^3$/s)")
+        ax_q.legend(fontsize="small")
+        return fig
+
+    def animate(self, *, interval: float = 50.0, fig=None):
+        """A :class:`matplotlib.animation.FuncAnimation` of pressure and radius along the tube over
+        the output times (returned, not saved: ``anim.save("inflation.gif")``)."""
+        import matplotlib.pyplot as plt
+        from matplotlib.animation import FuncAnimation
+
+        fig = fig or plt.figure(figsize=(8, 3.2), layout="constrained")
+        ax_p, ax_r = fig.subplots(1, 2)
+        z_mm = 1e3 * self.z
+        (line_p,) = ax_p.plot(z_mm, self.pressure_nodes[0])
+        (line_r,) = ax_r.plot(z_mm, 1e6 * self.radius_nodes[0])
+        ax_p.set(xlabel="z (mm)", ylabel="pressure (Pa)", ylim=_limits(self.pressure_nodes))
+        ax_r.set(xlabel="z (mm)", ylabel="radius (µm)", ylim=_limits(1e6 * self.radius_nodes))
+        title = fig.suptitle("")
+
+        def frame(k):
+            line_p.set_ydata(self.pressure_nodes[k])
+            line_r.set_ydata(1e6 * self.radius_nodes[k])
+            title.set_text(f"t = {self.times[k]:.4g} s")
+            return line_p, line_r, title
+
+        return FuncAnimation(fig, frame, frames=self.times.size, interval=interval, blit=False)
+
+
+def _limits(values):
+    lo, hi = float(np.min(values)), float(np.max(values))
+    pad = 0.05 * (hi - lo) if hi > lo else 0.05 * max(abs(hi), 1.0)
+    return lo - pad, hi + pad
+
+
+# ----------------------------------------------------------------------------------- the driver
+def _run(system: _System, times, y0, rtol, method):
+    """One integration: ``(Transient fields dict, rhs evaluations)``."""
+    n = system.n
+    s_scale = max(float(np.max(np.abs(y0[:n]))), _area_strain_scale(system))
+    atol = np.full(system.size, rtol * s_scale)
+    # the volume counters: to the tolerance of the stored volume's change
+    volume_scale = math.pi * system.radius**2 * system.length * s_scale
+    if system.outlet_kind == "chamber":
+        atol[n] = rtol * system.pressure_scale
+        volume_scale += float(system.outlet.compliance_at(y0[n], system.pressure_scale)) * system.pressure_scale
+    atol[-2:] = rtol * volume_scale
+    span = (float(times[0]), float(times[-1]))
+    if span[1] == span[0]:
+        ys = y0[:, None]
+        nfev = 0
+    else:
+        res = integrate.solve_ivp(system.rhs, span, y0, method=method, t_eval=times, rtol=rtol, atol=atol,
+                                  jac=lambda t, y: system.jacobian(t, y, s_scale))
+        if res.status != 0 or res.y.shape[1] != times.size:
+            raise ConvergenceError(f"the time integration stopped: {res.message}")
+        ys, nfev = res.y, res.nfev
+    return _fields(system, times, ys), nfev
+
+
+def _area_strain_scale(system):
+    lam = 1.0 + float(system.wall.strain(system.pressure_scale, system.tb))
+    return lam * lam - 1.0
+
+
+def _fields(system, times, ys):
+    n = system.n
+    s = ys[:n].T
+    chamber = ys[n] if system.outlet_kind == "chamber" else None
+    p, lam, q = system.fluxes(times, s, chamber)
+    # the boundary nodes: the pressure the boundary holds (a pump's from the flux of the half cell)
+    if system.inlet_kind == "pressure":
+        p0 = _elementwise(system.inlet, times, "inlet_pressure")
+    else:
+        g = system.rheology.pressure_gradient(np.abs(q[:, 0]), system.radius * lam[:, 0]) * np.sign(q[:, 0])
+        p0 = p[:, 0] + 0.5 * system.dz * g
+    if system.outlet_kind == "pressure":
+        pl = _elementwise(system.outlet, times, "outlet_pressure")
+    elif system.outlet_kind == "chamber":
+        pl = chamber
+    else:
+        pl = p[:, -1]
+    ends = np.stack([p0, pl], axis=-1)
+    lam_ends = 1.0 + system.wall.strain(ends - system.external, system.tb)
+    pressure = np.concatenate([p0[:, None], p, pl[:, None]], axis=1)
+    stretch = np.concatenate([lam_ends[:, :1], lam, lam_ends[:, 1:]], axis=1)
+    area0 = math.pi * system.radius**2
+    stored = area0 * system.dz * np.sum(1.0 + s, axis=1)
+    if chamber is not None:
+        stored = stored + system.outlet.volume_at(chamber)
+    v_in, v_out = ys[-2], ys[-1]
+    change = stored - stored[0]
+    # (the chamber is part of the store: what leaves the tube into it stays)
+    balance = change - (v_in - (0.0 if chamber is not None else v_out))
+    scale = max(float(np.max(np.abs(change))), float(np.max(np.abs(v_in))), np.finfo(float).tiny)
+    return dict(pressure_nodes=pressure, radius_nodes=system.radius * stretch, flow_faces=q, stored=stored,
+                volume_in=v_in, volume_out=v_out, chamber_pressure=chamber,
+                mass_error=float(np.max(np.abs(balance))) / scale)
+
+
+def _monitored(system, fields):
+    """The inlet history the error control watches: the flow rate behind a pressure inlet, the
+    pressure behind a pump (the initial instant left out: a step's flow is singular there)."""
+    h = fields["flow_faces"][:, 0] if system.inlet_kind == "pressure" else fields["pressure_nodes"][:, 0]
+    return h[1:] if h.size > 1 else h
+
+
+def _difference(a, b):
+    scale = max(float(np.max(np.abs(b))), np.finfo(float).tiny)
+    return float(np.max(np.abs(a - b))) / scale
+
+
+@checked_keywords
+def evolve(rheology, wall, tube: Tube, times, *, inlet_pressure=None, inlet_flow_rate=None,
+           outlet_pressure=0.0, outlet="open", external_pressure: float = 0.0, initial=None,
+           rtol: float = 1e-6, cells: int | None = None, method: str = "BDF", density: float | None = None,
+           error_control: bool = True) -> Transient:
+    r"""Integrate the transient flow through a soft tube from ``times[0]`` to ``times[-1]``.
+
+    Solves :math:`C(p)\,\partial_t p = \partial_z Q(-\partial_z p, R(p))` (mass conservation,
+    the rheology's tube flow function :math:`Q` and the wall's tube law, ``docs/transients.md``).
+
+    Parameters
+    ----------
+    rheology, wall : model instance, class or registered name
+    tube : Tube
+        Scalar radius, thickness and length (graded tubes and arrays are not supported here).
+    times : array_like
+        Increasing output times (s); the integration starts at ``times[0]`` from ``initial``.
+    inlet_pressure : float or callable of t, optional
+        Gauge pressure at the inlet :math:`p(0, t)` (Pa).
+    inlet_flow_rate : float or callable of t, optional
+        Flow rate pumped in :math:`q(0, t)` (m^3/s). Exactly one of the two inlets.
+    outlet : {"open", "closed"}, Chamber or callable
+        ``"open"``: the outlet pressure ``outlet_pressure`` holds at :math:`z = L`; ``"closed"``: a
+        dead end, :math:`q(L) = 0`; a :class:`Chamber` or a callable :math:`V(p)` (m^3): a chamber
+        filled by the outlet flow.
+    outlet_pressure : float or callable of t
+        The outlet's gauge pressure (Pa) for ``outlet="open"``.
+    external_pressure : float
+        :math:`p_e` (Pa): the wall sees :math:`p - p_e`.
+    initial : None, float or Solution
+        ``None``: at rest at the outlet pressure (open) or at 0 (closed, chamber); a number: at rest
+        at that pressure (Pa); a steady :class:`Solution` of the same tube: its profile.
+    rtol : float
+        Requested relative accuracy of the inlet history (the flow rate behind a pressure inlet,
+        the pressure behind a pump), relative to its largest value.
+    cells : int, optional
+        Start the refinement at this many cells (default 16); with ``error_control=False``, the
+        cells of the one run.
+    method : {"BDF", "Radau"}
+        The stiff integrator of :func:`scipy.integrate.solve_ivp`.
+    density : float, optional
+        Fluid density (kg/m^3): warns (:class:`~tubefsi.ModelValidityWarning`) where the
+        Womersley number :math:`a\sqrt{\rho/(\mu t_c)}` exceeds :data:`WOMERSLEY` or the reduced
+        Reynolds number :math:`Re\,a/L` exceeds :data:`~tubefsi.validity.REDUCED_REYNOLDS`.
+    error_control : bool
+        ``False``: one run at ``cells`` and the integrator tolerance ``rtol`` (no estimate).
+
+    Returns
+    -------
+    Transient
+    """
+    rheo = resolve("rheology", rheology)
+    wall_model = resolve("wall", wall)
+    system, times, y0_of, rtol, method = _setup(rheo, wall_model, tube, times, inlet_pressure, inlet_flow_rate,
+                                                outlet_pressure, outlet, external_pressure, initial, rtol, method,
+                                                cells)
+    n = system.n
+    if not error_control:
+        fields, nfev = _run(system, times, y0_of(system), rtol, method)
+        return _result(system, times, fields, n, rtol, math.inf, math.inf, nfev, density)
+    tol = 0.1 * rtol
+    total = 0
+    loose = sharp = None           # the coarse grid at tol and at tol/10
+    while True:
+        if loose is None:
+            loose, nfev = _run(system, times, y0_of(system), tol, method)
+            total += nfev
+        if sharp is None:
+            sharp, nfev = _run(system, times, y0_of(system), 0.1 * tol, method)
+            total += nfev
+        fine_sys = attrs.evolve(system, n=2 * system.n)
+        fine, nfev = _run(fine_sys, times, y0_of(fine_sys), 0.1 * tol, method)
+        total += nfev
+        # space: the two grids at the same tolerance (second order); time: the coarse grid at two
+        # tolerances (the reported run has the tighter one: the estimate is conservative)
+        e_space = _difference(_monitored(system, sharp), _monitored(system, fine)) / 3.0
+        e_time = _difference(_monitored(system, loose), _monitored(system, sharp))
+        if e_space + e_time <= rtol:
+            return _result(fine_sys, times, fine, fine_sys.n, 0.1 * tol, e_space, e_time, total, density)
+        grow_space = e_space > 0.5 * rtol and 2 * fine_sys.n <= MAX_CELLS
+        grow_time = e_time > 0.5 * rtol and tol > _MIN_RTOL
+        if not (grow_space or grow_time):
+            warn_user(f"evolve: the estimated relative error of the inlet history, {e_space + e_time:.2g} "
+                      f"(space {e_space:.2g} at {fine_sys.n} cells, time {e_time:.2g}), misses rtol = {rtol:g}",
+                      AccuracyWarning)
+            return _result(fine_sys, times, fine, fine_sys.n, 0.1 * tol, e_space, e_time, total, density)
+        if grow_space:
+            # second order: the cells for the target, from the estimate, as a power of two
+            factor = math.sqrt(e_space / (0.4 * rtol))
+            k = max(1, math.ceil(math.log2(factor)))
+            system = attrs.evolve(system, n=min(fine_sys.n * 2 ** (k - 1), MAX_CELLS // 2))
+            loose = sharp = None
+        if grow_time:
+            tol = max(0.1 * tol, _MIN_RTOL)
+            loose, sharp = (sharp if not grow_space else None), None      # the old tol/10 run is the new tol run
+
+
+def _result(system, times, fields, cells, tol, e_space, e_time, total, density):
+    final = (float(_elementwise(system.inlet, times[-1], "inlet")),
+             float(_elementwise(system.outlet, times[-1], "outlet_pressure")) if system.outlet_kind == "pressure"
+             else math.nan)
+    z = np.concatenate([[0.0], system.z, [system.length]])
+    out = Transient(times=times, z=z, z_faces=np.arange(system.n + 1) * system.dz, cells=cells, integrator_rtol=tol,
+                    space_error=e_space, time_error=e_time, evaluations=total, system=system, final=final, **fields)
+    if density is not None:
+        _check_validity(out, float(density))
+    return out
+
+
+def _setup(rheo, wall, tube, times, inlet_pressure, inlet_flow_rate, outlet_pressure, outlet, external_pressure,
+           initial, rtol, method, cells):
+    if not isinstance(tube, Tube):
+        raise InvalidParameterError("tube", "a tubefsi.Tube", tube)
+    if tube.graded or any(np.ndim(v) for v in (tube.radius, tube.thickness, tube.length)):
+        raise InvalidParameterError("tube", "a uniform tube of scalar radius, thickness and length", tube,
+                                    "graded tubes and arrays of tubes are not supported by evolve")
+    for kind, model in (("rheology", rheo), ("wall", wall)):
+        arrays = [f.name for f in attrs.fields(type(model)) if np.ndim(getattr(model, f.name)) > 0] \
+            if attrs.has(type(model)) else []
+        if arrays:
+            raise InvalidParameterError(kind, "a model of scalar parameters", model,
+                                        f"{arrays[0]} is an array: evolve one scene per call")
+    times = np.asarray(times, dtype=float).ravel()
+    if times.size == 0 or not np.all(np.isfinite(times)) or np.any(np.diff(times) <= 0):
+        raise InvalidParameterError("times", "a non-empty array of finite, increasing times (s)", times)
+    rtol = float(rtol)
+    if not (1e-12 <= rtol < 1):
+        raise InvalidParameterError("rtol", "[1e-12, 1)", rtol)
+    if method not in ("BDF", "Radau"):
+        raise InvalidParameterError("method", "{'BDF', 'Radau'}", method)
+    if (inlet_pressure is None) == (inlet_flow_rate is None):
+        raise InvalidParameterError("inlet_pressure / inlet_flow_rate", "exactly one of the two", None)
+    inlet_kind = "pressure" if inlet_pressure is not None else "flow"
+    inlet = _boundary("inlet_pressure" if inlet_kind == "pressure" else "inlet_flow_rate",
+                      inlet_pressure if inlet_kind == "pressure" else inlet_flow_rate)
+    if isinstance(outlet, str) and outlet == "open":
+        outlet_kind, outlet_value = "pressure", _boundary("outlet_pressure", outlet_pressure)
+    elif isinstance(outlet, str) and outlet == "closed":
+        outlet_kind, outlet_value = "closed", None
+    elif isinstance(outlet, Chamber):
+        outlet_kind, outlet_value = "chamber", outlet
+    elif callable(outlet):
+        outlet_kind, outlet_value = "chamber", Chamber(volume=outlet)
+    else:
+        raise InvalidParameterError("outlet", "'open', 'closed', a Chamber or a callable V(p)", outlet)
+    p_ext = float(external_pressure)
+    n = 16 if cells is None else int(cells)
+    if not (2 <= n <= MAX_CELLS):
+        raise InvalidParameterError("cells", f"[2, {MAX_CELLS}]", cells)
+    a, t, length = float(tube.radius), float(tube.thickness), float(tube.length)
+    t0 = times[0]
+    p_rest = float(_elementwise(outlet_value, t0, "outlet_pressure")) if outlet_kind == "pressure" else 0.0
+    # the pressure scale: the largest boundary pressure met, or a pump's steady inlet pressure
+    sample = np.linspace(times[0], times[-1], 33)
+    if inlet_kind == "pressure":
+        scale = float(np.max(np.abs(_elementwise(inlet, sample, "inlet_pressure") - p_ext)))
+    else:
+        q = float(np.max(np.abs(_elementwise(inlet, sample, "inlet_flow_rate"))))
+        scale = float(np.max(rheo.pressure_gradient(q, a))) * length if q > 0 else 0.0
+    if outlet_kind == "pressure":
+        scale = max(scale, float(np.max(np.abs(_elementwise(outlet_value, sample, "outlet_pressure") - p_ext))))
+    scale = max(scale, abs(p_rest - p_ext), 1e-300)
+    if initial is not None and not isinstance(initial, Solution):
+        initial = float(initial)
+        scale = max(scale, abs(initial - p_ext))
+    system = _System(rheology=rheo, wall=wall, radius=a, tb=t / a, length=length, external=p_ext, n=n,
+                     inlet_kind=inlet_kind, inlet=inlet, outlet_kind=outlet_kind, outlet=outlet_value,
+                     pressure_scale=scale)
+    start = p_rest if initial is None else initial
+
+    def y0_of(sys_):
+        return sys_.initial_state(start, t0)
+
+    return system, times, y0_of, rtol, method
+
+
+def _check_validity(result: Transient, density: float) -> None:
+    r"""Warn where the quasi-steady, inertia-free model fails: the Womersley number
+    :math:`a\sqrt{\rho/(\mu t_c)}` with the apparent viscosity at the inlet's largest flow and the
+    process time :math:`t_c` (the 50 % settling time, else the span), and :math:`Re\,a/L`."""
+    sy = result._system
+    k = int(np.argmax(np.abs(result.inlet_flow_rate)))
+    q = abs(float(result.inlet_flow_rate[k]))
+    if q == 0.0:
+        return
+    r = float(result.radius_nodes[k, 0])
+    g = float(sy.rheology.pressure_gradient(q, r))
+    tau_w = 0.5 * g * r
+    rate = 4.0 * q / (math.pi * r**3)
+    mu = tau_w / rate
+    try:
+        t_c = result.settling_time(0.5)
+    except (InvalidParameterError, NoSteadyStateError):
+        t_c = math.inf
+    if not math.isfinite(t_c) or t_c <= 0:
+        t_c = float(result.times[-1] - result.times[0])
+    womersley = sy.radius * math.sqrt(density / (mu * t_c))
+    velocity = q / (math.pi * r * r)
+    reduced_re = 8.0 * density * velocity**2 / tau_w * r / sy.length
+    if womersley > WOMERSLEY:
+        warn_user(f"evolve: the Womersley number a*sqrt(rho/(mu t_c)) = {womersley:.3g} exceeds {WOMERSLEY} "
+                  f"(t_c = {t_c:.3g} s): fluid inertia is not negligible on this time scale", ModelValidityWarning)
+    if reduced_re > REDUCED_REYNOLDS:
+        warn_user(f"evolve: the reduced Reynolds number Re a/L = {reduced_re:.3g} exceeds {REDUCED_REYNOLDS}: "
+                  "inertia is not negligible", ModelValidityWarning)
