@@ -10,6 +10,8 @@ Gauss–Newton covariance of a Jacobian by central differences of independent ne
 from __future__ import annotations
 
 import math
+import pathlib
+import re
 import warnings
 
 import numpy as np
@@ -146,3 +148,19 @@ def test_unsupported_data_warn():
         warnings.simplefilter("always")
         net.fit(flow_rate={("a", "b"): 1e-9}, pressure={"b": 10.0}, moduli={"g": [("a", "b")]})
     assert any(issubclass(w.category, tubefsi.FitWarning) and "not determined" in str(w.message) for w in caught)
+
+
+def test_the_calibration_snippet_of_the_docs_runs_and_recovers_its_truth():
+    """docs/network.md, "Calibration": its Python block runs (it once gave 3 measurements for 3
+    parameters) and recovers the values its synthetic measurements were made with."""
+    text = (pathlib.Path(__file__).parents[1] / "docs" / "network.md").read_text()
+    section = text[text.index("## Calibration"):]
+    block = re.search(r"```python\n(.*?)```", section, flags=re.S).group(1)
+    namespace: dict = {}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", tubefsi.ModelValidityWarning)
+        exec(compile(block.replace("print(fitted)", "str(fitted)"), "docs/network.md", "exec"), namespace)
+    found = namespace["fitted"].parameters
+    truth = {"modulus[arteries]": 30e3, "modulus[branches]": 10e3, "resistance[b]": 2e12}
+    for name, value in truth.items():
+        assert abs(found[name] / value - 1) < 1e-8, (name, found[name])

@@ -437,10 +437,8 @@ class Network:
         pressure_sigma, flow_sigma : float, optional
             The scales of the pressure and flow residuals (default: the root mean square of the
             measured values of each kind).
-
-        Every parameter is fitted through its logarithm, within a factor 1e4 of its start, with
-        the analytic Jacobian of the implicit function theorem on the Kirchhoff system; each
-        evaluation is one :meth:`solve`, warm-started from the previous one.
+        rtol : float, optional
+            The relative tolerance of each network solve (as :meth:`solve`).
 
         Returns
         -------
@@ -453,6 +451,12 @@ class Network:
         -----
         FitWarning
             Where the data do not support the fit (as :func:`tubefsi.fit`).
+
+        Notes
+        -----
+        Every parameter is fitted through its logarithm, within a factor 1e4 of its start, with
+        the analytic Jacobian of the implicit function theorem on the Kirchhoff system; each
+        evaluation is one :meth:`solve`, warm-started from the previous one.
         """
         return fit_network(self, pressure=pressure, flow_rate=flow_rate, moduli=moduli, resistances=resistances,
                            pressure_sigma=pressure_sigma, flow_sigma=flow_sigma,
