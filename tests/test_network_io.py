@@ -339,3 +339,17 @@ def test_random_tables_round_trip(tmp_path_factory, n, data):
     again = tmp_path_factory.mktemp("tables") / "again.csv"
     network_io.write_network_table(tubefsi.read_network_table(path, rheology=NEWTONIAN), again)
     assert network_io.network_table(tubefsi.read_network_table(again, rheology=NEWTONIAN)) == columns
+
+
+@pytest.mark.parametrize("wall", [walls["thin-linear"](youngs_modulus=1e6, poisson_ratio=0.3),
+                                  walls["thick-linear"](youngs_modulus=1e6, poisson_ratio=0.5),
+                                  walls["thin-neo-hookean"](shear_modulus=3e5)])
+def test_the_table_refuses_a_wall_it_would_read_back_as_another(tmp_path, wall):
+    """The table keeps E and h only and reading makes openBF's wall (thin linear, nu = 1/2): a
+    thin linear wall with nu = 0.3 once came back with nu = 1/2 (its strain 11 % smaller), a thick
+    one as a thin one, silently."""
+    net = tubefsi.Network(rheology=NEWTONIAN)
+    net.add_tube(1, 2, wall, tubefsi.Tube(radius=2e-3, thickness=2e-4, length=0.1))
+    net.set_inflow(1, 1e-6).set_pressure(2, 0.0)
+    with pytest.raises(InvalidParameterError, match=r"tube \(1, 2\)"):
+        tubefsi.write_network_table(net, tmp_path / "net.csv")

@@ -85,6 +85,20 @@ def openbf_wall(youngs_modulus, thickness=None, radius=None):
     return _walls["thin-linear"](youngs_modulus=youngs_modulus, poisson_ratio=0.5)
 
 
+def _check_openbf_walls(network):
+    """Refuse a wall the table cannot hold: the table keeps only ``E`` (and ``h``), and reading
+    it back makes :func:`openbf_wall`, so any other linear wall (a ``poisson_ratio`` other than
+    1/2, a thick wall) would come back as a different tube law."""
+    for tube in network._tubes.values():
+        wall = tube.wall
+        ratio = np.asarray(getattr(wall, "poisson_ratio", math.nan), dtype=float)
+        if type(wall) is not _walls["thin-linear"] or not np.all(ratio == 0.5):
+            raise InvalidParameterError(
+                f"tube {tube.name!r}", "openBF's wall, walls['thin-linear'] with poisson_ratio=0.5 (the table "
+                "keeps only E and h, and reading it makes that wall: another wall would come back as a "
+                "different tube law; write_vtp writes any network, for viewing)", wall)
+
+
 def _wall_maker(wall):
     """``wall`` as a factory ``(E, h, R) -> WallModel``, and whether it needs the column E."""
     if wall is None:
@@ -443,6 +457,7 @@ def network_table(network, *, thickness="auto") -> dict:
         k = int(np.flatnonzero(bad)[0])
         raise InvalidParameterError(f"tube {g['name'][k]!r}", "a wall with a youngs_modulus (the table form holds "
                                     "linear elastic walls)", type(network._tubes[g["name"][k]].wall).__name__)
+    _check_openbf_walls(network)
     resistance = network._resistance
     # a resistance outlet on the first vessel that ends at its node
     first_into = {}
