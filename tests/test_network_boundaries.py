@@ -236,6 +236,8 @@ def test_bulk_boundary_conditions_are_the_single_ones():
         net.set_pressures(["a", "b"], [1.0, -2.0])
     with pytest.raises(InvalidParameterError, match="length 2"):
         net.set_pressures(["a", "b"], [1.0, 2.0, 3.0])
+    with pytest.raises(InvalidParameterError, match=r"nodes\[2\].*not named earlier"):
+        net.set_pressures(["a", "b", "a"], [0.0, 1.0, 5.0])    # the last value once won silently
     net.set_inflows(["a"], 1e-12)
     with pytest.raises(InvalidParameterError, match="inflow already"):
         net.set_pressures(["b", "a"], 1.0)

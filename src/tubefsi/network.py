@@ -278,6 +278,10 @@ class Network:
     def _many(self, nodes, values, label, admissible, check):
         """``(nodes, values)`` of a bulk setter as lists, the values checked and broadcast."""
         nodes = _names_of("nodes", nodes)
+        if len(set(nodes)) != len(nodes):      # two values for one node: which one is meant?
+            seen = set()
+            k = next(k for k, node in enumerate(nodes) if node in seen or seen.add(node))
+            raise InvalidParameterError(f"nodes[{k}]", "a node not named earlier in the same call", nodes[k])
         array = as_array(label, values, admissible, check)
         if array.shape not in ((), (len(nodes),)):
             raise InvalidParameterError(label, f"a number or an array of length {len(nodes)} (one per node)",
