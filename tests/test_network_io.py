@@ -353,3 +353,20 @@ def test_the_table_refuses_a_wall_it_would_read_back_as_another(tmp_path, wall):
     net.set_inflow(1, 1e-6).set_pressure(2, 0.0)
     with pytest.raises(InvalidParameterError, match=r"tube \(1, 2\)"):
         tubefsi.write_network_table(net, tmp_path / "net.csv")
+
+
+def test_plausible_mistakes_give_typed_errors_naming_the_argument(tmp_path):
+    """A missing table file, positions that are not a mapping or whose entry is not a point, and
+    an array where a node takes one pressure once gave FileNotFoundError, ValueError and
+    TypeError from Python."""
+    net = tubefsi.Network(rheology=NEWTONIAN)
+    net.add_tube("a", "b", walls["thin-linear"](youngs_modulus=1e6, poisson_ratio=0.5),
+                 tubefsi.Tube(radius=1e-3, thickness=1e-4, length=0.1))
+    with pytest.raises(InvalidParameterError, match="source must be a readable CSV file"):
+        tubefsi.read_network_table(tmp_path / "missing.csv", rheology=NEWTONIAN)
+    with pytest.raises(InvalidParameterError, match="positions must be a mapping"):
+        network_io.write_vtp(net, tmp_path / "x.vtp", positions="abc")
+    with pytest.raises(InvalidParameterError, match=r"positions\['a'\]"):
+        network_io.write_vtp(net, tmp_path / "x.vtp", positions={"a": "xy", "b": (0, 1)})
+    with pytest.raises(InvalidParameterError, match="pressure .*a single number"):
+        net.set_pressure("a", np.array([1.0, 2.0]))

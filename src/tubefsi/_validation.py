@@ -158,6 +158,14 @@ def as_array(name, value, admissible, predicate):
     return a
 
 
+def as_scalar(name, value, admissible, predicate) -> float:
+    """:func:`as_array` of one number: a float, or an error naming ``name`` for an array."""
+    a = as_array(name, value, admissible, predicate)
+    if a.ndim:
+        raise InvalidParameterError(name, admissible, value, "a single number")
+    return float(a)
+
+
 def positive_scalar(name, value) -> float:
     """A finite float ``> 0``."""
     a = real_array(name, value, "(0, inf)")

@@ -15,7 +15,7 @@ import numpy as np
 
 from ._keywords import checked_keywords
 from ._progress import bar
-from ._validation import as_array
+from ._validation import as_array, as_scalar
 from .errors import InvalidParameterError
 from .fields import broadcast_model, varies, _array_fields, parameter_shape
 from .geometry import Tube
@@ -222,14 +222,14 @@ class Network:
     def set_pressure(self, node: Hashable, pressure: float) -> Network:
         """Fix the (transmural, gauge) pressure of ``node`` (Pa, >= 0)."""
         self._free_of(node, "pressure")
-        self._pressure[node] = float(as_array("pressure", pressure, "[0, inf)", lambda a: a >= 0))
+        self._pressure[node] = as_scalar("pressure", pressure, "[0, inf)", lambda a: a >= 0)
         return self
 
     @checked_keywords
     def set_inflow(self, node: Hashable, flow_rate: float) -> Network:
         """Inject ``flow_rate`` (m^3/s; negative: withdraw) at ``node``."""
         self._free_of(node, "inflow")
-        self._inflow[node] = float(as_array("flow_rate", flow_rate, "(-inf, inf)", np.isfinite))
+        self._inflow[node] = as_scalar("flow_rate", flow_rate, "(-inf, inf)", np.isfinite)
         return self
 
     @checked_keywords
@@ -239,8 +239,8 @@ class Network:
         the network at ``node`` (the steady state of a Windkessel, whose resistance is R1 + R2).
         A component with a resistance outlet needs no fixed pressure."""
         self._free_of(node, "resistance")
-        r = float(as_array("resistance", resistance, "(0, inf) Pa s/m^3", lambda a: np.isfinite(a) & (a > 0)))
-        p_d = float(as_array("distal_pressure", distal_pressure, "the real numbers (Pa)", np.isfinite))
+        r = as_scalar("resistance", resistance, "(0, inf) Pa s/m^3", lambda a: np.isfinite(a) & (a > 0))
+        p_d = as_scalar("distal_pressure", distal_pressure, "the real numbers (Pa)", np.isfinite)
         self._resistance[node] = (r, p_d)
         return self
 
@@ -408,7 +408,7 @@ class Network:
             When rounding alone (pressures close to a limit pressure) keeps the mass balance above
             ``rtol`` times the throughput; the warning gives the balance reached.
         """
-        rtol = float(as_array("rtol", rtol, "[1e-15, 1)", lambda a: (a >= 1e-15) & (a < 1)))
+        rtol = as_scalar("rtol", rtol, "[1e-15, 1)", lambda a: (a >= 1e-15) & (a < 1))
         if isinstance(max_iterations, bool) or not isinstance(max_iterations, int) or max_iterations < 1:
             raise InvalidParameterError("max_iterations", "the integers >= 1", max_iterations)
         start = _initial_pressures(initial)
@@ -464,7 +464,7 @@ class Network:
         """
         return fit_network(self, pressure=pressure, flow_rate=flow_rate, moduli=moduli, resistances=resistances,
                            pressure_sigma=pressure_sigma, flow_sigma=flow_sigma,
-                           rtol=float(as_array("rtol", rtol, "[1e-15, 1)", lambda a: (a >= 1e-15) & (a < 1))))
+                           rtol=as_scalar("rtol", rtol, "[1e-15, 1)", lambda a: (a >= 1e-15) & (a < 1)))
 
     def _snapshot(self):
         """A copy that later changes to this network do not reach (the solution keeps it)."""
@@ -484,7 +484,7 @@ def _initial_pressures(initial):
         raise InvalidParameterError("initial", "a NetworkSolution or a mapping node -> pressure (Pa)", initial)
     start = {}
     for node, value in initial.items():
-        start[node] = float(as_array(f"initial[{node!r}]", value, "[0, inf) Pa", lambda a: np.isfinite(a) & (a >= 0)))
+        start[node] = as_scalar(f"initial[{node!r}]", value, "[0, inf) Pa", lambda a: np.isfinite(a) & (a >= 0))
     return start
 
 

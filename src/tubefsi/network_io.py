@@ -212,9 +212,12 @@ def _column_key(raw):
 def _read_csv(path):
     """The header, the rows and their line numbers of a CSV file; ``#`` starts a comment line;
     a trailing empty column (openBF's rows end with a comma) is dropped."""
-    with open(path, newline="", encoding="utf-8") as fh:
-        lines = [(i + 1, line) for i, line in enumerate(fh) if line.strip() and not line.lstrip().startswith("#")]
     label = Path(path).name
+    try:
+        with open(path, newline="", encoding="utf-8") as fh:
+            lines = [(i + 1, line) for i, line in enumerate(fh) if line.strip() and not line.lstrip().startswith("#")]
+    except (OSError, UnicodeDecodeError) as err:
+        raise InvalidParameterError("source", "a readable CSV file (UTF-8)", label, str(err)) from None
     if not lines:
         raise InvalidParameterError(label, "a table with a header and at least one row", "an empty file")
     parsed = [(i, row) for i, row in zip((i for i, _ in lines), csv.reader(line for _, line in lines))]
@@ -591,12 +594,17 @@ _NODE_DATA = ("fixed_pressure", "inflow", "resistance", "distal_pressure")
 
 
 def _positions(network, positions):
+    if positions is not None and not hasattr(positions, "keys"):
+        raise InvalidParameterError("positions", "a mapping node -> (x, y) or (x, y, z) (m)", positions)
     pos = dict(network.positions if positions is None else positions)
     if any(node not in pos for node in network.nodes):
         pos = {**tree_layout(network), **pos}
     xyz = np.zeros((len(network.nodes), 3))
     for i, node in enumerate(network.nodes):
-        p = np.asarray(pos[node], dtype=float).ravel()
+        try:
+            p = np.asarray(pos[node], dtype=float).ravel()
+        except (TypeError, ValueError):
+            p = np.array([math.nan])
         if p.size not in (2, 3) or not np.all(np.isfinite(p)):
             raise InvalidParameterError(f"positions[{node!r}]", "two or three finite coordinates (m)", pos[node])
         xyz[i, :p.size] = p
