@@ -189,6 +189,21 @@ class _System:
             raise InvalidParameterError("stretch", "stretches the wall holds", float(np.max(1.0 + strain)))
         return p + self.external
 
+    def face_flow(self, radius, gradient):
+        r""":math:`\operatorname{sign}(G)\,Q(R, |G|)` by the rheology's flow hook ``_flow_rate``:
+        the physics of :meth:`Rheology.flow_rate` without its argument checks (the radii and
+        gradients here are the scheme's own; the checks cost more than the flow law of a power
+        law). A flow beyond the doubles gets the public method's typed error."""
+        g = np.abs(gradient)
+        q = np.zeros(g.shape)
+        live = g > 0
+        with np.errstate(all="ignore"):
+            q[live] = self.rheology._flow_rate(radius[live], g[live])
+        if not np.all(np.isfinite(q)):
+            self.rheology.flow_rate(radius, g)          # raises the typed error
+            raise InvalidParameterError("pressure gradient", "gradients of a finite flow", float(np.max(g)))
+        return np.copysign(q, gradient)
+
     def fluxes(self, t, s, p_chamber=None):
         """``(p, lam, q)``: cell pressures and stretches and the ``n + 1`` face flow rates, for
         states ``s`` of shape ``(..., n)`` at times ``t`` (broadcast with ``s[..., 0]``)."""
@@ -211,7 +226,7 @@ class _System:
         h[0] = h[-1] = 0.5 * self.dz
         G = -np.diff(P, axis=-1) / h
         lam_f = np.concatenate([lam[..., :1], 0.5 * (lam[..., :-1] + lam[..., 1:]), lam[..., -1:]], axis=-1)
-        q = np.sign(G) * self.rheology.flow_rate(self.radius * lam_f, np.abs(G))
+        q = self.face_flow(self.radius * lam_f, G)
         if self.inlet_kind == "flow":
             q[..., 0] = _elementwise(self.inlet, t, "inlet_flow_rate")
         if self.outlet_kind == "closed":
@@ -686,44 +701,74 @@ def evolve(rheology, wall, tube: Tube, times, *, inlet_pressure=None, inlet_flow
                                                 outlet_pressure, outlet, external_pressure, initial, rtol, method,
                                                 cells)
     n = system.n
+    if error_control and 4 * n > MAX_CELLS:
+        raise InvalidParameterError("cells", f"[2, {MAX_CELLS // 4}] with error control (its finest run has four "
+                                    "times the cells)", cells)
     if not error_control:
         fields, nfev = _run(system, times, y0_of(system), rtol, method)
         return _result(system, times, fields, n, rtol, math.inf, math.inf, nfev, density)
     tol = 0.1 * rtol
-    total = 0
-    loose = sharp = None           # the coarse grid at tol and at tol/10
+    runs = {}                      # (cells, integrator tolerance) -> (fields, rhs evaluations), this call's
+
+    def run(cells, tolerance):
+        if (cells, tolerance) not in runs:
+            sys_n = attrs.evolve(system, n=cells)
+            runs[cells, tolerance] = _run(sys_n, times, y0_of(sys_n), tolerance, method)
+        return runs[cells, tolerance][0]
+
     while True:
-        if loose is None:
-            loose, nfev = _run(system, times, y0_of(system), tol, method)
-            total += nfev
-        if sharp is None:
-            sharp, nfev = _run(system, times, y0_of(system), 0.1 * tol, method)
-            total += nfev
-        fine_sys = attrs.evolve(system, n=2 * system.n)
-        fine, nfev = _run(fine_sys, times, y0_of(fine_sys), 0.1 * tol, method)
-        total += nfev
-        # space: the two grids at the same tolerance (second order); time: the coarse grid at two
-        # tolerances (the reported run has the tighter one: the estimate is conservative)
-        e_space = _difference(_monitored(system, sharp), _monitored(system, fine)) / 3.0
-        e_time = _difference(_monitored(system, loose), _monitored(system, sharp))
+        # the reported runs: n, 2n, 4n cells at tol/10; the time estimate: n cells at tol and tol/10
+        loose, coarse, middle, fine = run(n, tol), run(n, 0.1 * tol), run(2 * n, 0.1 * tol), run(4 * n, 0.1 * tol)
+        h1, h2, h4 = (_monitored(system, f) for f in (coarse, middle, fine))
+        # space: the Richardson extrapolations of the pairs (n, 2n) and (2n, 4n); their difference is
+        # the error of the coarser pair's, conservative for the reported finer pair's (third order)
+        e_space = _difference(_extrapolated(h1, h2), _extrapolated(h2, h4))
+        # time: the error of the run at tol, conservative for the reported ones at tol/10; the
+        # extrapolation (4 h_4n - h_2n)/3 adds the time errors of two runs with weights 4/3 and 1/3
+        e_time = 5.0 / 3.0 * _difference(_monitored(system, loose), h1)
+        total = sum(nfev for _, nfev in runs.values())
+        fine_sys = attrs.evolve(system, n=4 * n)
         if e_space + e_time <= rtol:
-            return _result(fine_sys, times, fine, fine_sys.n, 0.1 * tol, e_space, e_time, total, density)
-        grow_space = e_space > 0.5 * rtol and 2 * fine_sys.n <= MAX_CELLS
+            return _result(fine_sys, times, _extrapolated_fields(middle, fine), fine_sys.n, 0.1 * tol, e_space,
+                           e_time, total, density)
+        grow_space = e_space > 0.5 * rtol and 8 * n <= MAX_CELLS
         grow_time = e_time > 0.5 * rtol and tol > _MIN_RTOL
         if not (grow_space or grow_time):
             warn_user(f"evolve: the estimated relative error of the inlet history, {e_space + e_time:.2g} "
                       f"(space {e_space:.2g} at {fine_sys.n} cells, time {e_time:.2g}), misses rtol = {rtol:g}",
                       AccuracyWarning)
-            return _result(fine_sys, times, fine, fine_sys.n, 0.1 * tol, e_space, e_time, total, density)
+            return _result(fine_sys, times, _extrapolated_fields(middle, fine), fine_sys.n, 0.1 * tol, e_space,
+                           e_time, total, density)
         if grow_space:
-            # second order: the cells for the target, from the estimate, as a power of two
-            factor = math.sqrt(e_space / (0.4 * rtol))
-            k = max(1, math.ceil(math.log2(factor)))
-            system = attrs.evolve(system, n=min(fine_sys.n * 2 ** (k - 1), MAX_CELLS // 2))
-            loose = sharp = None
+            # the extrapolated values converge at third order: the cells for the target, as a power of two
+            factor = (e_space / (0.4 * rtol)) ** (1.0 / 3.0)
+            n = min(n * 2 ** max(1, math.ceil(math.log2(factor))), MAX_CELLS // 4)
         if grow_time:
             tol = max(0.1 * tol, _MIN_RTOL)
-            loose, sharp = (sharp if not grow_space else None), None      # the old tol/10 run is the new tol run
+
+
+def _extrapolated(coarse, fine):
+    """The Richardson extrapolation :math:`(4 h_{2n} - h_n)/3` of a second-order quantity."""
+    return fine + (fine - coarse) / 3.0
+
+
+#: The histories at the ends of the tube, the same points on every grid: extrapolated.
+_HISTORIES = ("stored", "volume_in", "volume_out", "chamber_pressure")
+
+
+def _extrapolated_fields(middle, fine):
+    """The fields of the run on 4n cells with the boundary histories (the flow rate, pressure and
+    radius at the inlet and the outlet, the stored volume, the volumes in and out, the chamber
+    pressure) Richardson-extrapolated from the runs on 2n and 4n cells; the mass error is the run's."""
+    out = dict(fine)
+    for key in _HISTORIES:
+        if fine[key] is not None:
+            out[key] = _extrapolated(middle[key], fine[key])
+    for key in ("pressure_nodes", "radius_nodes", "flow_faces"):
+        values = fine[key].copy()
+        values[:, [0, -1]] = _extrapolated(middle[key][:, [0, -1]], fine[key][:, [0, -1]])
+        out[key] = values
+    return out
 
 
 def _result(system, times, fields, cells, tol, e_space, e_time, total, density):
