@@ -24,12 +24,15 @@ second order in :math:`\Delta z`. Time: :func:`scipy.integrate.solve_ivp` (``BDF
 grouped forward differences: four right-hand sides per Jacobian (five with a chamber).
 
 **Error control.** The inlet history (the flow rate for a pressure inlet, the pressure for a pump)
-is computed on ``n`` and ``2n`` cells at the integrator tolerance :math:`\tau/10` (space estimate
-:math:`|h_{2n} - h_n|/3`, second order) and on ``n`` cells at :math:`\tau` (time estimate
-:math:`|h_{n,\tau} - h_{n,\tau/10}|`, conservative for the reported run at :math:`\tau/10`); the cells
+is computed on ``n``, ``2n`` and ``4n`` cells at the integrator tolerance :math:`\tau/10`; the
+reported boundary histories are the Richardson extrapolation :math:`E_{2n,4n} = h_{4n} + (h_{4n} -
+h_{2n})/3` (third order), the space estimate :math:`|E_{n,2n} - E_{2n,4n}|` (the coarser
+extrapolation's error, conservative for the reported one); the time estimate is
+:math:`\tfrac53|h_{n,\tau} - h_{n,\tau/10}|` (the error of a run at :math:`\tau`, conservative for the
+reported runs at :math:`\tau/10`; :math:`\tfrac53` bounds the extrapolation's weights). The cells
 grow and the tolerance falls until their sum, relative to the history's largest value, meets
-``rtol``, else an :class:`~tubefsi.AccuracyWarning` states the estimate. The run on ``2n`` cells is
-the result.
+``rtol``, else an :class:`~tubefsi.AccuracyWarning` states the estimate. The fields inside the tube
+are the ``4n`` run's.
 """
 
 from __future__ import annotations
@@ -309,7 +312,9 @@ class Transient:
 
     Fields are stored at the nodes ``z`` (the inlet, the cell centres, the outlet) and the flow
     rate at the cell faces; :meth:`pressure`, :meth:`radius` and :meth:`flow_rate` interpolate
-    linearly in z and in t (exact at the nodes and the output times, to the error estimate)."""
+    linearly in z and in t (exact at the nodes and the output times, to the error estimate). With
+    error control the values at the ends (z = 0 and L) and the volume histories are the Richardson
+    extrapolation of the two finest runs, the values inside the tube the finest run's."""
 
     #: The output times (s).
     times: np.ndarray = attrs.field(repr=False)
@@ -680,7 +685,8 @@ def evolve(rheology, wall, tube: Tube, times, *, inlet_pressure=None, inlet_flow
         Requested relative accuracy of the inlet history (the flow rate behind a pressure inlet,
         the pressure behind a pump), relative to its largest value.
     cells : int, optional
-        Start the refinement at this many cells (default 16); with ``error_control=False``, the
+        The coarsest grid of the refinement (default 16; at most ``MAX_CELLS / 4``: the error
+        control runs ``cells``, twice and four times as many); with ``error_control=False``, the
         cells of the one run.
     method : {"BDF", "Radau"}
         The stiff integrator of :func:`scipy.integrate.solve_ivp`.
@@ -694,6 +700,10 @@ def evolve(rheology, wall, tube: Tube, times, *, inlet_pressure=None, inlet_flow
     Returns
     -------
     Transient
+        With error control: the fields inside the tube of the finest run (``cells`` is its
+        count), the boundary histories (inlet and outlet flow, pressure and radius, the chamber
+        pressure, the stored volume, the volumes in and out) Richardson-extrapolated from the two
+        finest runs, :math:`h_{4n} + (h_{4n} - h_{2n})/3`.
     """
     rheo = resolve("rheology", rheology)
     wall_model = resolve("wall", wall)
