@@ -20,8 +20,10 @@ natural hook of every registered wall: no inversion of the tube law in the loop)
 through a face is :math:`Q(-(p_{i+1} - p_i)/\Delta z, a\bar\lambda)` with the mean stretch of
 the two cells (at a boundary: the half cell to the boundary pressure, the stretch of the cell),
 second order in :math:`\Delta z`. Time: :func:`scipy.integrate.solve_ivp` (``BDF`` or
-``Radau``) with a sparse (tridiagonal plus the chamber and the volume counters) Jacobian by
-grouped forward differences: four right-hand sides per Jacobian (five with a chamber).
+``Radau``) with the exact sparse Jacobian (tridiagonal plus the chamber and the volume
+counters): the face flows' slopes :math:`\partial Q/\partial G = (\pi R^3\dot\gamma_w - 3Q)/G`,
+:math:`\partial Q/\partial R = \pi R^2\dot\gamma_w` from the rheology's shear rate at the wall
+stress, the cells' :math:`dp/ds` from the wall's stiffness; about two right-hand sides per Jacobian.
 
 **Error control.** The inlet history (the flow rate for a pressure inlet, the pressure for a pump)
 is computed on ``n``, ``2n`` and ``4n`` cells at the integrator tolerance :math:`\tau/10`; the
@@ -247,46 +249,74 @@ class _System:
         out[-2], out[-1] = q[0], q[-1]
         return out
 
-    def pattern(self):
-        """``(rows, cols)`` of the Jacobian's nonzero entries: the cells' tridiagonal band, the
-        chamber's coupling to the last cell, the counters' to the end cells."""
-        n, m = self.n, self.size
-        rows, cols = [], []
-        for d in (-1, 0, 1):
-            i = np.arange(max(0, -d), min(n, n - d))
-            rows.append(i)
-            cols.append(i + d)
-        extra = [(m - 2, 0), (m - 1, n - 1)]
-        if self.outlet_kind == "chamber":
-            extra += [(n, n - 1), (n, n), (n - 1, n), (m - 1, n)]
-        rows.append(np.array([r for r, _ in extra]))
-        cols.append(np.array([c for _, c in extra]))
-        return np.concatenate(rows), np.concatenate(cols)
+    def face_slopes(self, radius, gradient):
+        r"""The derivatives of the face flow :math:`q = \operatorname{sign}(G)\,Q(R, |G|)`:
+        ``(dq/dG, dq/dR)``, from the Rabinowitsch–Mooney form :math:`Q = \pi R^3\Gamma(\tau_w)/4`,
+        :math:`\tau_w = GR/2`, whose slope :math:`d\Gamma/d\tau_w` follows from
+        :math:`\Gamma = (4/\tau_w^3)\int_0^{\tau_w}\tau^2\dot\gamma(\tau)\,d\tau`:
 
-    def jacobian(self, t, y, s_scale):
-        r"""The Jacobian by forward differences, the cells in three groups (columns ``j = g mod 3``
-        touch disjoint rows) and the chamber's pressure apart: four or five right-hand sides. The
-        steps, :math:`\max(10^{-6}\max(|s_j|, s_{scale}), 10^{-9})`, stay well above the rounding
-        of the stretch :math:`\sqrt{1+s}` at tiny strains; the counters' columns are zero."""
+        .. math::
+
+            \frac{\partial Q}{\partial G} = \frac{\pi R^3\dot\gamma_w - 3Q}{G}, \qquad
+            \frac{\partial Q}{\partial R} = \pi R^2\dot\gamma_w, \qquad \dot\gamma_w = \dot\gamma(\tau_w)
+
+        (the rheology's flow hook and its shear rate at the wall stress; Newtonian:
+        :math:`\pi R^4/8\mu` and :math:`4Q/R`). At rest (:math:`G = 0`, where the first is a limit)
+        both are taken at a gradient of :math:`10^{-8}` of the problem's scale: the Jacobian steers
+        Newton's iteration, the residual stays exact."""
+        floor = 1e-8 * self.pressure_scale / self.length
+        g = np.maximum(np.abs(gradient), floor)
+        q = self.face_flow(radius, g)
+        rate = self.rheology.shear_rate(0.5 * g * radius)
+        d_gradient = (math.pi * radius**3 * rate - 3.0 * q) / g
+        d_radius = np.copysign(math.pi * radius**2 * rate, gradient)
+        return d_gradient, d_radius
+
+    def jacobian(self, t, y):
+        r"""The exact Jacobian of :meth:`rhs`: the cells' tridiagonal band from the face flows'
+        slopes (:meth:`face_slopes`), the cells' :math:`dp/ds = P'(\lambda)/(2\lambda)` (the wall's
+        stiffness) and :math:`d\lambda/ds = 1/(2\lambda)`, the chamber's coupling to the last cell,
+        the counters' to the end cells. Costs about two right-hand sides."""
         n, m = self.n, self.size
-        rows, cols = self.pattern()
-        f0 = self.rhs(t, y)
-        h = np.zeros(m)
-        h[:n] = 1e-7 * np.maximum(np.abs(y[:n]), s_scale)
-        group = np.where(cols < n, cols % 3, 3)
-        if self.outlet_kind == "chamber":
-            h[n] = 1e-7 * max(abs(float(y[n])), self.pressure_scale)
-        vals = np.zeros(rows.size)
-        for g in range(4 if self.outlet_kind == "chamber" else 3):
-            mask = group == g
-            if not np.any(mask):
-                continue
-            step = np.zeros(m)
-            picked = np.unique(cols[mask])
-            step[picked] = h[picked]
-            df = self.rhs(t, y + step) - f0
-            vals[mask] = df[rows[mask]] / h[cols[mask]]
-        return sparse.csc_matrix((vals, (rows, cols)), shape=(m, m))
+        chamber = self.outlet_kind == "chamber"
+        s = y[:n]
+        p, lam, q = self.fluxes(t, s, y[n] if chamber else None)
+        dp = self.wall.stiffness(lam, self.tb) / (2.0 * lam)            # dp_i/ds_i
+        dlam = 0.5 / lam                                                  # dlambda_i/ds_i
+        # the faces' gradients and radii as in fluxes, and the slopes
+        p0 = p[0] if self.inlet_kind == "flow" else float(_elementwise(self.inlet, t, "inlet_pressure"))
+        pl = {"pressure": lambda: float(_elementwise(self.outlet, t, "outlet_pressure")),
+              "chamber": lambda: float(y[n]), "closed": lambda: p[-1]}[self.outlet_kind]()
+        h = np.full(n + 1, self.dz)
+        h[0] = h[-1] = 0.5 * self.dz
+        G = -np.diff(np.concatenate([[p0], p, [pl]])) / h
+        weight = np.full(n + 1, 0.5)
+        weight[0] = weight[-1] = 1.0
+        lam_f = np.concatenate([lam[:1], 0.5 * (lam[:-1] + lam[1:]), lam[-1:]])
+        q_g, q_r = self.face_slopes(self.radius * lam_f, G)
+        # face j sits between cell j-1 (left) and cell j (right)
+        left = q_g[1:] / h[1:] * dp + q_r[1:] * self.radius * weight[1:] * dlam       # dq_j/ds_{j-1}, j = 1..n
+        right = -q_g[:-1] / h[:-1] * dp + q_r[:-1] * self.radius * weight[:-1] * dlam  # dq_j/ds_j, j = 0..n-1
+        if self.inlet_kind == "flow":
+            right[0] = 0.0
+        if self.outlet_kind == "closed":
+            left[-1] = 0.0
+        volume = math.pi * self.radius**2 * self.dz
+        i = np.arange(n)
+        rows = [i, i[1:], i[:-1], [m - 2], [m - 1]]
+        cols = [i, i[:-1], i[1:], [0], [n - 1]]
+        vals = [(right - left) / volume, left[:-1] / volume, -right[1:] / volume, [right[0]], [left[-1]]]
+        if chamber:
+            c = float(self.outlet.compliance_at(y[n], self.pressure_scale))
+            step = 1e-4 * max(abs(float(y[n])), self.pressure_scale)
+            dc = (float(self.outlet.compliance_at(y[n] + step, self.pressure_scale))
+                  - float(self.outlet.compliance_at(y[n] - step, self.pressure_scale))) / (2.0 * step)
+            dq_dpl = -q_g[-1] / h[-1]                                     # dq_n/dp_chamber
+            rows += [[n], [n], [n - 1], [m - 1]]
+            cols += [[n - 1], [n], [n], [n]]
+            vals += [[left[-1] / c], [dq_dpl / c - q[-1] * dc / c**2], [-dq_dpl / volume], [dq_dpl]]
+        return sparse.csc_matrix((np.concatenate([np.asarray(v, dtype=float) for v in vals]),
+                                  (np.concatenate(rows), np.concatenate(cols))), shape=(m, m))
 
     def initial_state(self, initial, t0):
         """The state at ``t0``: at rest at ``initial`` (a pressure, Pa) or from a steady Solution."""
@@ -590,7 +620,7 @@ def _run(system: _System, times, y0, rtol, method):
         nfev = 0
     else:
         res = integrate.solve_ivp(system.rhs, span, y0, method=method, t_eval=times, rtol=rtol, atol=atol,
-                                  jac=lambda t, y: system.jacobian(t, y, s_scale))
+                                  jac=system.jacobian)
         if res.status != 0 or res.y.shape[1] != times.size:
             raise ConvergenceError(f"the time integration stopped: {res.message}")
         ys, nfev = res.y, res.nfev
