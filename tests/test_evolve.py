@@ -42,20 +42,24 @@ def _series(kind, t, conductance, diffusivity, p_in):
     return conductance * 2 * p_in / L * np.sum(np.exp(-diffusivity * k**2 * t), axis=0)
 
 
+@pytest.mark.parametrize("rtol", [1e-4, pytest.param(1e-6, marks=pytest.mark.slow)])
 @pytest.mark.parametrize("outlet", ["open", "closed"])
-def test_linear_limit_against_fourier_series(outlet):
+def test_linear_limit_against_fourier_series(outlet, rtol):
+    """The error-controlled inlet flow (boundary histories extrapolated from 2n and 4n cells)
+    against the series: within rtol and within the estimate (measured: 0.03 to 0.5 of it from
+    rtol 1e-3 to 1e-7)."""
     tube, fluid, wall, conductance, diffusivity = _linear_setup()
     p_in = 1e-3                                          # strain 1e-8: the nonlinearity is ~4e-8
     times = np.linspace(0.0, 4e-3, 41)
-    rtol = 1e-4
     result = tubefsi.evolve(fluid, wall, tube, times, inlet_pressure=p_in, outlet=outlet, rtol=rtol)
     reference = _series(outlet, times[1:], conductance, diffusivity, p_in)
     error = np.max(np.abs(result.inlet_flow_rate[1:] - reference)) / np.max(reference)
     assert error <= rtol
-    assert error <= 3 * result.error_estimate        # the estimate is honest
+    assert error <= result.error_estimate            # the estimate is honest
     assert result.mass_error < 1e-6
 
 
+@pytest.mark.slow
 def test_long_time_limit_matches_solve():
     """A power-law fluid in a thick neo-Hookean tube: the steady flow rate of the transient (at
     t = 40 diffusion times, on 16, 32, 64 cells, extrapolated with h^2 and h^3 terms) against
