@@ -40,6 +40,7 @@ def scene():
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--plot", metavar="PNG", help="also draw the work-precision chart into this file")
     args = parser.parse_args(argv)
     fluid, wall, tube, bc = scene()
     times = np.linspace(0.0, 2.0, 41)
@@ -56,11 +57,13 @@ def main(argv=None):
     print(f"baseline: one run, 512 cells, integrator rtol 1e-6, no error control: {baseline:.3f} s")
     print(f"{'rtol':>8} {'time (s)':>9} {'rhs evals':>10} {'cells':>6} {'int. rtol':>10} {'estimate':>9} "
           f"{'(space':>8} {'time)':>8} {'true error':>10} {'t90 (s)':>9} {'/baseline':>9}")
+    controlled = []                      # (rtol, time, estimate, true error) for the chart
     for rtol in ((1e-2, 1e-3) if args.quick else (1e-2, 1e-3, 1e-4, 1e-5, 1e-6)):
         start = time.perf_counter()
         r = tubefsi.evolve(fluid, wall, tube, times, rtol=rtol, **bc)
         elapsed = time.perf_counter() - start
         error = np.max(np.abs(r.inlet_flow_rate[1:] - q_ref)) / np.max(np.abs(q_ref))
+        controlled.append((rtol, elapsed, r.error_estimate, error))
         print(f"{rtol:8.0e} {elapsed:9.3f} {r.evaluations:10d} {r.cells:6d} {r.integrator_rtol:10.0e} "
               f"{r.error_estimate:9.2g} {r.space_error:8.2g} {r.time_error:8.2g} {error:10.2g} {r.settling_time(0.9):9.4f} {elapsed / baseline:9.2f}")
     print("\ncost against cells (integrator rtol 1e-6, no error control)")
@@ -73,6 +76,47 @@ def main(argv=None):
         per = elapsed / (n * r.evaluations) * 1e6
         base = base or per
         print(f"{n:6d} {elapsed:9.3f} {r.evaluations:10d} {per:15.3f} {per / base:12.2f}")
+    if args.plot:
+        plot(args.plot, controlled, fixed_runs(fluid, wall, tube, times, bc, q_ref, args.quick), baseline)
+
+
+def fixed_runs(fluid, wall, tube, times, bc, q_ref, quick):
+    """Single runs without error control (cells, integrator rtol) -> (time, true error): what a
+    user who picks a grid and a tolerance by hand gets, and does not know the error of."""
+    out = []
+    for n, tol in ((16, 1e-4), (32, 1e-5), (64, 1e-6), (128, 1e-7)) + (() if quick else ((256, 1e-8), (512, 1e-9))):
+        start = time.perf_counter()
+        r = tubefsi.evolve(fluid, wall, tube, times, rtol=tol, cells=n, error_control=False, **bc)
+        elapsed = time.perf_counter() - start
+        out.append((n, tol, elapsed, np.max(np.abs(r.inlet_flow_rate[1:] - q_ref)) / np.max(np.abs(q_ref))))
+    return out
+
+
+def plot(path, controlled, fixed, baseline):
+    """The work-precision chart: the true error of the inlet-flow history against the wall time,
+    for the error-controlled calls (with their own estimates) and single hand-picked runs."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.4), layout="constrained")
+    rtol, elapsed, estimate, error = (np.array(c) for c in zip(*controlled))
+    ax.loglog(elapsed, error, "o-", color="C0", label="evolve(rtol=...): true error")
+    ax.loglog(elapsed, estimate, "o", mfc="none", color="C0", label="evolve(rtol=...): its estimate")
+    for r, t, e in zip(rtol, elapsed, error):
+        ax.annotate(f"rtol {r:.0e}", (t, e), textcoords="offset points", xytext=(6, -10), fontsize=8)
+    n, tol, t_fixed, e_fixed = (np.array(c) for c in zip(*fixed))
+    ax.loglog(t_fixed, e_fixed, "s--", color="C1", label="one run, cells and tolerance by hand (no estimate)")
+    for k, t, e in zip(n, t_fixed, e_fixed):
+        ax.annotate(f"{int(k)}", (t, e), textcoords="offset points", xytext=(-4, 6), fontsize=8, color="C1")
+    ax.axvline(baseline, color="0.6", lw=0.8, ls=":")
+    ax.set_xlabel("wall time of the call (s)")
+    ax.set_ylabel("relative error of the inlet-flow history")
+    ax.set_title("Transient: a soft actuator inflating through its tube", fontsize=10)
+    ax.legend(fontsize=8, loc="lower left")
+    ax.grid(True, which="both", alpha=0.3)
+    fig.savefig(path, dpi=130)
+    print(f"chart: {path}")
 
 
 if __name__ == "__main__":
