@@ -153,3 +153,11 @@ def test_pressure_step_at_an_output_time():
     steady = tubefsi.solve(FLUID, WALL, TUBE, pressure_drop=1e4).flow_rate
     assert r.inlet_flow_rate[-1] == pytest.approx(steady, rel=1e-3)
     assert r.error_estimate <= 1e-3
+
+
+@pytest.mark.parametrize("fraction", ["0.9", np.array([0.5, 0.9]), 1.0])
+def test_bad_settling_fraction(fraction):
+    r = tubefsi.evolve(FLUID, WALL, TUBE, TIMES, inlet_pressure=1e3, error_control=False, cells=8)
+    with pytest.raises(tubefsi.InvalidParameterError) as info:
+        r.settling_time(fraction)
+    assert info.value.parameter == "fraction"

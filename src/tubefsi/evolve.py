@@ -511,9 +511,10 @@ class Transient:
         is not reached by the last output time. The steady state is that of the boundary values at
         the last output time (:meth:`steady`, :meth:`steady_volume`); a pump still running into a
         closed end or a chamber has none: :class:`~tubefsi.NoSteadyStateError`."""
-        f = float(fraction)
-        if not (0.0 < f < 1.0):
+        f = real_array("fraction", fraction, "(0, 1)")
+        if f.ndim or not (0.0 < float(f) < 1.0):
             raise InvalidParameterError("fraction", "(0, 1)", fraction)
+        f = float(f)
         v_inf = self.steady_volume()
         dev = np.abs(self.stored - v_inf)
         band = (1.0 - f) * abs(v_inf - self.stored[0])
