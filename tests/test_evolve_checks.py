@@ -161,3 +161,11 @@ def test_bad_settling_fraction(fraction):
     with pytest.raises(tubefsi.InvalidParameterError) as info:
         r.settling_time(fraction)
     assert info.value.parameter == "fraction"
+
+
+def test_pressure_above_the_limit_is_no_steady_state():
+    limit = float(WALL.limit_pressure(TUBE.thickness / TUBE.radius))    # from the wall itself
+    with pytest.raises(tubefsi.NoSteadyStateError) as info:
+        tubefsi.evolve(FLUID, WALL, TUBE, TIMES, inlet_pressure=1.2 * limit, rtol=1e-2)
+    assert not isinstance(info.value, tubefsi.BucklingError)
+    assert info.value.limit == pytest.approx(limit)

@@ -643,7 +643,10 @@ def _run(system: _System, times, y0, rtol, method):
 
 
 def _area_strain_scale(system):
-    lam = 1.0 + float(system.wall.strain(system.pressure_scale, system.tb))
+    """The area strain at the pressure scale (at most half the wall's limit pressure: the scale is
+    a magnitude, and a suction's may exceed the limit of inflation)."""
+    p = min(system.pressure_scale, 0.5 * float(system.wall.limit_pressure(system.tb)))
+    lam = 1.0 + float(system.wall.strain(p, system.tb))
     return lam * lam - 1.0
 
 
@@ -914,16 +917,22 @@ def _setup(rheo, wall, tube, times, inlet_pressure, inlet_flow_rate, outlet_pres
         initial = float(initial)
         scale = max(scale, abs(initial - p_ext))
     # the lowest transmural pressure met at the boundaries and at the start: not below buckling
-    low = [p_rest if initial is None else (initial if not isinstance(initial, Solution)
+    # and not at or above the wall's limit pressure (signed: a large suction is buckling, above)
+    met = [p_rest if initial is None else (initial if not isinstance(initial, Solution)
                                            else float(initial.pressure(length)))]
     if inlet_kind == "pressure":
-        low.append(float(np.min(_elementwise(inlet, sample, "inlet_pressure"))))
+        met.append(_elementwise(inlet, sample, "inlet_pressure"))
     if outlet_kind == "pressure":
-        low.append(float(np.min(_elementwise(outlet_value, sample, "outlet_pressure"))))
+        met.append(_elementwise(outlet_value, sample, "outlet_pressure"))
+    low = min(float(np.min(m)) for m in met) - p_ext
+    high = max(float(np.max(m)) for m in met) - p_ext
     bound = float(wall.min_pressure(t / a))
-    if min(low) - p_ext < bound:
-        raise BucklingError(bound, min(low) - p_ext, "a boundary or starting pressure minus external_pressure is "
-                            "below it")
+    if low < bound:
+        raise BucklingError(bound, low, "a boundary or starting pressure minus external_pressure is below it")
+    limit = float(wall.limit_pressure(t / a))
+    if high >= limit:
+        raise NoSteadyStateError("pressure", limit, high, f"a boundary or starting transmural pressure; "
+                                 f"{type(wall).__name__} cannot sustain it")
     system = _System(rheology=rheo, wall=wall, radius=a, tb=t / a, length=length, external=p_ext, n=n,
                      inlet_kind=inlet_kind, inlet=inlet, outlet_kind=outlet_kind, outlet=outlet_value,
                      pressure_scale=scale)
