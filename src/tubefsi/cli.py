@@ -738,7 +738,8 @@ def _cmd_evolve(args, out) -> int:
     if not (args.t_end > 0 and args.steps >= 2):
         raise UsageError("--t-end must be > 0 and --steps >= 2")
     result = evolve(fluid, wall, tube, np.linspace(0.0, args.t_end, args.steps), inlet_pressure=args.inlet_pressure,
-                    inlet_flow_rate=args.inlet_flow_rate, outlet=outlet, outlet_pressure=args.outlet_pressure,
+                    inlet_flow_rate=args.inlet_flow_rate, outlet=outlet,
+                    outlet_pressure=args.outlet_pressure if isinstance(outlet, str) and outlet == "open" else None,
                     external_pressure=args.external_pressure, rtol=args.rtol, density=args.density)
     result.to_csv(args.output if args.output is not None else out)
     if args.netcdf is not None:

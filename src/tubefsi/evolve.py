@@ -32,8 +32,9 @@ h_{2n})/3` (third order), the space estimate :math:`|E_{n,2n} - E_{2n,4n}|` (the
 extrapolation's error, conservative for the reported one); the time estimate is
 :math:`\tfrac53|h_{n,\tau} - h_{n,\tau/10}|` (the error of a run at :math:`\tau`, conservative for the
 reported runs at :math:`\tau/10`; :math:`\tfrac53` bounds the extrapolation's weights). The cells
-grow and the tolerance falls until their sum, relative to the history's largest value, meets
-``rtol``, else an :class:`~tubefsi.AccuracyWarning` states the estimate. The fields inside the tube
+grow and the tolerance falls until their sum, relative to the history's scale (its largest value,
+at least the flow :math:`Q(p_s/L, a)` under the problem's pressure scale :math:`p_s`, or :math:`p_s` behind
+a pump: not pointwise, a relaxation's history decays to ~0), meets ``rtol``, else an :class:`~tubefsi.AccuracyWarning` states the estimate. The fields inside the tube
 are the ``4n`` run's.
 """
 
@@ -47,8 +48,9 @@ import numpy as np
 
 from ._keywords import checked_keywords
 from ._lazy import lazy_module
-from .errors import (AccuracyWarning, ConvergenceError, InvalidParameterError, ModelValidityWarning, NoSteadyStateError,
-                     warn_user)
+from ._validation import positive_scalar, real_array
+from .errors import (AccuracyWarning, BucklingError, ConvergenceError, InvalidParameterError, ModelValidityWarning,
+                     NoSteadyStateError, TubefsiError, warn_user)
 from .geometry import Tube
 from .scene import resolve
 from .solution import Solution
@@ -80,38 +82,65 @@ class Chamber:
     volume : callable
         :math:`V(p)`, increasing (a measured or modelled pressure–volume curve).
     compliance : callable, optional
-        :math:`dV/dp` (m^3/Pa). Without it, a fourth-order central difference of ``volume``
-        at a step of 1e-3 of the problem's pressure scale.
+        :math:`dV/dp` (m^3/Pa), checked at construction against a fourth-order central
+        difference of ``volume`` at 0, 100 and 1000 Pa (relative 1e-6; else
+        :class:`InvalidParameterError` naming ``compliance``). Without it, a fourth-order central
+        difference of ``volume`` at a step of 1e-3 of the problem's pressure scale.
+
+    A chamber whose volume becomes negative during a run (emptied by suction) raises
+    :class:`InvalidParameterError` naming ``outlet``.
     """
 
     volume: Callable = attrs.field()
-    compliance: Callable | None = None
+    compliance: Callable | None = attrs.field(default=None)
 
     @volume.validator
     def _callable(self, attribute, value):
         if not callable(value):
             raise InvalidParameterError("volume", "a callable V(p) (m^3)", value)
 
+    @compliance.validator
+    def _consistent(self, attribute, value):
+        r"""A given ``compliance`` must be :math:`dV/dp`: checked against a fourth-order central
+        difference of ``volume`` (step 0.1 to 10 Pa) at 0, 100 and 1000 Pa, to a relative 1e-6."""
+        if value is None:
+            return
+        if not callable(value):
+            raise InvalidParameterError("compliance", "a callable dV/dp (m^3/Pa) or None", value)
+        v = lambda x: _elementwise(self.volume, x, "volume", "p")         # noqa: E731
+        for p in (0.0, 100.0, 1000.0):
+            try:                  # (a curve not defined there, e.g. only for p > 0: not checked there)
+                given = float(_elementwise(value, p, "compliance", "p"))
+                volume = abs(float(v(p)))
+                # the step: C h ~ 1e-4 V (rounding of V far below 1e-6), within [0.1, 10] Pa
+                h = min(max(0.1, 1e-4 * volume / abs(given)), 10.0) if given else 0.1
+                difference = float((8.0 * (v(p + h) - v(p - h)) - (v(p + 2 * h) - v(p - 2 * h))) / (12.0 * h))
+            except TubefsiError:
+                continue
+            rounding = 10.0 * np.finfo(float).eps * volume / h
+            if abs(given - difference) > 1e-6 * max(abs(difference), abs(given)) + rounding:
+                raise InvalidParameterError("compliance", "dV/dp of the chamber's volume V(p)", given,
+                                            f"at p = {p:g} Pa, while a difference of volume gives {difference:.6g}")
+
     @classmethod
     def linear(cls, volume: float, compliance: float) -> Chamber:
         r"""The linear chamber :math:`V = V_0 + C p` (``volume`` :math:`V_0` m^3, ``compliance`` :math:`C` m^3/Pa)."""
-        v0 = float(volume)
-        c = float(compliance)
-        if not (math.isfinite(c) and c > 0):
-            raise InvalidParameterError("compliance", "(0, inf) m^3/Pa", compliance)
-        if not (math.isfinite(v0) and v0 >= 0):
-            raise InvalidParameterError("volume", "[0, inf) m^3", volume)
+        c = positive_scalar("compliance", compliance)
+        v0 = real_array("volume", volume, "[0, inf) m^3")
+        if v0.ndim or not (math.isfinite(float(v0)) and float(v0) >= 0):
+            raise InvalidParameterError("volume", "[0, inf) m^3 (one number)", volume)
+        v0 = float(v0)
         return cls(volume=lambda p: v0 + c * np.asarray(p, dtype=float), compliance=lambda p: c + 0.0 * np.asarray(p))
 
     def volume_at(self, p):
         """:math:`V(p)` (m^3), elementwise."""
-        return _elementwise(self.volume, p, "volume")
+        return _elementwise(self.volume, p, "outlet", "p")
 
     def compliance_at(self, p, scale: float = 1.0):
         """:math:`dV/dp` (m^3/Pa), elementwise (a difference of ``volume`` at steps ``1e-3 scale``
         where no ``compliance`` is given)."""
         if self.compliance is not None:
-            c = _elementwise(self.compliance, p, "compliance")
+            c = _elementwise(self.compliance, p, "outlet", "p")
         else:
             h = 1e-3 * scale
             p = np.asarray(p, dtype=float)
@@ -122,29 +151,49 @@ class Chamber:
         return c
 
 
-def _elementwise(function, t, name):
+def _elementwise(function, t, name, argument="t"):
     """``function`` at the array ``t``: called on the array, or point by point where it does not
-    broadcast (a function written for one number); a float array of the shape of ``t``."""
+    broadcast (a function written for one number); a float array of the shape of ``t``. A call
+    that raises, returns no real number (an array, a string) or a non-finite value raises
+    :class:`InvalidParameterError` naming ``name``, with the value and the argument."""
     t = np.asarray(t, dtype=float)
     try:
         out = np.asarray(function(t), dtype=float)
         if out.shape != t.shape:
             out = np.broadcast_to(out, t.shape).astype(float)
-    except (TypeError, ValueError):
-        out = np.array([float(function(float(x))) for x in t.ravel()]).reshape(t.shape)
+    except Exception:                     # (a function of one number: called point by point below)
+        out = np.array([_one(function, float(x), name, argument) for x in t.ravel()]).reshape(t.shape)
     if not np.all(np.isfinite(out)):
-        raise InvalidParameterError(name, "finite values", float(t.ravel()[np.argmin(np.isfinite(out).ravel())]),
-                                    f"{name} is not finite there")
+        k = int(np.argmin(np.isfinite(out).ravel()))
+        raise InvalidParameterError(name, "finite values", float(out.ravel()[k]),
+                                    f"at {argument} = {float(t.ravel()[k]):.6g}")
     return out
+
+
+def _one(function, x, name, argument):
+    """``function(x)`` as one float (see :func:`_elementwise`)."""
+    try:
+        value = function(x)
+    except TubefsiError:
+        raise
+    except Exception as error:
+        raise InvalidParameterError(name, "a callable returning one finite number", None,
+                                    f"at {argument} = {x:.6g} it raised {type(error).__name__}: {error}") from error
+    v = real_array(name, value, "one finite number")
+    if v.ndim:
+        raise InvalidParameterError(name, "a callable returning one finite number", None,
+                                    f"at {argument} = {x:.6g} it returned an array of shape {v.shape}")
+    return float(v)
 
 
 def _boundary(name, value):
     """A boundary value as a function of time (a number: constant)."""
     if callable(value):
         return value
-    v = float(np.asarray(value, dtype=float)) if np.ndim(value) == 0 else None
-    if v is None or not math.isfinite(v):
+    v = real_array(name, value, "a finite number or a callable of t")
+    if v.ndim or not math.isfinite(float(v)):
         raise InvalidParameterError(name, "a finite number or a callable of t", value)
+    v = float(v)
     return lambda t: v + 0.0 * np.asarray(t, dtype=float)
 
 
@@ -455,9 +504,16 @@ class Transient:
 
     # -------------------------------------------------------------- the steady state
     def steady(self) -> Solution | None:
-        """The steady state of the boundary values at the last output time: a :class:`Solution`
-        for an open outlet, None for a closed end or a chamber (then the pressure is uniform,
-        the inlet pressure). Raises NoSteadyStateError for a pump into a closed end or a chamber."""
+        """The steady state of the boundary values at the last output time.
+
+        - open outlet: a :class:`Solution` of :func:`~tubefsi.solve` with the final inlet pressure
+          (a pressure drop to the final outlet pressure) or the final pump flow rate;
+        - closed end or chamber behind a pressure inlet: None (no flow; the pressure is uniform,
+          the final inlet pressure);
+        - closed end or chamber behind a pump that has stopped (final flow rate 0): None (no flow;
+          the volume held is what was pumped in, see :meth:`steady_volume`);
+        - a pump still running into a closed end or a chamber: no steady state,
+          :class:`~tubefsi.NoSteadyStateError`."""
         sy = self._system
         inlet, outlet = self._final
         if sy.outlet_kind != "pressure":
@@ -479,10 +535,16 @@ class Transient:
 
     def steady_volume(self) -> float:
         """The stored volume of :meth:`steady` (m^3): :math:`\\int_0^L \\pi R^2 dz` by 64-point
-        Gauss–Legendre quadrature of the steady profile (plus the chamber's volume)."""
+        Gauss–Legendre quadrature of the steady profile (open outlet), the tube and chamber at the
+        final inlet pressure (a pressure inlet into a closed end or a chamber), or
+        :math:`V(t_0) + \\int q_{in}\\,dt` (a stopped pump into a closed end or a chamber: what was
+        pumped in stays). Raises :class:`~tubefsi.NoSteadyStateError` where :meth:`steady` does."""
         sy = self._system
         inlet, _ = self._final
         sol = self.steady()
+        if sol is None and sy.inlet_kind == "flow":
+            # a stopped pump into a closed end or a chamber: mass, V(t0) + the volume pumped in
+            return float(self.stored[0] + self.volume_in[-1])
         if sol is None:
             lam = 1.0 + float(sy.wall.strain(inlet - sy.external, sy.tb))
             chamber = float(sy.outlet.volume_at(inlet)) if sy.outlet_kind == "chamber" else 0.0
@@ -496,10 +558,12 @@ class Transient:
         ``(1 - fraction)`` of its change to the steady state, :math:`|V(t) - V_\infty| \le
         (1 - f)|V_\infty - V(t_0)|` (linear interpolation between output times); ``inf`` if that
         is not reached by the last output time. The steady state is that of the boundary values at
-        the last output time (:meth:`steady`)."""
-        f = float(fraction)
-        if not (0.0 < f < 1.0):
+        the last output time (:meth:`steady`, :meth:`steady_volume`); a pump still running into a
+        closed end or a chamber has none: :class:`~tubefsi.NoSteadyStateError`."""
+        f = real_array("fraction", fraction, "(0, 1)")
+        if f.ndim or not (0.0 < float(f) < 1.0):
             raise InvalidParameterError("fraction", "(0, 1)", fraction)
+        f = float(f)
         v_inf = self.steady_volume()
         dev = np.abs(self.stored - v_inf)
         band = (1.0 - f) * abs(v_inf - self.stored[0])
@@ -628,7 +692,10 @@ def _run(system: _System, times, y0, rtol, method):
 
 
 def _area_strain_scale(system):
-    lam = 1.0 + float(system.wall.strain(system.pressure_scale, system.tb))
+    """The area strain at the pressure scale (at most half the wall's limit pressure: the scale is
+    a magnitude, and a suction's may exceed the limit of inflation)."""
+    p = min(system.pressure_scale, 0.5 * float(system.wall.limit_pressure(system.tb)))
+    lam = 1.0 + float(system.wall.strain(p, system.tb))
     return lam * lam - 1.0
 
 
@@ -656,7 +723,13 @@ def _fields(system, times, ys):
     area0 = math.pi * system.radius**2
     stored = area0 * system.dz * np.sum(1.0 + s, axis=1)
     if chamber is not None:
-        stored = stored + system.outlet.volume_at(chamber)
+        held = system.outlet.volume_at(chamber)
+        if np.any(held < 0):
+            k = int(np.argmax(held < 0))
+            raise InvalidParameterError("outlet", "a chamber whose volume V(p) stays >= 0", float(held[k]),
+                                        f"the outlet chamber empties: V = {held[k]:.6g} m^3 at p = {chamber[k]:.6g} "
+                                        f"Pa (t = {times[k]:.6g} s)")
+        stored = stored + held
     v_in, v_out = ys[-2], ys[-1]
     change = stored - stored[0]
     # (the chamber is part of the store: what leaves the tube into it stays)
@@ -664,24 +737,45 @@ def _fields(system, times, ys):
     scale = max(float(np.max(np.abs(change))), float(np.max(np.abs(v_in))), np.finfo(float).tiny)
     return dict(pressure_nodes=pressure, radius_nodes=system.radius * stretch, flow_faces=q, stored=stored,
                 volume_in=v_in, volume_out=v_out, chamber_pressure=chamber,
-                mass_error=float(np.max(np.abs(balance))) / scale)
+                mass_error=float(np.max(np.abs(balance)) / scale))
 
 
-def _monitored(system, fields):
+def _monitored(system, fields, times):
     """The inlet history the error control watches: the flow rate behind a pressure inlet, the
-    pressure behind a pump (the initial instant left out: a step's flow is singular there)."""
+    pressure behind a pump (the initial instant left out: a step's flow is singular there; so are
+    the output times where a pressure inlet jumps, its values just before and after differing by
+    more than 1e-6 of the pressure scale)."""
     h = fields["flow_faces"][:, 0] if system.inlet_kind == "pressure" else fields["pressure_nodes"][:, 0]
-    return h[1:] if h.size > 1 else h
+    keep = np.ones(h.size, dtype=bool)
+    keep[0] = h.size == 1
+    if system.inlet_kind == "pressure":
+        delta = 1e-9 * max(float(times[-1] - times[0]), float(np.max(np.abs(times))))
+        jump = np.abs(_elementwise(system.inlet, times + delta, "inlet_pressure")
+                      - _elementwise(system.inlet, times - delta, "inlet_pressure"))
+        keep &= jump <= 1e-6 * system.pressure_scale
+    return h[keep] if np.any(keep) else h[-1:]
 
 
-def _difference(a, b):
-    scale = max(float(np.max(np.abs(b))), np.finfo(float).tiny)
+def _difference(a, b, floor=0.0):
+    """The largest :math:`|a - b|` relative to the history's scale: its largest :math:`|b|`, but at
+    least ``floor`` (:func:`_history_scale`), not pointwise: a history that decays to ~0 (a
+    relaxation) is measured against the flow or pressure the problem drives, not against noise."""
+    scale = max(float(np.max(np.abs(b))), floor, np.finfo(float).tiny)
     return float(np.max(np.abs(a - b))) / scale
+
+
+def _history_scale(system):
+    r"""The scale of the watched inlet history: behind a pressure inlet the flow rate the tube
+    carries under the problem's pressure scale over its length, :math:`Q(p_s/L, a)` (rigid
+    radius); behind a pump its pressure scale :math:`p_s`."""
+    if system.inlet_kind == "flow":
+        return float(system.pressure_scale)
+    return float(system.rheology.flow_rate(system.radius, system.pressure_scale / system.length))
 
 
 @checked_keywords
 def evolve(rheology, wall, tube: Tube, times, *, inlet_pressure=None, inlet_flow_rate=None,
-           outlet_pressure=0.0, outlet="open", external_pressure: float = 0.0, initial=None,
+           outlet_pressure=None, outlet="open", external_pressure: float = 0.0, initial=None,
            rtol: float = 1e-6, cells: int | None = None, method: str = "BDF", density: float | None = None,
            error_control: bool = True) -> Transient:
     r"""Integrate the transient flow through a soft tube from ``times[0]`` to ``times[-1]``.
@@ -695,7 +789,8 @@ def evolve(rheology, wall, tube: Tube, times, *, inlet_pressure=None, inlet_flow
     tube : Tube
         Scalar radius, thickness and length (graded tubes and arrays are not supported here).
     times : array_like
-        Increasing output times (s); the integration starts at ``times[0]`` from ``initial``.
+        At least two increasing output times (s); the integration starts at ``times[0]`` from
+        ``initial``.
     inlet_pressure : float or callable of t, optional
         Gauge pressure at the inlet :math:`p(0, t)` (Pa).
     inlet_flow_rate : float or callable of t, optional
@@ -704,16 +799,20 @@ def evolve(rheology, wall, tube: Tube, times, *, inlet_pressure=None, inlet_flow
         ``"open"``: the outlet pressure ``outlet_pressure`` holds at :math:`z = L`; ``"closed"``: a
         dead end, :math:`q(L) = 0`; a :class:`Chamber` or a callable :math:`V(p)` (m^3): a chamber
         filled by the outlet flow.
-    outlet_pressure : float or callable of t
-        The outlet's gauge pressure (Pa) for ``outlet="open"``.
+    outlet_pressure : float or callable of t, optional
+        The outlet's gauge pressure (Pa) for ``outlet="open"`` (default 0); refused with a closed
+        end or a chamber (they set their own pressure).
     external_pressure : float
         :math:`p_e` (Pa): the wall sees :math:`p - p_e`.
     initial : None, float or Solution
         ``None``: at rest at the outlet pressure (open) or at 0 (closed, chamber); a number: at rest
-        at that pressure (Pa); a steady :class:`Solution` of the same tube: its profile.
+        at that pressure (Pa); a steady :class:`Solution` of the same fluid, wall, tube and external
+        pressure (compared by value, else :class:`InvalidParameterError`): its profile. A starting
+        or boundary pressure below the wall's buckling bound raises :class:`~tubefsi.BucklingError`.
     rtol : float
         Requested relative accuracy of the inlet history (the flow rate behind a pressure inlet,
-        the pressure behind a pump), relative to its largest value.
+        the pressure behind a pump), relative to its scale (its largest value, at least the flow
+        the tube carries under the problem's pressure scale; the pressure scale behind a pump).
     cells : int, optional
         The coarsest grid of the refinement (default 16; at most ``MAX_CELLS / 4``: the error
         control runs ``cells``, twice and four times as many); with ``error_control=False``, the
@@ -735,6 +834,8 @@ def evolve(rheology, wall, tube: Tube, times, *, inlet_pressure=None, inlet_flow
         pressure, the stored volume, the volumes in and out) Richardson-extrapolated from the two
         finest runs, :math:`h_{4n} + (h_{4n} - h_{2n})/3`.
     """
+    if density is not None:
+        density = positive_scalar("density", density)
     rheo = resolve("rheology", rheology)
     wall_model = resolve("wall", wall)
     system, times, y0_of, rtol, method = _setup(rheo, wall_model, tube, times, inlet_pressure, inlet_flow_rate,
@@ -761,13 +862,14 @@ def evolve(rheology, wall, tube: Tube, times, *, inlet_pressure=None, inlet_flow
     while True:
         # the reported runs: n, 2n, 4n cells at tol/10; the time estimate: n cells at tol and tol/10
         loose, coarse, middle, fine = run(n, tol), run(n, 0.1 * tol), run(2 * n, 0.1 * tol), run(4 * n, 0.1 * tol)
-        h1, h2, h4 = (_monitored(system, f) for f in (coarse, middle, fine))
+        h1, h2, h4 = (_monitored(system, f, times) for f in (coarse, middle, fine))
+        floor = _history_scale(system)
         # space: the Richardson extrapolations of the pairs (n, 2n) and (2n, 4n); their difference is
         # the error of the coarser pair's, conservative for the reported finer pair's (third order)
-        e_space = _difference(_extrapolated(h1, h2), _extrapolated(h2, h4))
+        e_space = _difference(_extrapolated(h1, h2), _extrapolated(h2, h4), floor)
         # time: the error of the run at tol, conservative for the reported ones at tol/10; the
         # extrapolation (4 h_4n - h_2n)/3 adds the time errors of two runs with weights 4/3 and 1/3
-        e_time = 5.0 / 3.0 * _difference(_monitored(system, loose), h1)
+        e_time = 5.0 / 3.0 * _difference(_monitored(system, loose, times), h1, floor)
         total = sum(nfev for _, nfev in runs.values())
         fine_sys = attrs.evolve(system, n=4 * n)
         if e_space + e_time <= rtol:
@@ -838,10 +940,13 @@ def _setup(rheo, wall, tube, times, inlet_pressure, inlet_flow_rate, outlet_pres
         if arrays:
             raise InvalidParameterError(kind, "a model of scalar parameters", model,
                                         f"{arrays[0]} is an array: evolve one scene per call")
-    times = np.asarray(times, dtype=float).ravel()
-    if times.size == 0 or not np.all(np.isfinite(times)) or np.any(np.diff(times) <= 0):
-        raise InvalidParameterError("times", "a non-empty array of finite, increasing times (s)", times)
-    rtol = float(rtol)
+    if getattr(wall, "is_rigid", False):
+        raise InvalidParameterError("wall", "a compliant wall", wall, "a rigid wall stores no volume: a transient "
+                                    "needs a compliant wall or a chamber")
+    times = real_array("times", times, "an array of at least 2 finite, increasing times (s)")
+    if times.ndim != 1 or times.size < 2 or not np.all(np.isfinite(times)) or np.any(np.diff(times) <= 0):
+        raise InvalidParameterError("times", "a 1-d array of at least 2 finite, increasing times (s)", times)
+    rtol = positive_scalar("rtol", rtol)
     if not (1e-12 <= rtol < 1):
         raise InvalidParameterError("rtol", "[1e-12, 1)", rtol)
     if method not in ("BDF", "Radau"):
@@ -851,8 +956,12 @@ def _setup(rheo, wall, tube, times, inlet_pressure, inlet_flow_rate, outlet_pres
     inlet_kind = "pressure" if inlet_pressure is not None else "flow"
     inlet = _boundary("inlet_pressure" if inlet_kind == "pressure" else "inlet_flow_rate",
                       inlet_pressure if inlet_kind == "pressure" else inlet_flow_rate)
+    if outlet_pressure is not None and not (isinstance(outlet, str) and outlet == "open"):
+        raise InvalidParameterError("outlet_pressure", "None unless outlet='open'", outlet_pressure,
+                                    "a closed end or a chamber sets its own pressure")
     if isinstance(outlet, str) and outlet == "open":
-        outlet_kind, outlet_value = "pressure", _boundary("outlet_pressure", outlet_pressure)
+        outlet_kind = "pressure"
+        outlet_value = _boundary("outlet_pressure", 0.0 if outlet_pressure is None else outlet_pressure)
     elif isinstance(outlet, str) and outlet == "closed":
         outlet_kind, outlet_value = "closed", None
     elif isinstance(outlet, Chamber):
@@ -861,7 +970,12 @@ def _setup(rheo, wall, tube, times, inlet_pressure, inlet_flow_rate, outlet_pres
         outlet_kind, outlet_value = "chamber", Chamber(volume=outlet)
     else:
         raise InvalidParameterError("outlet", "'open', 'closed', a Chamber or a callable V(p)", outlet)
-    p_ext = float(external_pressure)
+    p_ext = real_array("external_pressure", external_pressure, "a finite number (Pa)")
+    if p_ext.ndim or not math.isfinite(float(p_ext)):
+        raise InvalidParameterError("external_pressure", "a finite number (Pa)", external_pressure)
+    p_ext = float(p_ext)
+    if cells is not None and (isinstance(cells, (bool, np.bool_)) or not isinstance(cells, (int, np.integer))):
+        raise InvalidParameterError("cells", f"an integer in [2, {MAX_CELLS}]", cells)
     n = 16 if cells is None else int(cells)
     if not (2 <= n <= MAX_CELLS):
         raise InvalidParameterError("cells", f"[2, {MAX_CELLS}]", cells)
@@ -877,10 +991,34 @@ def _setup(rheo, wall, tube, times, inlet_pressure, inlet_flow_rate, outlet_pres
         scale = float(np.max(rheo.pressure_gradient(q, a))) * length if q > 0 else 0.0
     if outlet_kind == "pressure":
         scale = max(scale, float(np.max(np.abs(_elementwise(outlet_value, sample, "outlet_pressure") - p_ext))))
-    scale = max(scale, abs(p_rest - p_ext), 1e-300)
-    if initial is not None and not isinstance(initial, Solution):
+    scale = max(scale, abs(p_rest - p_ext))
+    if scale == 0.0:            # nothing drives the tube (at rest at p_e): the pressure of a strain 1e-6
+        scale = 1e-6 * float(wall.small_strain_modulus(t / a))
+    if isinstance(initial, Solution):
+        _check_initial(initial, rheo, wall, tube, p_ext)
+    elif initial is not None:
+        initial = real_array("initial", initial, "None, a pressure (Pa) or a steady Solution of the same tube")
+        if initial.ndim or not math.isfinite(float(initial)):
+            raise InvalidParameterError("initial", "None, a finite pressure (Pa) or a steady Solution", initial)
         initial = float(initial)
         scale = max(scale, abs(initial - p_ext))
+    # the lowest transmural pressure met at the boundaries and at the start: not below buckling
+    # and not at or above the wall's limit pressure (signed: a large suction is buckling, above)
+    met = [p_rest if initial is None else (initial if not isinstance(initial, Solution)
+                                           else float(initial.pressure(length)))]
+    if inlet_kind == "pressure":
+        met.append(_elementwise(inlet, sample, "inlet_pressure"))
+    if outlet_kind == "pressure":
+        met.append(_elementwise(outlet_value, sample, "outlet_pressure"))
+    low = min(float(np.min(m)) for m in met) - p_ext
+    high = max(float(np.max(m)) for m in met) - p_ext
+    bound = float(wall.min_pressure(t / a))
+    if low < bound:
+        raise BucklingError(bound, low, "a boundary or starting pressure minus external_pressure is below it")
+    limit = float(wall.limit_pressure(t / a))
+    if high >= limit:
+        raise NoSteadyStateError("pressure", limit, high, f"a boundary or starting transmural pressure; "
+                                 f"{type(wall).__name__} cannot sustain it")
     system = _System(rheology=rheo, wall=wall, radius=a, tb=t / a, length=length, external=p_ext, n=n,
                      inlet_kind=inlet_kind, inlet=inlet, outlet_kind=outlet_kind, outlet=outlet_value,
                      pressure_scale=scale)
@@ -890,6 +1028,27 @@ def _setup(rheo, wall, tube, times, inlet_pressure, inlet_flow_rate, outlet_pres
         return sys_.initial_state(start, t0)
 
     return system, times, y0_of, rtol, method
+
+
+def _check_initial(initial, rheo, wall, tube, p_ext):
+    """A starting Solution must be of the same fluid, wall, tube and external pressure (by value)."""
+    other = initial.tube
+    differs = []
+    if initial.rheology != rheo:
+        differs.append(f"its rheology {initial.rheology!r} is not {rheo!r}")
+    if initial.wall != wall:
+        differs.append(f"its wall {initial.wall!r} is not {wall!r}")
+    for field in ("radius", "thickness", "length"):
+        mine, theirs = getattr(tube, field), getattr(other, field)
+        if other.graded or np.ndim(theirs) or float(theirs) != float(mine):
+            differs.append(f"its tube {field} {theirs!r} is not {float(mine)!r}")
+    if np.ndim(initial.external_pressure) or float(initial.external_pressure) != p_ext:
+        differs.append(f"its external pressure {initial.external_pressure!r} Pa is not {p_ext!r}")
+    if np.ndim(initial.pressure_drop) or not math.isfinite(float(initial.pressure_drop)):
+        differs.append("it is not one steady state of finite pressures")
+    if differs:
+        raise InvalidParameterError("initial", "a steady Solution of the same fluid, wall, tube and external pressure",
+                                    None, "; ".join(differs))
 
 
 def _check_validity(result: Transient, density: float) -> None:
