@@ -73,10 +73,8 @@ class _Groups:
         groups: dict = {}
         graded: dict = {}
         by_models: dict = {}
-        take = subset.tolist()
-        for i, t in enumerate(tubes):
-            if not take[i]:
-                continue
+        for i in np.flatnonzero(subset).tolist():      # (the tubes of the subset only)
+            t = tubes[i]
             ids = (id(t.wall), id(t.tube), id(t.rheology))
             found = by_models.get(ids)
             if found is None:
@@ -228,6 +226,19 @@ class _Groups:
                 out[index] = np.where(ok & np.isfinite(value) & (value > 0), value, mu[index])
         return out
 
+    def strain(self, pressure):
+        """Per tube, the hoop strain of its wall under the node (gauge) ``pressure`` (one per tube)
+        held below 90 % of its limit pressure and above its external pressure (0 for the tubes of
+        no part and for a graded tube): the rigid start's estimate of the inflated radii."""
+        out = np.zeros(pressure.size)
+        for part in self.parts:
+            if part.reverse is not None:
+                continue
+            index, p_e = part.index, np.asarray(part.external, dtype=float)
+            transmural = np.clip(pressure[index] - p_e, 0.0, 0.9 * (self.limit[index] - p_e))
+            out[index] = np.broadcast_to(part.wall.strain(transmural, part.tube.reduced_thickness), index.shape)
+        return out
+
     def nominal_viscosity(self, n):
         mu = np.empty(n)
         for part in self.parts:
@@ -317,6 +328,7 @@ def _gather(members, which, fields) -> dict:
             entry[2].append(m.row)
     out = {f: np.empty(len(members)) for f in fields}
     for model, positions, rows in by_model.values():
+        rows = np.asarray(rows) if rows[0] is not None else rows     # (one conversion for every field)
         for f in fields:
             value = getattr(model, f)
             out[f][positions] = value[rows] if isinstance(value, np.ndarray) and value.ndim else value

@@ -20,7 +20,8 @@ share their wall and fluid classes (their parameters stacked into arrays).
 
 Globalization: the start is the rigid Newtonian network (each tube a Hagen–Poiseuille
 conductance :math:`\pi a^4/(8\mu L)` at the fluid's apparent viscosity, refined by three
-Picard sweeps); every Newton step is cut to stay inside :math:`0 \le p_i < p_{lim}` (a step goes
+Picard sweeps, the last with each tube's conductance times :math:`(1+\varepsilon)^4`, its wall's
+hoop strain at the mean of its end pressures); every Newton step is cut to stay inside :math:`0 \le p_i < p_{lim}` (a step goes
 at most 90 % of the way to a tube's limit pressure or to zero) and then halved until the
 residual norm :math:`\|F\|_2` decreases (Armijo). The derivative of a tube without flow is
 degenerate — :math:`\partial q/\partial p \to 0` for a shear-thinning fluid, :math:`\infty` for a
@@ -126,6 +127,7 @@ class _Solver:
                                      f"{self._limiting_tube(i)!r}")
         self._check_outlet_capacity()
         self.n_tubes = n_tubes
+        self.unknown = None
         self._unknowns(~self.fixed)
 
     def _check_outlet_capacity(self):
@@ -165,10 +167,13 @@ class _Solver:
     def _unknowns(self, mask):
         """Make the nodes of ``mask`` the unknowns (the rigid start: every free node; Newton: the
         free nodes but the feeders)."""
+        if self.unknown is not None and np.array_equal(mask, self.unknown):
+            return                           # the same unknowns: the Jacobian's pattern is kept
         self.unknown = mask
         self.free = np.flatnonzero(mask)
         self.where = np.full(mask.size, -1)
         self.where[self.free] = np.arange(self.free.size)
+        self._pattern = None                 # built by the next _jacobian
 
     def _limiting_tube(self, i):
         at = np.flatnonzero((self.U == i) | (self.V == i))
@@ -177,15 +182,13 @@ class _Solver:
     # ------------------------------------------------------------------ linear algebra
     def _jacobian(self, gu, gv):
         """dF/dp over the free nodes from dq_e/dp_u = gu, dq_e/dp_v = gv, and the exact -1/R of
-        each resistance outlet on the diagonal."""
-        U, V = self.U, self.V
+        each resistance outlet on the diagonal; in the order of :class:`_Pattern` (the unknowns'
+        fill-reducing order once a first factorization has found it)."""
+        if self._pattern is None:
+            self._pattern = _Pattern(self, None)
         outlets = np.flatnonzero(self.g_out)
-        rows = np.concatenate([U, U, V, V, outlets])
-        cols = np.concatenate([U, V, U, V, outlets])
         vals = np.concatenate([-gu, -gv, gu, gv, -self.g_out[outlets]])
-        keep = self.unknown[rows] & self.unknown[cols]
-        m = self.free.size
-        return sp.csc_matrix((vals[keep], (self.where[rows[keep]], self.where[cols[keep]])), shape=(m, m))
+        return self._pattern.matrix(vals)
 
     def _balance(self, q, p):
         """Net inflow at every node: sum of q into it - sum out of it + injection + what a
@@ -199,7 +202,9 @@ class _Solver:
         return self.source + self.g_out * (self.p_distal - p)
 
     def _rigid_start(self):
-        """Pressures of the rigid Newtonian network (apparent viscosities, three Picard sweeps)."""
+        """Pressures of the rigid Newtonian network (apparent viscosities, three Picard sweeps, the
+        last with the tubes inflated by their walls' strains at the pressures of the one before), and
+        the rigid conductances (the Jacobian's reference scale)."""
         a, length = self.radius, self.length
         mu = np.where(self.feeder, self.feed_groups.nominal_viscosity(self.n_tubes),
                       self.groups.nominal_viscosity(self.n_tubes))
@@ -207,7 +212,11 @@ class _Solver:
         mu = np.where(good, mu, np.median(mu[good]) if np.any(good) else 1e-3)
         p = self.p_fixed.copy()
         for sweep in range(4):
-            c = math.pi * a**4 / (8 * mu * length)
+            c = rigid = math.pi * a**4 / (8 * mu * length)
+            if sweep == 3 and np.all(p < self.p_limit):
+                # inflated by the pressures of the sweep before, where they are below every bound
+                # (beyond one, no steady state may exist: the start stays rigid)
+                c = rigid * self._inflation(p)
             rhs = self._supplied(np.zeros_like(p))
             # K p = s with K the weighted Laplacian; move the fixed columns to the right
             known = np.where(self.fixed, self.p_fixed, 0.0)
@@ -219,7 +228,13 @@ class _Solver:
             if sweep < 3:
                 mu = self.feed_groups.apparent_viscosity(q, self.groups.apparent_viscosity(q, mu))
         self._unknowns(~self.fixed & ~self.feeds)
-        return p, c
+        return p, rigid
+
+    def _inflation(self, p):
+        """Per tube, the factor by which its inflation raises its conductance at the pressures
+        ``p``: the mean of :math:`(R/a)^4` at its two ends (the start only)."""
+        mid = 0.5 * (p[self.U] + p[self.V])
+        return (1.0 + self.feed_groups.strain(mid) + self.groups.strain(mid)) ** 4
 
     # ------------------------------------------------------------------ Newton
     def _edges(self, p):
@@ -251,10 +266,19 @@ class _Solver:
         return sign * q, gu, gv, r_u, r_v
 
     def _linear_solve(self, jac, rhs):
+        """Solve ``jac x = rhs`` (``jac`` from :meth:`_jacobian`, ``rhs`` and ``x`` over the free
+        nodes in their own order). The first factorization of a pattern orders its columns by
+        minimum degree on A^T + A (the pattern is symmetric, a graph's: less fill than the default
+        COLAMD); the Jacobian is then assembled in that order, so that every later factorization
+        keeps it (``permc_spec="NATURAL"``) instead of computing it again."""
+        pattern = self._pattern
         try:
-            # the Jacobian's pattern is symmetric (a graph's): minimum degree on A^T + A orders it
-            # with less fill than the default COLAMD (a 10^5-vessel tree: 0.05 s against 0.15 s)
-            return spla.splu(jac, permc_spec="MMD_AT_PLUS_A").solve(rhs)
+            if pattern.order is None:
+                lu = spla.splu(jac, permc_spec="MMD_AT_PLUS_A")
+                self._pattern = _Pattern(self, lu.perm_c)
+                return lu.solve(rhs)
+            # position order[i] holds free node i: solve for the positions, read them back per node
+            return spla.splu(jac, permc_spec="NATURAL").solve(rhs[pattern.inverse])[pattern.order]
         except RuntimeError as exc:          # an exactly singular Jacobian
             raise ConvergenceError(f"network: singular Jacobian ({exc})") from None
 
@@ -479,6 +503,37 @@ class _Solver:
                                         "inflation, not collapse)", self.nodes[node],
                                         f"node {self.nodes[node]!r} would need a negative transmural pressure")
         return float(frac[i]), (node if up[i] else None)
+
+
+class _Pattern:
+    """The sparsity pattern of the Jacobian over a solver's unknowns, in compressed-column form,
+    built once per set of unknowns: an entry of :meth:`_Solver._jacobian`'s value list (the tubes'
+    four derivatives and the outlets' diagonal) either falls outside the unknowns (dropped) or
+    adds into one slot of the matrix's data (duplicates, such as the diagonal, add up). With
+    ``order`` (a permutation of the free nodes, from a first factorization) free node ``i`` sits
+    at row and column ``order[i]``; ``inverse`` is the free node at each position."""
+
+    def __init__(self, solver, order):
+        U, V = solver.U, solver.V
+        outlets = np.flatnonzero(solver.g_out)
+        rows = np.concatenate([U, U, V, V, outlets])
+        cols = np.concatenate([U, V, U, V, outlets])
+        self.keep = solver.unknown[rows] & solver.unknown[cols]
+        m = self.m = solver.free.size
+        r, c = solver.where[rows[self.keep]], solver.where[cols[self.keep]]
+        self.order = None if order is None else np.asarray(order)
+        if order is not None:
+            r, c = self.order[r], self.order[c]
+            self.inverse = np.argsort(self.order)
+        # column-major keys: their sorted distinct values are the matrix's entries in CSC order
+        keys, self.slot = np.unique(c.astype(np.int64) * m + r, return_inverse=True)
+        self.indices = (keys % m).astype(np.int32)
+        self.indptr = np.concatenate([[0], np.cumsum(np.bincount(keys // m, minlength=m))]).astype(np.int32)
+
+    def matrix(self, values):
+        """The CSC matrix of the pattern with the entries ``values`` (summed into their slots)."""
+        data = np.bincount(self.slot, values[self.keep], self.indices.size)
+        return sp.csc_matrix((data, self.indices, self.indptr), shape=(self.m, self.m))
 
 
 #: Why a network can have no resolvable throughput: tubes in series whose conductances differ by
