@@ -6,7 +6,9 @@ the tubes of :meth:`Network.add_tube` and :meth:`Network.add_tubes` alike.
 
 from __future__ import annotations
 
+import itertools
 import math
+import operator
 
 import attrs
 import numpy as np
@@ -20,6 +22,11 @@ from .profiles import Profile
 from .scene import make_scene
 from .solve import max_flow_rate as tubefsi_max_flow
 from .solve import solve_unchecked
+
+
+#: a network tube's models, external pressure and row (``network._Tube``), read by ``map`` over many tubes
+_WALL, _TUBE, _FLUID = (operator.attrgetter(f) for f in ("wall", "tube", "rheology"))
+_EXTERNAL, _ROW = operator.attrgetter("external_pressure"), operator.attrgetter("row")
 
 
 @attrs.frozen(eq=False)
@@ -71,28 +78,24 @@ class _Groups:
         # one dict lookup per tube: the models' identities -> the group they belong to (a graded
         # tube's: its very models; a uniform one's: its wall and fluid classes and fixed parameters)
         groups: dict = {}
-        graded: dict = {}
         by_models: dict = {}
         for i in np.flatnonzero(subset).tolist():      # (the tubes of the subset only)
             t = tubes[i]
             ids = (id(t.wall), id(t.tube), id(t.rheology))
             found = by_models.get(ids)
             if found is None:
-                if t.graded:
-                    found = by_models[ids] = graded.setdefault(ids, [])
-                else:
-                    key = ((type(t.wall), _fixed(t.wall)), (type(t.rheology), _fixed(t.rheology)))
-                    found = by_models[ids] = groups.setdefault(key, [])
+                key = ("graded", ids) if t.graded else \
+                    ((type(t.wall), _fixed(t.wall)), (type(t.rheology), _fixed(t.rheology)))
+                found = by_models[ids] = groups.setdefault(key, ([], t.graded))[0]
             found.append(i)
         self.parts = []
-        for index in (g for g in groups.values() if g):
+        for index in (index for index, graded in groups.values() if not graded):
             members = [tubes[i] for i in index]
             wall = _stack(members, "wall")
             fluid = _stack(members, "rheology")
             tube = Tube(**_gather(members, "tube", ("radius", "thickness", "length")))
-            self.parts.append(_Part(np.asarray(index), fluid, wall, tube,
-                                    _column([m.external_pressure for m in members])))
-        for index in (g for g in graded.values() if g):
+            self.parts.append(_Part(np.asarray(index), fluid, wall, tube, _column(list(map(_EXTERNAL, members)))))
+        for index in (index for index, graded in groups.values() if graded):
             t = tubes[index[0]]
             self.parts.append(_Part(np.asarray(index), t.rheology, t.wall, t.tube,
                                     _column([tubes[i].external_pressure for i in index]), _reversed(t.wall, t.tube)))
@@ -314,10 +317,10 @@ def _gather(members, which, fields) -> dict:
     agree, else an array aligned with ``members``). Tubes added together by
     :meth:`Network.add_tubes` share one model: their entries are taken at their rows, in one
     indexing per model rather than one lookup per tube."""
-    models = [getattr(m, which) for m in members]
+    models = list(map(operator.attrgetter(which), members))
     first = models[0]
-    if all(model is first for model in models):          # one model (one add_tubes call, or shared)
-        by_model = {id(first): (first, slice(None), [m.row for m in members])}
+    if all(map(operator.is_, models, itertools.repeat(first))):     # one model (one add_tubes call, or shared)
+        by_model = {id(first): (first, slice(None), list(map(_ROW, members)))}
     else:
         by_model = {}
         for j, (m, model) in enumerate(zip(members, models)):

@@ -19,11 +19,11 @@ evaluated in one broadcast :func:`tubefsi.solve` per iteration and per group of 
 share their wall and fluid classes (their parameters stacked into arrays).
 
 Globalization: the start is the rigid Newtonian network (each tube a Hagen–Poiseuille
-conductance :math:`\pi a^4/(8\mu L)` at the fluid's apparent viscosity, refined by three
+conductance :math:`\pi a^4/(8\mu L)` at the fluid's apparent viscosity, refined by two
 Picard sweeps, the last with each tube's conductance times :math:`(1+\varepsilon)^4`, its wall's
-hoop strain at the mean of its end pressures); every Newton step is cut to stay inside :math:`0 \le p_i < p_{lim}` (a step goes
-at most 90 % of the way to a tube's limit pressure or to zero) and then halved until the
-residual norm :math:`\|F\|_2` decreases (Armijo). The derivative of a tube without flow is
+hoop strain at the mean of its end pressures); every Newton step is cut to stay inside
+:math:`0 \le p_i < p_{lim}` (a step goes at most 90 % of the way to a tube's limit pressure or
+to zero) and then halved until the residual norm :math:`\|F\|_2` decreases (Armijo). The derivative of a tube without flow is
 degenerate — :math:`\partial q/\partial p \to 0` for a shear-thinning fluid, :math:`\infty` for a
 shear-thickening one, as :math:`\Delta p \to 0` — so a tube whose pressure drop is below
 :math:`10^{-8}` of the largest pressure enters the Jacobian with its secant conductance
@@ -58,6 +58,9 @@ from .network_solution import NetworkSolution, _hashable
 
 #: Jacobian conductances are clipped to [_CLIP, 1/_CLIP] times the rigid start conductance
 _CLIP = 1e-8
+#: linear solves of the rigid start: the first at the viscosity at 1/s, then Picard sweeps on the
+#: apparent viscosity, the last with the tubes inflated (``_Solver._rigid_start``)
+_SWEEPS = 3
 #: fraction of the way to a bound (a limit pressure, zero) that one Newton step may go
 _TO_BOUND = 0.9
 #: a tube whose pressure drop is below this times the largest pressure counts as without flow
@@ -202,7 +205,7 @@ class _Solver:
         return self.source + self.g_out * (self.p_distal - p)
 
     def _rigid_start(self):
-        """Pressures of the rigid Newtonian network (apparent viscosities, three Picard sweeps, the
+        """Pressures of the rigid Newtonian network (apparent viscosities, two Picard sweeps, the
         last with the tubes inflated by their walls' strains at the pressures of the one before), and
         the rigid conductances (the Jacobian's reference scale)."""
         a, length = self.radius, self.length
@@ -211,9 +214,9 @@ class _Solver:
         good = np.isfinite(mu) & (mu > 0)
         mu = np.where(good, mu, np.median(mu[good]) if np.any(good) else 1e-3)
         p = self.p_fixed.copy()
-        for sweep in range(4):
+        for sweep in range(_SWEEPS):
             c = rigid = math.pi * a**4 / (8 * mu * length)
-            if sweep == 3 and np.all(p < self.p_limit):
+            if sweep == _SWEEPS - 1 and np.all(p < self.p_limit):
                 # inflated by the pressures of the sweep before, where they are below every bound
                 # (beyond one, no steady state may exist: the start stays rigid)
                 c = rigid * self._inflation(p)
@@ -225,7 +228,7 @@ class _Solver:
             jac = self._jacobian(c, -c)
             p[self.free] = self._linear_solve(jac, -rhs[self.free]) if self.free.size else p[self.free]
             q = c * (p[self.U] - p[self.V])
-            if sweep < 3:
+            if sweep < _SWEEPS - 1:
                 mu = self.feed_groups.apparent_viscosity(q, self.groups.apparent_viscosity(q, mu))
         self._unknowns(~self.fixed & ~self.feeds)
         return p, rigid
