@@ -273,15 +273,19 @@ class _Solver:
         nodes in their own order). The first factorization of a pattern orders its columns by
         minimum degree on A^T + A (the pattern is symmetric, a graph's: less fill than the default
         COLAMD); the Jacobian is then assembled in that order, so that every later factorization
-        keeps it (``permc_spec="NATURAL"``) instead of computing it again."""
+        keeps it (``permc_spec="NATURAL"``) instead of computing it again. No relaxed supernodes and
+        panels of one column: a network's Jacobian is so sparse (a graph's pattern) that SuperLU's
+        supernode machinery costs more than it saves (per factorization, the 10^5-tube tree of
+        ``benchmarks/network_scale.py``: 10 ms against 25 ms; its lattice: 88 ms against 128 ms)."""
         pattern = self._pattern
         try:
             if pattern.order is None:
-                lu = spla.splu(jac, permc_spec="MMD_AT_PLUS_A")
+                lu = spla.splu(jac, permc_spec="MMD_AT_PLUS_A", relax=1, panel_size=1)
                 self._pattern = _Pattern(self, lu.perm_c)
                 return lu.solve(rhs)
             # position order[i] holds free node i: solve for the positions, read them back per node
-            return spla.splu(jac, permc_spec="NATURAL").solve(rhs[pattern.inverse])[pattern.order]
+            lu = spla.splu(jac, permc_spec="NATURAL", relax=1, panel_size=1)
+            return lu.solve(rhs[pattern.inverse])[pattern.order]
         except RuntimeError as exc:          # an exactly singular Jacobian
             raise ConvergenceError(f"network: singular Jacobian ({exc})") from None
 
