@@ -160,7 +160,7 @@ class Network:
         n = len(u)
         if n == 0 or len(v) != n:
             raise InvalidParameterError("v", f"a sequence as long as u ({n} >= 1 node names)", len(v))
-        names = [(a, b) for a, b in zip(u, v)] if names is None else _names_of("names", names)
+        names = list(zip(u, v)) if names is None else _names_of("names", names)
         if len(names) != n:
             raise InvalidParameterError("names", f"{n} names, one per tube", len(names))
         loops = [k for k, (a, b) in enumerate(zip(u, v)) if a == b]

@@ -45,6 +45,7 @@ throughput (the total flow that enters the network); otherwise :class:`Convergen
 from __future__ import annotations
 
 import math
+import operator
 
 import numpy as np
 import scipy.sparse as sp
@@ -88,21 +89,22 @@ class _Solver:
         self.tubes = list(net._tubes.values())
         self.nodes = list(net._nodes)
         index = net._nodes
-        self.U = np.array([index[t.u] for t in self.tubes])
-        self.V = np.array([index[t.v] for t in self.tubes])
         n_nodes, n_tubes = len(self.nodes), len(self.tubes)
+        self.U, self.V = (np.fromiter(map(index.__getitem__, map(operator.attrgetter(end), self.tubes)), np.intp,
+                                      n_tubes) for end in ("u", "v"))
+        # the boundary conditions, node by node (one indexing per kind)
         self.fixed = np.zeros(n_nodes, dtype=bool)
         self.p_fixed = np.zeros(n_nodes)
-        for node, p in net._pressure.items():
-            self.fixed[index[node]], self.p_fixed[index[node]] = True, p
+        at, values = _at(index, net._pressure)
+        self.fixed[at], self.p_fixed[at] = True, values
         self.source = np.zeros(n_nodes)
-        for node, s in net._inflow.items():
-            self.source[index[node]] = s
+        at, values = _at(index, net._inflow)
+        self.source[at] = values
         # resistance outlets: q = g (p - p_d) leaves node i, g = 1/R (0 elsewhere)
         self.g_out = np.zeros(n_nodes)
         self.p_distal = np.zeros(n_nodes)
-        for node, (r, p_d) in net._resistance.items():
-            self.g_out[index[node]], self.p_distal[index[node]] = 1.0 / r, p_d
+        at, values = _at(index, net._resistance)
+        self.g_out[at], self.p_distal[at] = (1.0 / values[:, 0], values[:, 1]) if at.size else (0.0, 0.0)
         self._check_connected(n_nodes)
         # a feeder: a node with an inflow and one tube; that tube's flow is known, so it is solved
         # flow-controlled after the rest (no pressure unknown near a limit pressure at the inlet)
@@ -553,6 +555,13 @@ _UNRESOLVED = ("; no flow is resolved at all: tubes in series whose conductances
 #: The largest mass imbalance (a share of the throughput) accepted, with an AccuracyWarning, where
 #: the rounding of the pressures allows no better; beyond it the line search's stall is an error.
 _WORST_ROUNDED = 1e-6
+
+
+def _at(index, by_node):
+    """``(positions, values)`` of a mapping node -> value (a number or a pair): the nodes'
+    positions in ``index`` and their values as an array."""
+    at = np.fromiter(map(index.__getitem__, by_node), np.intp, len(by_node))
+    return at, np.array(list(by_node.values()), dtype=float)
 
 
 def _share(worst, through) -> float:
