@@ -531,9 +531,11 @@ class _Pattern:
         m = self.m = solver.free.size
         r, c = solver.where[rows[self.keep]], solver.where[cols[self.keep]]
         self.order = None if order is None else np.asarray(order)
-        if order is not None:
-            r, c = self.order[r], self.order[c]
-            self.inverse = np.argsort(self.order)
+        if order is None:              # (one matrix before the ordering: SciPy sums it from COO)
+            self.rows, self.cols = r, c
+            return
+        r, c = self.order[r], self.order[c]
+        self.inverse = np.argsort(self.order)
         # column-major keys: their sorted distinct values are the matrix's entries in CSC order
         keys, self.slot = np.unique(c.astype(np.int64) * m + r, return_inverse=True)
         self.indices = (keys % m).astype(np.int32)
@@ -541,6 +543,8 @@ class _Pattern:
 
     def matrix(self, values):
         """The CSC matrix of the pattern with the entries ``values`` (summed into their slots)."""
+        if self.order is None:
+            return sp.csc_matrix((values[self.keep], (self.rows, self.cols)), shape=(self.m, self.m))
         data = np.bincount(self.slot, values[self.keep], self.indices.size)
         return sp.csc_matrix((data, self.indices, self.indptr), shape=(self.m, self.m))
 
