@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import copy
 import itertools
+import operator
 from collections.abc import Hashable
 
 import attrs
@@ -160,12 +161,11 @@ class Network:
         n = len(u)
         if n == 0 or len(v) != n:
             raise InvalidParameterError("v", f"a sequence as long as u ({n} >= 1 node names)", len(v))
-        names = [(a, b) for a, b in zip(u, v)] if names is None else _names_of("names", names)
+        names = list(zip(u, v)) if names is None else _names_of("names", names)
         if len(names) != n:
             raise InvalidParameterError("names", f"{n} names, one per tube", len(names))
-        loops = [k for k, (a, b) in enumerate(zip(u, v)) if a == b]
-        if loops:
-            k = loops[0]
+        if any(map(operator.eq, u, v)):                   # (a loop: found in C, then named)
+            k = next(k for k, (a, b) in enumerate(zip(u, v)) if a == b)
             raise InvalidParameterError(f"v[{k}]", "a node other than u[k]", v[k], "a tube joins two distinct nodes")
         taken = self._tubes.keys()
         if len(set(names)) != n or not taken.isdisjoint(names):       # (set operations: one pass in C)

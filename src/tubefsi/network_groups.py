@@ -6,7 +6,9 @@ the tubes of :meth:`Network.add_tube` and :meth:`Network.add_tubes` alike.
 
 from __future__ import annotations
 
+import itertools
 import math
+import operator
 
 import attrs
 import numpy as np
@@ -20,6 +22,11 @@ from .profiles import Profile
 from .scene import make_scene
 from .solve import max_flow_rate as tubefsi_max_flow
 from .solve import solve_unchecked
+
+
+#: a network tube's models, external pressure and row (``network._Tube``), read by ``map`` over many tubes
+_WALL, _TUBE, _FLUID = (operator.attrgetter(f) for f in ("wall", "tube", "rheology"))
+_EXTERNAL, _ROW = operator.attrgetter("external_pressure"), operator.attrgetter("row")
 
 
 @attrs.frozen(eq=False)
@@ -71,30 +78,24 @@ class _Groups:
         # one dict lookup per tube: the models' identities -> the group they belong to (a graded
         # tube's: its very models; a uniform one's: its wall and fluid classes and fixed parameters)
         groups: dict = {}
-        graded: dict = {}
         by_models: dict = {}
-        take = subset.tolist()
-        for i, t in enumerate(tubes):
-            if not take[i]:
-                continue
+        for i in np.flatnonzero(subset).tolist():      # (the tubes of the subset only)
+            t = tubes[i]
             ids = (id(t.wall), id(t.tube), id(t.rheology))
             found = by_models.get(ids)
             if found is None:
-                if t.graded:
-                    found = by_models[ids] = graded.setdefault(ids, [])
-                else:
-                    key = ((type(t.wall), _fixed(t.wall)), (type(t.rheology), _fixed(t.rheology)))
-                    found = by_models[ids] = groups.setdefault(key, [])
+                key = ("graded", ids) if t.graded else \
+                    ((type(t.wall), _fixed(t.wall)), (type(t.rheology), _fixed(t.rheology)))
+                found = by_models[ids] = groups.setdefault(key, ([], t.graded))[0]
             found.append(i)
         self.parts = []
-        for index in (g for g in groups.values() if g):
+        for index in (index for index, graded in groups.values() if not graded):
             members = [tubes[i] for i in index]
             wall = _stack(members, "wall")
             fluid = _stack(members, "rheology")
             tube = Tube(**_gather(members, "tube", ("radius", "thickness", "length")))
-            self.parts.append(_Part(np.asarray(index), fluid, wall, tube,
-                                    _column([m.external_pressure for m in members])))
-        for index in (g for g in graded.values() if g):
+            self.parts.append(_Part(np.asarray(index), fluid, wall, tube, _column(list(map(_EXTERNAL, members)))))
+        for index in (index for index, graded in groups.values() if graded):
             t = tubes[index[0]]
             self.parts.append(_Part(np.asarray(index), t.rheology, t.wall, t.tube,
                                     _column([tubes[i].external_pressure for i in index]), _reversed(t.wall, t.tube)))
@@ -228,6 +229,19 @@ class _Groups:
                 out[index] = np.where(ok & np.isfinite(value) & (value > 0), value, mu[index])
         return out
 
+    def strain(self, pressure):
+        """Per tube, the hoop strain of its wall under the node (gauge) ``pressure`` (one per tube)
+        held below 90 % of its limit pressure and above its external pressure (0 for the tubes of
+        no part and for a graded tube): the rigid start's estimate of the inflated radii."""
+        out = np.zeros(pressure.size)
+        for part in self.parts:
+            if part.reverse is not None:
+                continue
+            index, p_e = part.index, np.asarray(part.external, dtype=float)
+            transmural = np.clip(pressure[index] - p_e, 0.0, 0.9 * (self.limit[index] - p_e))
+            out[index] = np.broadcast_to(part.wall.strain(transmural, part.tube.reduced_thickness), index.shape)
+        return out
+
     def nominal_viscosity(self, n):
         mu = np.empty(n)
         for part in self.parts:
@@ -303,10 +317,10 @@ def _gather(members, which, fields) -> dict:
     agree, else an array aligned with ``members``). Tubes added together by
     :meth:`Network.add_tubes` share one model: their entries are taken at their rows, in one
     indexing per model rather than one lookup per tube."""
-    models = [getattr(m, which) for m in members]
+    models = list(map(operator.attrgetter(which), members))
     first = models[0]
-    if all(model is first for model in models):          # one model (one add_tubes call, or shared)
-        by_model = {id(first): (first, slice(None), [m.row for m in members])}
+    if all(map(operator.is_, models, itertools.repeat(first))):     # one model (one add_tubes call, or shared)
+        by_model = {id(first): (first, slice(None), list(map(_ROW, members)))}
     else:
         by_model = {}
         for j, (m, model) in enumerate(zip(members, models)):
@@ -317,6 +331,7 @@ def _gather(members, which, fields) -> dict:
             entry[2].append(m.row)
     out = {f: np.empty(len(members)) for f in fields}
     for model, positions, rows in by_model.values():
+        rows = np.asarray(rows) if rows[0] is not None else rows     # (one conversion for every field)
         for f in fields:
             value = getattr(model, f)
             out[f][positions] = value[rows] if isinstance(value, np.ndarray) and value.ndim else value

@@ -11,6 +11,7 @@ from __future__ import annotations
 import csv
 import json
 import math
+import operator
 import os
 from collections.abc import Hashable
 
@@ -110,7 +111,7 @@ class NetworkSolution:
 
     @property
     def tube_names(self) -> list:
-        return self._once("tube_names", lambda: [t.name for t in self.tubes])
+        return self._once("tube_names", lambda: list(map(operator.attrgetter("name"), self.tubes)))
 
     @property
     def tube_index(self) -> dict:

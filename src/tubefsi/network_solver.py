@@ -19,10 +19,11 @@ evaluated in one broadcast :func:`tubefsi.solve` per iteration and per group of 
 share their wall and fluid classes (their parameters stacked into arrays).
 
 Globalization: the start is the rigid Newtonian network (each tube a Hagen–Poiseuille
-conductance :math:`\pi a^4/(8\mu L)` at the fluid's apparent viscosity, refined by three
-Picard sweeps); every Newton step is cut to stay inside :math:`0 \le p_i < p_{lim}` (a step goes
-at most 90 % of the way to a tube's limit pressure or to zero) and then halved until the
-residual norm :math:`\|F\|_2` decreases (Armijo). The derivative of a tube without flow is
+conductance :math:`\pi a^4/(8\mu L)` at the fluid's apparent viscosity, refined by two
+Picard sweeps, the last with each tube's conductance times :math:`(1+\varepsilon)^4`, its wall's
+hoop strain at the mean of its end pressures); every Newton step is cut to stay inside
+:math:`0 \le p_i < p_{lim}` (a step goes at most 90 % of the way to a tube's limit pressure or
+to zero) and then halved until the residual norm :math:`\|F\|_2` decreases (Armijo). The derivative of a tube without flow is
 degenerate — :math:`\partial q/\partial p \to 0` for a shear-thinning fluid, :math:`\infty` for a
 shear-thickening one, as :math:`\Delta p \to 0` — so a tube whose pressure drop is below
 :math:`10^{-8}` of the largest pressure enters the Jacobian with its secant conductance
@@ -44,6 +45,7 @@ throughput (the total flow that enters the network); otherwise :class:`Convergen
 from __future__ import annotations
 
 import math
+import operator
 
 import numpy as np
 import scipy.sparse as sp
@@ -57,6 +59,9 @@ from .network_solution import NetworkSolution, _hashable
 
 #: Jacobian conductances are clipped to [_CLIP, 1/_CLIP] times the rigid start conductance
 _CLIP = 1e-8
+#: linear solves of the rigid start: the first at the viscosity at 1/s, then Picard sweeps on the
+#: apparent viscosity, the last with the tubes inflated (``_Solver._rigid_start``)
+_SWEEPS = 3
 #: fraction of the way to a bound (a limit pressure, zero) that one Newton step may go
 _TO_BOUND = 0.9
 #: a tube whose pressure drop is below this times the largest pressure counts as without flow
@@ -84,21 +89,22 @@ class _Solver:
         self.tubes = list(net._tubes.values())
         self.nodes = list(net._nodes)
         index = net._nodes
-        self.U = np.array([index[t.u] for t in self.tubes])
-        self.V = np.array([index[t.v] for t in self.tubes])
         n_nodes, n_tubes = len(self.nodes), len(self.tubes)
+        self.U, self.V = (np.fromiter(map(index.__getitem__, map(operator.attrgetter(end), self.tubes)), np.intp,
+                                      n_tubes) for end in ("u", "v"))
+        # the boundary conditions, node by node (one indexing per kind)
         self.fixed = np.zeros(n_nodes, dtype=bool)
         self.p_fixed = np.zeros(n_nodes)
-        for node, p in net._pressure.items():
-            self.fixed[index[node]], self.p_fixed[index[node]] = True, p
+        at, values = _at(index, net._pressure)
+        self.fixed[at], self.p_fixed[at] = True, values
         self.source = np.zeros(n_nodes)
-        for node, s in net._inflow.items():
-            self.source[index[node]] = s
+        at, values = _at(index, net._inflow)
+        self.source[at] = values
         # resistance outlets: q = g (p - p_d) leaves node i, g = 1/R (0 elsewhere)
         self.g_out = np.zeros(n_nodes)
         self.p_distal = np.zeros(n_nodes)
-        for node, (r, p_d) in net._resistance.items():
-            self.g_out[index[node]], self.p_distal[index[node]] = 1.0 / r, p_d
+        at, values = _at(index, net._resistance)
+        self.g_out[at], self.p_distal[at] = (1.0 / values[:, 0], values[:, 1]) if at.size else (0.0, 0.0)
         self._check_connected(n_nodes)
         # a feeder: a node with an inflow and one tube; that tube's flow is known, so it is solved
         # flow-controlled after the rest (no pressure unknown near a limit pressure at the inlet)
@@ -126,6 +132,7 @@ class _Solver:
                                      f"{self._limiting_tube(i)!r}")
         self._check_outlet_capacity()
         self.n_tubes = n_tubes
+        self.unknown = None
         self._unknowns(~self.fixed)
 
     def _check_outlet_capacity(self):
@@ -165,10 +172,13 @@ class _Solver:
     def _unknowns(self, mask):
         """Make the nodes of ``mask`` the unknowns (the rigid start: every free node; Newton: the
         free nodes but the feeders)."""
+        if self.unknown is not None and np.array_equal(mask, self.unknown):
+            return                           # the same unknowns: the Jacobian's pattern is kept
         self.unknown = mask
         self.free = np.flatnonzero(mask)
         self.where = np.full(mask.size, -1)
         self.where[self.free] = np.arange(self.free.size)
+        self._pattern = None                 # built by the next _jacobian
 
     def _limiting_tube(self, i):
         at = np.flatnonzero((self.U == i) | (self.V == i))
@@ -177,15 +187,13 @@ class _Solver:
     # ------------------------------------------------------------------ linear algebra
     def _jacobian(self, gu, gv):
         """dF/dp over the free nodes from dq_e/dp_u = gu, dq_e/dp_v = gv, and the exact -1/R of
-        each resistance outlet on the diagonal."""
-        U, V = self.U, self.V
+        each resistance outlet on the diagonal; in the order of :class:`_Pattern` (the unknowns'
+        fill-reducing order once a first factorization has found it)."""
+        if self._pattern is None:
+            self._pattern = _Pattern(self, None)
         outlets = np.flatnonzero(self.g_out)
-        rows = np.concatenate([U, U, V, V, outlets])
-        cols = np.concatenate([U, V, U, V, outlets])
         vals = np.concatenate([-gu, -gv, gu, gv, -self.g_out[outlets]])
-        keep = self.unknown[rows] & self.unknown[cols]
-        m = self.free.size
-        return sp.csc_matrix((vals[keep], (self.where[rows[keep]], self.where[cols[keep]])), shape=(m, m))
+        return self._pattern.matrix(vals)
 
     def _balance(self, q, p):
         """Net inflow at every node: sum of q into it - sum out of it + injection + what a
@@ -199,15 +207,21 @@ class _Solver:
         return self.source + self.g_out * (self.p_distal - p)
 
     def _rigid_start(self):
-        """Pressures of the rigid Newtonian network (apparent viscosities, three Picard sweeps)."""
+        """Pressures of the rigid Newtonian network (apparent viscosities, two Picard sweeps, the
+        last with the tubes inflated by their walls' strains at the pressures of the one before), and
+        the rigid conductances (the Jacobian's reference scale)."""
         a, length = self.radius, self.length
         mu = np.where(self.feeder, self.feed_groups.nominal_viscosity(self.n_tubes),
                       self.groups.nominal_viscosity(self.n_tubes))
         good = np.isfinite(mu) & (mu > 0)
         mu = np.where(good, mu, np.median(mu[good]) if np.any(good) else 1e-3)
         p = self.p_fixed.copy()
-        for sweep in range(4):
-            c = math.pi * a**4 / (8 * mu * length)
+        for sweep in range(_SWEEPS):
+            c = rigid = math.pi * a**4 / (8 * mu * length)
+            if sweep == _SWEEPS - 1 and np.all(p < self.p_limit):
+                # inflated by the pressures of the sweep before, where they are below every bound
+                # (beyond one, no steady state may exist: the start stays rigid)
+                c = rigid * self._inflation(p)
             rhs = self._supplied(np.zeros_like(p))
             # K p = s with K the weighted Laplacian; move the fixed columns to the right
             known = np.where(self.fixed, self.p_fixed, 0.0)
@@ -216,10 +230,16 @@ class _Solver:
             jac = self._jacobian(c, -c)
             p[self.free] = self._linear_solve(jac, -rhs[self.free]) if self.free.size else p[self.free]
             q = c * (p[self.U] - p[self.V])
-            if sweep < 3:
+            if sweep < _SWEEPS - 1:
                 mu = self.feed_groups.apparent_viscosity(q, self.groups.apparent_viscosity(q, mu))
         self._unknowns(~self.fixed & ~self.feeds)
-        return p, c
+        return p, rigid
+
+    def _inflation(self, p):
+        """Per tube, the factor by which its inflation raises its conductance at the pressures
+        ``p``: the mean of :math:`(R/a)^4` at its two ends (the start only)."""
+        mid = 0.5 * (p[self.U] + p[self.V])
+        return (1.0 + self.feed_groups.strain(mid) + self.groups.strain(mid)) ** 4
 
     # ------------------------------------------------------------------ Newton
     def _edges(self, p):
@@ -251,10 +271,23 @@ class _Solver:
         return sign * q, gu, gv, r_u, r_v
 
     def _linear_solve(self, jac, rhs):
+        """Solve ``jac x = rhs`` (``jac`` from :meth:`_jacobian`, ``rhs`` and ``x`` over the free
+        nodes in their own order). The first factorization of a pattern orders its columns by
+        minimum degree on A^T + A (the pattern is symmetric, a graph's: less fill than the default
+        COLAMD); the Jacobian is then assembled in that order, so that every later factorization
+        keeps it (``permc_spec="NATURAL"``) instead of computing it again. No relaxed supernodes and
+        panels of one column: a network's Jacobian is so sparse (a graph's pattern) that SuperLU's
+        supernode machinery costs more than it saves (per factorization, the 10^5-tube tree of
+        ``benchmarks/network_scale.py``: 10 ms against 25 ms; its lattice: 88 ms against 128 ms)."""
+        pattern = self._pattern
         try:
-            # the Jacobian's pattern is symmetric (a graph's): minimum degree on A^T + A orders it
-            # with less fill than the default COLAMD (a 10^5-vessel tree: 0.05 s against 0.15 s)
-            return spla.splu(jac, permc_spec="MMD_AT_PLUS_A").solve(rhs)
+            if pattern.order is None:
+                lu = spla.splu(jac, permc_spec="MMD_AT_PLUS_A", relax=1, panel_size=1)
+                self._pattern = _Pattern(self, lu.perm_c)
+                return lu.solve(rhs)
+            # position order[i] holds free node i: solve for the positions, read them back per node
+            lu = spla.splu(jac, permc_spec="NATURAL", relax=1, panel_size=1)
+            return lu.solve(rhs[pattern.inverse])[pattern.order]
         except RuntimeError as exc:          # an exactly singular Jacobian
             raise ConvergenceError(f"network: singular Jacobian ({exc})") from None
 
@@ -481,6 +514,41 @@ class _Solver:
         return float(frac[i]), (node if up[i] else None)
 
 
+class _Pattern:
+    """The sparsity pattern of the Jacobian over a solver's unknowns, in compressed-column form,
+    built once per set of unknowns: an entry of :meth:`_Solver._jacobian`'s value list (the tubes'
+    four derivatives and the outlets' diagonal) either falls outside the unknowns (dropped) or
+    adds into one slot of the matrix's data (duplicates, such as the diagonal, add up). With
+    ``order`` (a permutation of the free nodes, from a first factorization) free node ``i`` sits
+    at row and column ``order[i]``; ``inverse`` is the free node at each position."""
+
+    def __init__(self, solver, order):
+        U, V = solver.U, solver.V
+        outlets = np.flatnonzero(solver.g_out)
+        rows = np.concatenate([U, U, V, V, outlets])
+        cols = np.concatenate([U, V, U, V, outlets])
+        self.keep = solver.unknown[rows] & solver.unknown[cols]
+        m = self.m = solver.free.size
+        r, c = solver.where[rows[self.keep]], solver.where[cols[self.keep]]
+        self.order = None if order is None else np.asarray(order)
+        if order is None:              # (one matrix before the ordering: SciPy sums it from COO)
+            self.rows, self.cols = r, c
+            return
+        r, c = self.order[r], self.order[c]
+        self.inverse = np.argsort(self.order)
+        # column-major keys: their sorted distinct values are the matrix's entries in CSC order
+        keys, self.slot = np.unique(c.astype(np.int64) * m + r, return_inverse=True)
+        self.indices = (keys % m).astype(np.int32)
+        self.indptr = np.concatenate([[0], np.cumsum(np.bincount(keys // m, minlength=m))]).astype(np.int32)
+
+    def matrix(self, values):
+        """The CSC matrix of the pattern with the entries ``values`` (summed into their slots)."""
+        if self.order is None:
+            return sp.csc_matrix((values[self.keep], (self.rows, self.cols)), shape=(self.m, self.m))
+        data = np.bincount(self.slot, values[self.keep], self.indices.size)
+        return sp.csc_matrix((data, self.indices, self.indptr), shape=(self.m, self.m))
+
+
 #: Why a network can have no resolvable throughput: tubes in series whose conductances differ by
 #: more than double precision resolves (the drop over the wide one is below one rounding unit of
 #: the pressures, so its flow is either 0 or far too large).
@@ -491,6 +559,13 @@ _UNRESOLVED = ("; no flow is resolved at all: tubes in series whose conductances
 #: The largest mass imbalance (a share of the throughput) accepted, with an AccuracyWarning, where
 #: the rounding of the pressures allows no better; beyond it the line search's stall is an error.
 _WORST_ROUNDED = 1e-6
+
+
+def _at(index, by_node):
+    """``(positions, values)`` of a mapping node -> value (a number or a pair): the nodes'
+    positions in ``index`` and their values as an array."""
+    at = np.fromiter(map(index.__getitem__, by_node), np.intp, len(by_node))
+    return at, np.array(list(by_node.values()), dtype=float)
 
 
 def _share(worst, through) -> float:
