@@ -247,3 +247,18 @@ def test_cli_evolve(tmp_path, capsys):
     r = tubefsi.evolve(fluid, wall, tube, np.linspace(0.0, 4e-3, 5), inlet_pressure=1e-3, outlet="closed", rtol=1e-2)
     np.testing.assert_array_equal(table[:, 1], r.inlet_flow_rate)
     assert (tmp_path / "h.png").stat().st_size > 0
+
+
+def test_cli_evolve_refuses_an_outlet_pressure_at_a_closed_end(tmp_path, capsys):
+    """``--outlet-pressure`` with ``--outlet closed`` has no meaning: it was silently ignored;
+    now the command fails naming it (as ``evolve`` refuses ``outlet_pressure``)."""
+    from tubefsi.cli import main
+
+    status = main(["evolve", "--rheology", "newtonian:viscosity=1e-3", "--wall",
+                   "thin-linear:youngs_modulus=1e6,poisson_ratio=0.5,end_condition=open",
+                   "--tube", "radius=1e-4,thickness=1e-5,length=1e-2", "--inlet-pressure", "1e-3",
+                   "--outlet", "closed", "--outlet-pressure", "5", "--t-end", "4e-3", "--steps", "5",
+                   "--output", str(tmp_path / "h.csv")])
+    assert status != 0
+    assert "outlet_pressure" in capsys.readouterr().err
+    assert not (tmp_path / "h.csv").exists()

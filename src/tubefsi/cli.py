@@ -341,7 +341,8 @@ def _parser() -> argparse.ArgumentParser:
     inlet.add_argument("--inlet-flow-rate", type=float, metavar="Q", help="a pump at the inlet (m^3/s)")
     p.add_argument("--outlet", choices=("open", "closed"), default="open", help="open (default) or a dead end")
     p.add_argument("--chamber", metavar="V0,C", help="a linear chamber V = V0 + C p at the outlet (m^3, m^3/Pa)")
-    p.add_argument("--outlet-pressure", type=float, default=0.0, metavar="P", help="open outlet's pressure (Pa)")
+    p.add_argument("--outlet-pressure", type=float, default=None, metavar="P",
+                   help="open outlet's pressure (Pa, default 0; refused with a closed end or a chamber)")
     p.add_argument("--external-pressure", type=float, default=0.0, metavar="PE", help="pressure outside (Pa)")
     p.add_argument("--t-end", type=float, required=True, metavar="T", help="last time (s)")
     p.add_argument("--steps", type=int, default=101, metavar="N", help="output times from 0 to T (default 101)")
@@ -739,7 +740,7 @@ def _cmd_evolve(args, out) -> int:
         raise UsageError("--t-end must be > 0 and --steps >= 2")
     result = evolve(fluid, wall, tube, np.linspace(0.0, args.t_end, args.steps), inlet_pressure=args.inlet_pressure,
                     inlet_flow_rate=args.inlet_flow_rate, outlet=outlet,
-                    outlet_pressure=args.outlet_pressure if isinstance(outlet, str) and outlet == "open" else None,
+                    outlet_pressure=args.outlet_pressure,
                     external_pressure=args.external_pressure, rtol=args.rtol, density=args.density)
     result.to_csv(args.output if args.output is not None else out)
     if args.netcdf is not None:

@@ -87,6 +87,8 @@ class Chamber:
         :class:`InvalidParameterError` naming ``compliance``). Without it, a fourth-order central
         difference of ``volume`` at a step of 1e-3 of the problem's pressure scale.
 
+    Notes
+    -----
     A chamber whose volume becomes negative during a run (emptied by suction) raises
     :class:`InvalidParameterError` naming ``outlet``.
     """
