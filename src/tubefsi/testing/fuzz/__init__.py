@@ -79,6 +79,7 @@ from ._models import (_advise_probes, _entry_keyword_probes, _model_probes, _rhe
 from ._plugins import _plugins_family
 from ._scenes import scene_outcomes
 from ._solutions import solution_probes
+from ._transients import argument_probes, transient_probes
 
 __all__ = ["Probe", "Outcome", "Report", "BREACHES", "TIME_LIMIT", "FAMILIES", "Selection", "bad_input_probes", "run_probe", "scene_outcomes",
            "campaign", "FuzzContract", "main"]
@@ -131,6 +132,17 @@ def _solutions_family(chosen):
             yield from solution_probes(fluid, wall, tube, tag)
 
 
+def _transients_family(chosen):
+    """``evolve`` for the first pair of each model, and its own arguments at bad values."""
+    tube = Tube(**_TUBE)
+    for fluid, wall, tag in chosen.pairs():
+        if tag.split()[0].endswith("#0"):
+            yield from transient_probes(fluid, wall, tube, tag)
+    if chosen.core and "power-law" in registry.rheologies and "thick-neo-hookean" in registry.walls:
+        yield from argument_probes(registry.rheologies["power-law"](consistency=0.017, index=0.7),
+                                   registry.walls["thick-neo-hookean"](shear_modulus=2e3), tube)
+
+
 def _known_family(chosen):
     if chosen.core:
         yield from _known_probes()
@@ -158,6 +170,7 @@ FAMILIES = {
     "hostile plugins": _plugins_family,
     "extremes": extremes_family,
     "inputs": _inputs_family,
+    "transients": _transients_family,
 }
 
 
