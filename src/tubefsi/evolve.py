@@ -260,9 +260,12 @@ class _System:
             raise InvalidParameterError("pressure gradient", "gradients of a finite flow", float(np.max(g)))
         return np.copysign(q, gradient)
 
-    def fluxes(self, t, s, p_chamber=None):
-        """``(p, lam, q)``: cell pressures and stretches and the ``n + 1`` face flow rates, for
-        states ``s`` of shape ``(..., n)`` at times ``t`` (broadcast with ``s[..., 0]``)."""
+    def faces(self, t, s, p_chamber=None):
+        """``(p, lam, h, G, lam_f)``: cell pressures and stretches, and at the ``n + 1`` faces the
+        distances between the pressures they join (half a cell at the ends), the pressure
+        gradients and the mean stretches, for states ``s`` of shape ``(..., n)`` at times ``t``
+        (broadcast with ``s[..., 0]``). A pump's inlet face and a closed end get a zero gradient
+        here; :meth:`fluxes` sets their flow."""
         lam = self.stretch(s)
         p = self.cell_pressure(s)
         lead = p.shape[:-1]
@@ -282,7 +285,14 @@ class _System:
         h[0] = h[-1] = 0.5 * self.dz
         G = -np.diff(P, axis=-1) / h
         lam_f = np.concatenate([lam[..., :1], 0.5 * (lam[..., :-1] + lam[..., 1:]), lam[..., -1:]], axis=-1)
+        return p, lam, h, G, lam_f
+
+    def fluxes(self, t, s, p_chamber=None):
+        """``(p, lam, q)``: cell pressures and stretches and the ``n + 1`` face flow rates, for
+        states ``s`` of shape ``(..., n)`` at times ``t`` (broadcast with ``s[..., 0]``)."""
+        p, lam, _, G, lam_f = self.faces(t, s, p_chamber)
         q = self.face_flow(self.radius * lam_f, G)
+        t = np.broadcast_to(np.asarray(t, dtype=float), p.shape[:-1])
         if self.inlet_kind == "flow":
             q[..., 0] = _elementwise(self.inlet, t, "inlet_flow_rate")
         if self.outlet_kind == "closed":
@@ -330,20 +340,11 @@ class _System:
         the counters' to the end cells. Costs about two right-hand sides."""
         n, m = self.n, self.size
         chamber = self.outlet_kind == "chamber"
-        s = y[:n]
-        p, lam, q = self.fluxes(t, s, y[n] if chamber else None)
+        p, lam, h, G, lam_f = self.faces(t, y[:n], y[n] if chamber else None)
         dp = self.wall.stiffness(lam, self.tb) / (2.0 * lam)            # dp_i/ds_i
         dlam = 0.5 / lam                                                  # dlambda_i/ds_i
-        # the faces' gradients and radii as in fluxes, and the slopes
-        p0 = p[0] if self.inlet_kind == "flow" else float(_elementwise(self.inlet, t, "inlet_pressure"))
-        pl = {"pressure": lambda: float(_elementwise(self.outlet, t, "outlet_pressure")),
-              "chamber": lambda: float(y[n]), "closed": lambda: p[-1]}[self.outlet_kind]()
-        h = np.full(n + 1, self.dz)
-        h[0] = h[-1] = 0.5 * self.dz
-        G = -np.diff(np.concatenate([[p0], p, [pl]])) / h
         weight = np.full(n + 1, 0.5)
         weight[0] = weight[-1] = 1.0
-        lam_f = np.concatenate([lam[:1], 0.5 * (lam[:-1] + lam[1:]), lam[-1:]])
         q_g, q_r = self.face_slopes(self.radius * lam_f, G)
         # face j sits between cell j-1 (left) and cell j (right)
         left = q_g[1:] / h[1:] * dp + q_r[1:] * self.radius * weight[1:] * dlam       # dq_j/ds_{j-1}, j = 1..n
@@ -363,9 +364,10 @@ class _System:
             dc = (float(self.outlet.compliance_at(y[n] + step, self.pressure_scale))
                   - float(self.outlet.compliance_at(y[n] - step, self.pressure_scale))) / (2.0 * step)
             dq_dpl = -q_g[-1] / h[-1]                                     # dq_n/dp_chamber
+            q_end = self.face_flow(self.radius * lam_f, G)[-1]             # the chamber's inflow
             rows += [[n], [n], [n - 1], [m - 1]]
             cols += [[n - 1], [n], [n], [n]]
-            vals += [[left[-1] / c], [dq_dpl / c - q[-1] * dc / c**2], [-dq_dpl / volume], [dq_dpl]]
+            vals += [[left[-1] / c], [dq_dpl / c - q_end * dc / c**2], [-dq_dpl / volume], [dq_dpl]]
         return sparse.csc_matrix((np.concatenate([np.asarray(v, dtype=float) for v in vals]),
                                   (np.concatenate(rows), np.concatenate(cols))), shape=(m, m))
 
