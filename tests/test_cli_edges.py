@@ -19,6 +19,7 @@ import sys
 import pytest
 
 from tubefsi import cli
+from tubefsi.testing.fuzz._cli import _Broken, _closed     # the fuzz family's streams
 
 SCENE = ["--rheology", "newtonian:viscosity=1e-3", "--wall", "rigid", "--tube", "radius=1e-4,thickness=3e-5,length=1e-2"]
 NETWORK = {"rheology": "newtonian:viscosity=1e-3",
@@ -188,18 +189,7 @@ def test_network_output_suffix(tmp_path, capsys):
 
 
 # ---------------------------------------------------------------------------- standard output
-class _BrokenPipe(io.StringIO):
-    def write(self, text):
-        raise BrokenPipeError(32, "Broken pipe")
-
-
-def _closed():
-    stream = io.StringIO()
-    stream.close()
-    return stream
-
-
-@pytest.mark.parametrize("stdout", [None, _closed, _BrokenPipe], ids=["None", "closed", "broken pipe"])
+@pytest.mark.parametrize("stdout", [None, _closed, _Broken], ids=["None", "closed", "broken pipe"])
 @pytest.mark.parametrize("argv", [["solve", *SCENE, "--flow-rate", "1e-9", "--json"], ["list"], ["--help"]],
                          ids=["solve --json", "list", "--help"])
 def test_a_closed_or_broken_stdout_ends_quietly(argv, stdout, monkeypatch, capsys):

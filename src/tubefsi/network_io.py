@@ -58,7 +58,7 @@ _COLUMNS = {
 #: the spellings of a unit that are read as the SI unit above
 _UNIT_SPELLINGS = {"pas/m3": "pas/m^3", "pa.s/m^3": "pas/m^3", "pa*s/m^3": "pas/m^3", "m3/pa": "m^3/pa"}
 #: the header the writer writes (openBF's, with an optional thickness column h(m) after E(Pa))
-_HEADER = ["Name", "sn", "tn", "wkn", "l(m)", "M", "Rp(m)", "Rd(m)", "E(Pa)", "Pext", "R1", "R2", "C"]
+_HEADER = ("Name", "sn", "tn", "wkn", "l(m)", "M", "Rp(m)", "Rd(m)", "E(Pa)", "Pext", "R1", "R2", "C")
 
 
 # ---------------------------------------------------------------------------- the wall

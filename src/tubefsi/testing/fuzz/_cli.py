@@ -204,7 +204,7 @@ def _network_file_probes():
         yield _network_probe(f"tubes[0].{key} left out", _with(("tubes", 0, key), ...), _fails("net.json", "tubes[0]"))
 
 
-_SCENE = ["--rheology", "newtonian:viscosity=1e-3", "--wall", "rigid", "--tube", "radius=1e-4,thickness=3e-5,length=1e-2"]
+_SCENE = ("--rheology", "newtonian:viscosity=1e-3", "--wall", "rigid", "--tube", "radius=1e-4,thickness=3e-5,length=1e-2")
 
 
 def _output_probes():
