@@ -370,3 +370,23 @@ def test_plausible_mistakes_give_typed_errors_naming_the_argument(tmp_path):
         network_io.write_vtp(net, tmp_path / "x.vtp", positions={"a": "xy", "b": (0, 1)})
     with pytest.raises(InvalidParameterError, match="pressure .*a single number"):
         net.set_pressure("a", np.array([1.0, 2.0]))
+
+
+def test_a_tapered_vessel_round_trips_through_vtp(tmp_path):
+    """A linear taper written to .vtp (proximal and distal radius and thickness as cell data) is
+    read back as the same taper: the same ends, and the same solve (Poiseuille's closed form of a
+    linear taper, R = 8 mu L (a_p^2 + a_p a_d + a_d^2) / (3 pi a_p^3 a_d^3), for a stiff wall)."""
+    wall = walls["thin-linear"](youngs_modulus=1e15, poisson_ratio=0.5)      # rigid to 1e-12
+    net = tubefsi.Network(rheology=NEWTONIAN)
+    net.add_tube("in", "out", wall, tubefsi.Tube.tapered(length=0.1, radius=2e-3, outlet_radius=1e-3,
+                                                          thickness=2e-4, outlet_thickness=1.5e-4))
+    net.set_inflow("in", 1e-6).set_pressure("out", 0.0)
+    path = network_io.write_vtp(net, tmp_path / "taper.vtp")
+    again = network_io.read_vtp(path, rheology=NEWTONIAN)
+    again.set_inflow(0, 1e-6).set_pressure(1, 0.0)
+    table = network_io.network_table(again, thickness=False)
+    assert (table["Rp(m)"], table["Rd(m)"], table["l(m)"]) == ([2e-3], [1e-3], [0.1])
+    a_p, a_d, mu, length = 2e-3, 1e-3, 3.5e-3, 0.1
+    resistance = 8 * mu * length * (a_p**2 + a_p * a_d + a_d**2) / (3 * np.pi * a_p**3 * a_d**3)
+    for network, inlet in ((net, "in"), (again, 0)):
+        assert abs(network.solve().pressure[inlet] / (resistance * 1e-6) - 1) < 1e-9

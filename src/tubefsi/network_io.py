@@ -811,10 +811,9 @@ def read_vtp(path, *, rheology=None, wall=None):
                           names=[names_of[k] for k in run])
             continue
         for k in run:
-            ends = [0.0, float(length[k])]
             net.add_tube(u[k], v[k], make_wall(float(modulus[k]), float(hp[k]), float(rp[k])),
-                         Tube(radius=sampled(ends, [rp[k], rd[k]], kind="linear"),
-                              thickness=sampled(ends, [hp[k], hd[k]], kind="linear"), length=float(length[k])),
+                         Tube.tapered(length=float(length[k]), radius=float(rp[k]), outlet_radius=float(rd[k]),
+                                      thickness=float(hp[k]), outlet_thickness=float(hd[k])),
                          name=names_of[k], external_pressure=float(p_ext[k]))
     for i, node in enumerate(names):
         if node not in net._nodes:
