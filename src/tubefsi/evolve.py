@@ -48,7 +48,7 @@ import numpy as np
 
 from ._keywords import checked_keywords
 from ._lazy import lazy_module
-from ._validation import positive_scalar, real_array
+from ._validation import as_scalar, positive_scalar, real_array
 from .errors import (AccuracyWarning, BucklingError, ConvergenceError, InvalidParameterError, ModelValidityWarning,
                      NoSteadyStateError, TubefsiError, warn_user)
 from .geometry import Tube
@@ -192,10 +192,7 @@ def _boundary(name, value):
     """A boundary value as a function of time (a number: constant)."""
     if callable(value):
         return value
-    v = real_array(name, value, "a finite number or a callable of t")
-    if v.ndim or not math.isfinite(float(v)):
-        raise InvalidParameterError(name, "a finite number or a callable of t", value)
-    v = float(v)
+    v = as_scalar(name, value, "a finite number or a callable of t", np.isfinite)
     return lambda t: v + 0.0 * np.asarray(t, dtype=float)
 
 
