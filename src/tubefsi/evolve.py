@@ -128,10 +128,7 @@ class Chamber:
     def linear(cls, volume: float, compliance: float) -> Chamber:
         r"""The linear chamber :math:`V = V_0 + C p` (``volume`` :math:`V_0` m^3, ``compliance`` :math:`C` m^3/Pa)."""
         c = positive_scalar("compliance", compliance)
-        v0 = real_array("volume", volume, "[0, inf) m^3")
-        if v0.ndim or not (math.isfinite(float(v0)) and float(v0) >= 0):
-            raise InvalidParameterError("volume", "[0, inf) m^3 (one number)", volume)
-        v0 = float(v0)
+        v0 = as_scalar("volume", volume, "[0, inf) m^3", lambda v: v >= 0)
         return cls(volume=lambda p: v0 + c * np.asarray(p, dtype=float), compliance=lambda p: c + 0.0 * np.asarray(p))
 
     def volume_at(self, p):
@@ -561,10 +558,7 @@ class Transient:
         is not reached by the last output time. The steady state is that of the boundary values at
         the last output time (:meth:`steady`, :meth:`steady_volume`); a pump still running into a
         closed end or a chamber has none: :class:`~tubefsi.NoSteadyStateError`."""
-        f = real_array("fraction", fraction, "(0, 1)")
-        if f.ndim or not (0.0 < float(f) < 1.0):
-            raise InvalidParameterError("fraction", "(0, 1)", fraction)
-        f = float(f)
+        f = as_scalar("fraction", fraction, "(0, 1)", lambda v: (v > 0) & (v < 1))
         v_inf = self.steady_volume()
         dev = np.abs(self.stored - v_inf)
         band = (1.0 - f) * abs(v_inf - self.stored[0])
@@ -971,10 +965,7 @@ def _setup(rheo, wall, tube, times, inlet_pressure, inlet_flow_rate, outlet_pres
         outlet_kind, outlet_value = "chamber", Chamber(volume=outlet)
     else:
         raise InvalidParameterError("outlet", "'open', 'closed', a Chamber or a callable V(p)", outlet)
-    p_ext = real_array("external_pressure", external_pressure, "a finite number (Pa)")
-    if p_ext.ndim or not math.isfinite(float(p_ext)):
-        raise InvalidParameterError("external_pressure", "a finite number (Pa)", external_pressure)
-    p_ext = float(p_ext)
+    p_ext = as_scalar("external_pressure", external_pressure, "a finite number (Pa)", np.isfinite)
     if cells is not None and (isinstance(cells, (bool, np.bool_)) or not isinstance(cells, (int, np.integer))):
         raise InvalidParameterError("cells", f"an integer in [2, {MAX_CELLS}]", cells)
     n = 16 if cells is None else int(cells)
@@ -998,10 +989,8 @@ def _setup(rheo, wall, tube, times, inlet_pressure, inlet_flow_rate, outlet_pres
     if isinstance(initial, Solution):
         _check_initial(initial, rheo, wall, tube, p_ext)
     elif initial is not None:
-        initial = real_array("initial", initial, "None, a pressure (Pa) or a steady Solution of the same tube")
-        if initial.ndim or not math.isfinite(float(initial)):
-            raise InvalidParameterError("initial", "None, a finite pressure (Pa) or a steady Solution", initial)
-        initial = float(initial)
+        initial = as_scalar("initial", initial, "None, a finite pressure (Pa) or a steady Solution of the same tube",
+                            np.isfinite)
         scale = max(scale, abs(initial - p_ext))
     # the lowest transmural pressure met at the boundaries and at the start: not below buckling
     # and not at or above the wall's limit pressure (signed: a large suction is buckling, above)
