@@ -603,14 +603,15 @@ def one_batch_mapped(engine, scene, target, index, q, bound):
     solved = np.zeros(target.size, dtype=bool)
     bound = np.broadcast_to(bound, target.shape)
     live = np.flatnonzero((target > 0) & (q > 0))
-    if live.size == 0 or flow_map.kind(scene.rheology) is None:
+    which = flow_map.kind(scene.rheology)
+    if live.size == 0 or which is None:
         return v, solved
     pts = scene.at(index)
     with np.errstate(all="ignore"):
         y_out = (np.log(4.0 / math.pi * q) - 3.0 * np.log(pts.radius * pts.outlet_stretch)) + np.zeros(target.size)
         # the linear guess from the law at the outlet's apparent rate (a start: within a factor ~2)
-        if flow_map.kind(scene.rheology) == "closed":      # (exact there, and cheap)
-            rough, _, _ = flow_map.flow_map(pts.rheology, y_out, y_out).wall_stress(y_out[None])
+        if which == "closed":      # (exact there, and cheap)
+            rough, _, _ = flow_map.flow_map(pts.rheology, y_out, y_out, which=which).wall_stress(y_out[None])
             rough = rough[0]
         else:
             rough = np.asarray(pts.rheology._stress(np.exp(y_out)), dtype=float) + np.zeros(target.size)
@@ -624,7 +625,7 @@ def one_batch_mapped(engine, scene, target, index, q, bound):
     for degree in _MAPPED_DEGREES:
         if live.size == 0:
             break
-        f, vouched = _mapped_integrand(engine, scene, index[live], y_out[live], top[live])
+        f, vouched = _mapped_integrand(engine, scene, index[live], y_out[live], top[live], which)
         with np.errstate(all="ignore"):
             x, good, short = solve_integral(f, target[live], top[live], rtol=rtol, degree=degree)
         good &= vouched
@@ -644,7 +645,7 @@ def one_batch_mapped(engine, scene, target, index, q, bound):
     for pieces in _MAPPED_PIECES:
         if split.size == 0:
             break
-        f, vouched = _mapped_integrand(engine, scene, index[split], y_out[split], top[split])
+        f, vouched = _mapped_integrand(engine, scene, index[split], y_out[split], top[split], which)
         with np.errstate(all="ignore"):
             x, good = _solve_in_pieces(f, target[split], top[split], pieces, _MAPPED_DEGREES[-1], rtol)
         good &= vouched
@@ -659,12 +660,13 @@ def one_batch_mapped(engine, scene, target, index, q, bound):
 _MAPPED_PIECES = (2, 4)
 
 
-def _mapped_integrand(engine, scene, ids, y_out, top):
+def _mapped_integrand(engine, scene, ids, y_out, top, which):
     """``(f, vouched)``: the separated integrand of the points ``ids`` (a non-separable fluid, at their
     flow rates: ``y_out`` is ln Gamma at the outlet) from a flow map built over ``[0, top]`` of each,
-    and whether the map vouched for every value ``f`` gave (updated by each call)."""
+    and whether the map vouched for every value ``f`` gave (updated by each call); ``which``: the
+    fluid's :func:`~tubefsi.rheology.flow_map.kind`."""
     sub = scene.at(ids)
-    fmap = flow_map.flow_map(sub.rheology, y_out - 3.0 * top - 1e-9, y_out + 1e-9)
+    fmap = flow_map.flow_map(sub.rheology, y_out - 3.0 * top - 1e-9, y_out + 1e-9, which=which)
     vouched = np.ones(ids.size, dtype=bool)
     a = sub.radius * sub.outlet_stretch
 

@@ -16,7 +16,8 @@ import numpy as np
 
 from .kernels import blocked_matmul
 
-__all__ = ["solve_integral", "CHEBYSHEV_DEGREE", "LOBATTO_NODES", "lobatto_rule", "clenshaw"]
+__all__ = ["solve_integral", "CHEBYSHEV_DEGREE", "LOBATTO_NODES", "lobatto_rule", "clenshaw", "barycentric",
+           "hermite_root"]
 
 #: Degree of the Chebyshev interpolant of :func:`solve_integral` (17 Chebyshev–Lobatto nodes).
 CHEBYSHEV_DEGREE = 16
@@ -38,6 +39,7 @@ class _LobattoRule:
     coef: slice
     anti: slice
     cumulative: slice
+    weights: np.ndarray
 
 
 @functools.lru_cache(maxsize=8)
@@ -54,9 +56,13 @@ def lobatto_rule(n):
     to_antiderivative = np.polynomial.chebyshev.chebint(to_coef, lbnd=-1.0, axis=0)
     cumulative = np.polynomial.chebyshev.chebvander(t, n + 1) @ to_antiderivative
     matrix = np.vstack([to_coef, to_antiderivative, cumulative])
-    for constant in (t, nodes, matrix):     # (shared by every call: a write into one would change later answers)
+    # the barycentric weights of Chebyshev-Lobatto nodes: alternating signs, the end nodes halved
+    weights = (-1.0) ** k
+    weights[[0, -1]] *= 0.5
+    for constant in (t, nodes, matrix, weights):     # (shared by every call: a write into one would change later answers)
         constant.setflags(write=False)
-    return _LobattoRule(n, t, nodes, matrix, slice(0, n + 1), slice(n + 1, 2 * n + 3), slice(2 * n + 3, 3 * n + 4))
+    return _LobattoRule(n, t, nodes, matrix, slice(0, n + 1), slice(n + 1, 2 * n + 3), slice(2 * n + 3, 3 * n + 4),
+                       weights)
 
 
 #: The Chebyshev–Lobatto nodes of :func:`solve_integral` on [0, 1] (an end node is exactly 0, the other 1).
@@ -81,9 +87,65 @@ def clenshaw(coef, t):
     return b1
 
 
-#: Batches of at most this many points evaluate an interpolant and its derivative in one pass
-#: (the same bits either way; only the time differs).
-_PAIRED_BELOW = 2048
+def hermite_root(rise, goal, d0, d1, iterations=3):
+    r"""The root :math:`s \in [0, 1]` of :math:`H(s) =` ``goal`` for the cubic Hermite
+    interpolant :math:`H` of a function rising by ``rise`` over :math:`[0, 1]` from 0, with
+    slopes ``d0`` and ``d1`` at the ends: Newton's method from the linear interpolant's root,
+    ``iterations`` steps, clipped to [0, 1]. A start for Newton's method on a better interpolant
+    (its rounding is moot). :math:`H(s) = ((a_3 s + a_2) s + d_0) s` with
+    :math:`a_3 = d_0 + d_1 - 2r`, :math:`a_2 = 3r - 2d_0 - d_1`, by Horner's rule."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        s = np.clip(goal / rise, 0.0, 1.0)
+        a3 = d0 + d1 - 2.0 * rise
+        a2 = 3.0 * rise - 2.0 * d0 - d1
+        a3_3, a2_2 = 3.0 * a3, 2.0 * a2
+        for _ in range(iterations):
+            value = a3 * s
+            value += a2
+            value *= s
+            value += d0
+            value *= s
+            value -= goal
+            slope = a3_3 * s
+            slope += a2_2
+            slope *= s
+            slope += d0
+            value /= slope
+            s -= value
+            np.clip(s, 0.0, 1.0, out=s)
+    return s
+
+
+def barycentric(rule, t, *values):
+    r"""The interpolants through each of ``values`` (their values at ``rule``'s Chebyshev–Lobatto
+    nodes, along the last axis) at ``t`` (one point per row: ``t`` has the shape of
+    ``values[k][..., 0]``).
+
+    The barycentric formula of the second kind (J.-P. Berrut and L. N. Trefethen, *SIAM Review*
+    46, 2004, section 5),
+
+    .. math:: p(t) = \frac{\sum_j r_j f_j}{\sum_j r_j}, \qquad r_j = \frac{w_j}{t - t_j},
+              \qquad w_j = (-1)^j \text{ (halved at the end nodes)},
+
+    is forward stable on these nodes (N. J. Higham, *IMA J. Numer. Anal.* 24, 2004) and costs a
+    fixed handful of array operations whatever the degree, where Clenshaw's recurrence takes three
+    per coefficient: the Newton iterations on an interpolant of one or a few points are bound by
+    the count of operations, not by arithmetic. The terms :math:`r_j` serve every interpolant on
+    the same nodes. A ``t`` on a node exactly is moved off it by one unit in the last place (the
+    formula divides by :math:`t - t_j`; the interpolant moves by that ulp times its slope).
+
+    The nodes run along the last axis, contiguous, because NumPy sums a contiguous row in the
+    same order whatever the number of rows: a point's bits do not depend on its batch (summed
+    along the first axis, a lone column is summed in another order than the columns of a batch)."""
+    t = np.asarray(t, dtype=float)
+    d = t[..., None] - rule.t
+    on_node = d == 0
+    if on_node.any():
+        t = np.where(on_node.any(axis=-1), np.nextafter(t, np.where(t < 0.5, 2.0, -2.0)), t)
+        d = t[..., None] - rule.t
+    r = rule.weights / d
+    sum_r = r.sum(axis=-1)
+    return tuple((r * f).sum(axis=-1) / sum_r for f in values)
 
 
 def solve_integral(f, target, upper, *, rtol=1e-14, values=None, degree=CHEBYSHEV_DEGREE):
@@ -154,47 +216,23 @@ def solve_integral(f, target, upper, *, rtol=1e-14, values=None, degree=CHEBYSHE
     d1 = flat_y.take(lower + live.size)
     d1 *= scale                                              # dJ/ds at the ends, s in [0, 1]
     rise, goal = c1 - c0, t_goal - c0
-    s = np.clip(goal / rise, 0.0, 1.0)
-    # the Hermite cubic in monomial form, H(s) = ((a3 s + a2) s + d0) s: Horner for it and for its
-    # slope (a third of the passes of the Bernstein-like form; a start, so its rounding is moot)
-    a3 = d0 + d1 - 2.0 * rise
-    a2 = 3.0 * rise - 2.0 * d0 - d1
-    a3_3, a2_2 = 3.0 * a3, 2.0 * a2
-    # the integrand values (nodes x points) and the bracket's ends are no longer needed: freed
-    # before the Newton iterations allocate theirs, the call's peak memory is lower, and with it
-    # the heap that glibc trims after the call and the next call faults back in
-    del values, y, flat_y, flat_cumulative, c0, c1, d1, rise, scale, j, lower
-    for _ in range(3):
-        value = a3 * s
-        value += a2
-        value *= s
-        value += d0
-        value *= s
-        value -= goal
-        slope = a3_3 * s
-        slope += a2_2
-        slope *= s
-        slope += d0
-        value /= slope
-        s -= value
-        np.clip(s, 0.0, 1.0, out=s)
+    del flat_y, flat_cumulative, c0, c1, scale, j, lower
+    s = hermite_root(rise, goal, d0, d1)
     t = t0 + (t1 - t0) * s
-    # Newton on the interpolant: quadratic, so a step below 1e-9 leaves an error of order
-    # (f'/f) 1e-18 after it, and is the last one
+    # Newton on the interpolant A of the integral (degree n + 1), its slope the integrand's (degree
+    # n): both by the barycentric formula through their values at the nodes. That formula gives
+    # the degree-n interpolant of A's values; on Chebyshev-Lobatto nodes T_{n+1} takes the values
+    # of T_{n-1} (cos((n + 1) theta_j) = cos((n - 1) theta_j) at theta_j = j pi / n), so
+    # A = that interpolant + a_{n+1} (T_{n+1} - T_{n-1}), and T_{n+1} - T_{n-1} = -2 sin(n theta)
+    # sin(theta) at t = cos(theta). Quadratic: a step below 1e-9 leaves an error of order
+    # (f'/f) 1e-18 after it, and is the last one.
+    top = anti[-1]
+    n = rule.degree
+    cumulative_rows, y_rows = np.ascontiguousarray(cumulative.T), np.ascontiguousarray(y.T)
     moving = np.ones(live.size, dtype=bool)
-    # a small batch pays per array operation: the integral and the integrand in one Clenshaw pass
-    # halve them (the integrand's top coefficient is zero, so its values are the same bits); a
-    # large batch is faster in two passes over contiguous rows
-    paired = live.size <= _PAIRED_BELOW
-    if paired:
-        pair = np.zeros((anti.shape[0], 2, live.size))
-        pair[:, 0] = anti
-        pair[:-1, 1] = coef
     for _ in range(8):
-        if paired:
-            integral, integrand = clenshaw(pair, np.broadcast_to(t, (2, live.size)))
-        else:
-            integral, integrand = clenshaw(anti, t), clenshaw(coef, t)
+        integral, integrand = barycentric(rule, t, cumulative_rows, y_rows)
+        integral += top * (-2.0 * np.sin(n * np.arccos(t)) * np.sqrt((1.0 - t) * (1.0 + t)))
         step = (integral - t_goal) / (integrand * h)
         step[~moving] = 0.0                  # a point's iterations do not depend on its neighbours'
         t = np.clip(t - step, t0, t1)

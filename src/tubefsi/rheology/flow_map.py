@@ -37,7 +37,7 @@ import numpy as np
 from ..fields import _array_fields, _replace
 from ..numerics.kernels import blocked_matmul
 from ..numerics.quadrature import unit_integral
-from ..numerics.spectral import clenshaw, lobatto_rule
+from ..numerics.spectral import clenshaw, hermite_root, lobatto_rule
 
 __all__ = ["kind", "ClosedMap", "PanelMap", "flow_map", "wall_stress", "log_rate_bracket"]
 
@@ -59,10 +59,14 @@ _NEWTON = 60
 @functools.lru_cache(maxsize=2)
 def _y_maps(degree):
     """Values at the Chebyshev-Lobatto nodes -> the Chebyshev coefficients of their interpolant (rows
-    ``0..degree``) and of its derivative (the rest), in one matrix: one product per panel gives both
-    (constants of the degree, read-only)."""
-    to_coef = lobatto_rule(degree).matrix[lobatto_rule(degree).coef]
-    maps = np.vstack([to_coef, np.polynomial.chebyshev.chebder(to_coef, axis=0)])
+    ``0..degree``), of its derivative (the next ``degree``) and that derivative at the nodes (the
+    last ``degree + 1``), in one matrix: one product per panel gives all (constants of the degree,
+    read-only)."""
+    rule = lobatto_rule(degree)
+    to_coef = rule.matrix[rule.coef]
+    to_derivative = np.polynomial.chebyshev.chebder(to_coef, axis=0)
+    at_nodes = np.polynomial.chebyshev.chebvander(rule.t, degree - 1) @ to_derivative
+    maps = np.vstack([to_coef, to_derivative, at_nodes])
     maps.setflags(write=False)
     return maps
 
@@ -195,6 +199,7 @@ class PanelMap:
         # each panel's y at its middle node apart: the interpolant holds y's variation over the panel
         self.offset = np.full((MAX_PANELS, n), np.nan)
         self.y_nodes = np.full((DEGREE + 1, MAX_PANELS, n), np.nan)
+        self.node_slopes = np.full((DEGREE + 1, MAX_PANELS, n), np.nan)     # dy/dt at the nodes
         self.ok = np.isfinite(self.x0) & np.isfinite(y_hi)
         self.panels = np.zeros(n, dtype=int)
         with np.errstate(all="ignore"):
@@ -258,22 +263,24 @@ class PanelMap:
         tail = np.abs(c[-3:]).sum(axis=0)
         good = np.all(np.isfinite(y), axis=0) & np.all(np.diff(y, axis=0) > 0, axis=0) & \
             np.all(cube > 0, axis=0) & (err_y + tail <= TOL + 32.0 * _EPS * np.max(np.abs(y), axis=0))
-        # each point takes its panels in order until one fails or reaches y_hi (as one by one)
-        at = np.arange(p)                                           # positions in live of the live points
-        for b in range(batch):
-            if at.size == 0:
-                break
-            j, pts = j0 + b, live[at]
-            self.pair[:, 0, j, pts], self.pair[:-1, 1, j, pts] = c[:, b, at], c_and_slope[DEGREE + 1:, b, at]
-            self.offset[j, pts] = ref[b, at]
-            self.y_nodes[:, j, pts] = y[:, b, at]
-            K[pts], err_k[pts] = k_nodes[-1, b, at], err_nodes[-1, b, at]
-            self.panels[pts] = j + 1
-            self.ok[pts[~good[b, at]]] = False
-            if j == 0 and check_bottom:
-                self.ok[pts[y[0, b, at] > y_lo[pts]]] = False       # (cannot happen for an increasing law)
-            at = at[good[b, at] & (y[-1, b, at] < y_hi[pts])]
-        return live[at]
+        # each point takes its panels in order until one fails or reaches y_hi (as one by one):
+        # panel b where every panel before it was good and below y_hi
+        goes_on = good & (y[-1] < y_hi[live])                      # (batch, P): the next one is built
+        taken = np.ones((batch, p), dtype=bool)
+        taken[1:] = np.logical_and.accumulate(goes_on[:-1], axis=0)
+        b, at = np.nonzero(taken)
+        j, pts = j0 + b, live[at]
+        self.pair[:, 0, j, pts], self.pair[:-1, 1, j, pts] = c[:, b, at], c_and_slope[DEGREE + 1:2 * DEGREE + 1, b, at]
+        self.offset[j, pts] = ref[b, at]
+        self.y_nodes[:, j, pts] = y[:, b, at]
+        self.node_slopes[:, j, pts] = c_and_slope[2 * DEGREE + 1:, b, at]
+        self.ok[pts[~good[b, at]]] = False
+        last = taken.sum(axis=0) - 1                                # each point's last panel taken
+        K[live], err_k[live] = k_nodes[-1, last, np.arange(p)], err_nodes[-1, last, np.arange(p)]
+        self.panels[live] = j0 + last + 1
+        if j0 == 0 and check_bottom:
+            self.ok[live[y[0, 0] > y_lo[live]]] = False             # (cannot happen for an increasing law)
+        return live[np.all(goes_on, axis=0)]
 
     def wall_rate(self, tau, x):
         """The wall shear rate at the answers of :meth:`wall_stress`: :math:`e^x` (its natural
@@ -305,13 +312,16 @@ class PanelMap:
             j = np.minimum(np.sum(tops[:, None, :] < y2[None], axis=0), np.maximum(self.panels - 1, 0))
             nodes = self.y_nodes[:, j, cols]                       # (DEGREE + 1, rows, P)
             inside = (y2 >= self.y_nodes[0, 0]) & (y2 <= nodes[-1]) & self.ok
-            # the start: linear interpolation between the panel's nodes that bracket y
+            # the start: the cubic Hermite interpolant between the panel's nodes that bracket y,
+            # from their values and slopes (within ~1e-6: one Newton step fewer than a line)
             k = np.clip(np.sum(nodes < y2[None], axis=0), 1, DEGREE)
             t_nodes = self.rule.t
             ya = np.take_along_axis(nodes, (k - 1)[None], axis=0)[0]
             yb = np.take_along_axis(nodes, k[None], axis=0)[0]
             ta, tb = t_nodes[k - 1], t_nodes[k]
-            t = np.where(yb > ya, ta + (tb - ta) * (y2 - ya) / (yb - ya), ta)
+            sa, sb = self.node_slopes[k - 1, j, cols], self.node_slopes[k, j, cols]
+            s = hermite_root(yb - ya, y2 - ya, sa * (tb - ta), sb * (tb - ta))
+            t = np.where(np.isfinite(s), ta + (tb - ta) * s, ta)
             pair = self.pair[:, :, j, cols]                          # (DEGREE + 1, 2, rows, P)
             y2 = y2 - self.offset[j, cols]                           # (exact within a factor 2: Sterbenz)
             # Newton on the interpolant, quadratic: after a step below 1e-9 the error is ~1e-18 and
@@ -331,12 +341,13 @@ class PanelMap:
         return tau.reshape(shape), inside.reshape(shape), x.reshape(shape)
 
 
-def flow_map(rheology, y_lo, y_hi, x_lo=None):
+def flow_map(rheology, y_lo, y_hi, x_lo=None, which=None):
     r"""The map of ``rheology`` (its array parameters one per point, along the last axis) over
     ``[y_lo, y_hi]`` per point (``y = ln Gamma``), or None where :func:`kind` is None. ``x_lo``
     (a law given by its stress): start the map's panels there in :math:`\ln\dot\gamma_w` instead
-    (``y_lo`` is then ignored; :class:`ClosedMap` needs no range)."""
-    which = kind(rheology)
+    (``y_lo`` is then ignored; :class:`ClosedMap` needs no range). ``which``: :func:`kind` of
+    ``rheology``, where the caller has it."""
+    which = kind(rheology) if which is None else which
     if which is None:
         return None
     y_hi = np.atleast_1d(np.asarray(y_hi, dtype=float))
