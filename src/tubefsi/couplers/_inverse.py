@@ -672,7 +672,7 @@ def _mapped_integrand(engine, scene, ids, y_out, top, which):
 
     def f(u, i):
         tau, ok, _ = fmap.wall_stress(y_out - 3.0 * u)
-        vouched[:] &= np.all(ok, axis=0)
+        vouched[:] &= ok.all(axis=0)
         return engine._slope(sub, u) * (a * np.exp(u)) / (2.0 * tau)
 
     return f, vouched

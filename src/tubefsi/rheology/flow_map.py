@@ -261,8 +261,8 @@ class PanelMap:
         c = c_and_slope[:DEGREE + 1]
         err_y = np.max((4.0 / 3.0) * err_nodes / (cube * gamma), axis=0)
         tail = np.abs(c[-3:]).sum(axis=0)
-        good = np.all(np.isfinite(y), axis=0) & np.all(np.diff(y, axis=0) > 0, axis=0) & \
-            np.all(cube > 0, axis=0) & (err_y + tail <= TOL + 32.0 * _EPS * np.max(np.abs(y), axis=0))
+        good = np.isfinite(y).all(axis=0) & (np.diff(y, axis=0) > 0).all(axis=0) & \
+            (cube > 0).all(axis=0) & (err_y + tail <= TOL + 32.0 * _EPS * np.abs(y).max(axis=0))
         # each point takes its panels in order until one fails or reaches y_hi (as one by one):
         # panel b where every panel before it was good and below y_hi
         goes_on = good & (y[-1] < y_hi[live])                      # (batch, P): the next one is built
@@ -280,7 +280,7 @@ class PanelMap:
         self.panels[live] = j0 + last + 1
         if j0 == 0 and check_bottom:
             self.ok[live[y[0, 0] > y_lo[live]]] = False             # (cannot happen for an increasing law)
-        return live[np.all(goes_on, axis=0)]
+        return live[goes_on.all(axis=0)]
 
     def wall_rate(self, tau, x):
         """The wall shear rate at the answers of :meth:`wall_stress`: :math:`e^x` (its natural
@@ -314,10 +314,9 @@ class PanelMap:
             inside = (y2 >= self.y_nodes[0, 0]) & (y2 <= nodes[-1]) & self.ok
             # the start: the cubic Hermite interpolant between the panel's nodes that bracket y,
             # from their values and slopes (within ~1e-6: one Newton step fewer than a line)
-            k = np.clip(np.sum(nodes < y2[None], axis=0), 1, DEGREE)
+            k = np.minimum(np.maximum((nodes < y2[None]).sum(axis=0), 1), DEGREE)
             t_nodes = self.rule.t
-            ya = np.take_along_axis(nodes, (k - 1)[None], axis=0)[0]
-            yb = np.take_along_axis(nodes, k[None], axis=0)[0]
+            ya, yb = self.y_nodes[k - 1, j, cols], self.y_nodes[k, j, cols]
             ta, tb = t_nodes[k - 1], t_nodes[k]
             sa, sb = self.node_slopes[k - 1, j, cols], self.node_slopes[k, j, cols]
             s = hermite_root(yb - ya, y2 - ya, sa * (tb - ta), sb * (tb - ta))
@@ -331,9 +330,9 @@ class PanelMap:
                 value, slope = clenshaw(pair, np.broadcast_to(t, pair.shape[1:]))
                 step = (value - y2) / slope
                 step = np.where(moving & np.isfinite(step), step, 0.0)
-                t = np.clip(t - step, -1.0, 1.0)
+                t = np.minimum(np.maximum(t - step, -1.0), 1.0)
                 moving &= ~(np.abs(step) <= 1e-9)
-                if not np.any(moving):
+                if not moving.any():
                     break
             inside &= ~moving
             x = self.x0[cols] + WIDTH * (j + 0.5 * (t + 1.0))
