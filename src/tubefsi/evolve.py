@@ -49,9 +49,11 @@ import numpy as np
 from ._keywords import checked_keywords
 from ._lazy import lazy_module
 from ._validation import as_scalar, positive_scalar, real_array
+from .fields import _array_fields, _replace, at_position, varies
 from .errors import (AccuracyWarning, BucklingError, ConvergenceError, InvalidParameterError, ModelValidityWarning,
                      NoSteadyStateError, TubefsiError, warn_user)
 from .geometry import Tube
+from .profiles import Profile
 from .scene import resolve
 from .solution import Solution
 from .solve import solve
@@ -194,16 +196,31 @@ def _boundary(name, value):
 
 
 # ------------------------------------------------------------------------------ discrete system
+def _aligned(model, shape):
+    """``model`` with its array parameters (per cell, per scene) broadcast to ``shape``, the shape
+    of the arguments of a hook call (the hooks get parameters aligned with their arguments, as
+    :func:`tubefsi.fields.evaluate` gives them); the model itself if its parameters are scalars."""
+    arrays = {name: v for name in _array_fields(type(model))
+              if isinstance(v := getattr(model, name), np.ndarray) and v.shape != tuple(shape)}
+    return _replace(model, {k: np.broadcast_to(v, shape) for k, v in arrays.items()}) if arrays else model
+
+
 @attrs.frozen
 class _System:
-    """The semi-discrete system on ``n`` cells: the state is ``[s_1..s_n, (p_chamber), V_in, V_out]``
-    with :math:`s = A/(\\pi a^2) - 1`, ``V_in``, ``V_out`` the volumes that entered and left."""
+    r"""The semi-discrete system on ``n`` cells: the state is ``[s_1..s_n, (p_chamber), V_in, V_out]``
+    with :math:`s_i = A_i/(\pi a_i^2) - 1` the area strain of cell :math:`i` relative to its own
+    undeformed radius :math:`a_i = a(z_i)`, ``V_in``, ``V_out`` the volumes that entered and left.
+
+    A graded tube (radius, thickness or wall parameters functions of z) has them per cell, taken
+    at the cell's centre :math:`z_i` (the tube law of cell :math:`i` is the wall's at
+    :math:`\bar t(z_i)` and the wall parameters there), and the undeformed radius per face
+    :math:`a(z_{i+1/2})`; a uniform tube has the scalars (:attr:`radius`, :attr:`tb`). The
+    derived per-cell quantities are built for the given ``n`` (``attrs.evolve(system, n=...)``
+    builds them again)."""
 
     rheology: object
-    wall: object
-    radius: float
-    tb: float
-    length: float
+    wall: object             # the wall as given (its parameters may be profiles along z)
+    tube: Tube               # the tube as given (graded or uniform)
     external: float
     n: int
     inlet_kind: str          # "pressure" or "flow"
@@ -211,6 +228,48 @@ class _System:
     outlet_kind: str         # "pressure", "closed" or "chamber"
     outlet: object           # callable p(t), None, or Chamber
     pressure_scale: float
+    #: The inlet's undeformed radius a(0) (m) and t(0)/a(0): the uniform tube's, and the scales
+    #: of a graded one.
+    radius: float = attrs.field(init=False)
+    tb: float = attrs.field(init=False)
+    length: float = attrs.field(init=False)
+    #: Per cell: the undeformed radius, t/a and the wall with its profiles evaluated at the
+    #: centres (scalars and the wall itself for a uniform tube); per face: the undeformed radius.
+    a_cells: object = attrs.field(init=False, repr=False)
+    tb_cells: object = attrs.field(init=False, repr=False)
+    wall_cells: object = attrs.field(init=False, repr=False)
+    a_faces: object = attrs.field(init=False, repr=False)
+
+    def __attrs_post_init__(self):
+        length = float(self.tube.length)
+        a0, t0 = (float(v) for v in self.tube.at(np.asarray(0.0)))
+        set_ = object.__setattr__
+        set_(self, "radius", a0)
+        set_(self, "tb", t0 / a0)
+        set_(self, "length", length)
+        if not self.graded:
+            set_(self, "a_cells", a0)
+            set_(self, "tb_cells", t0 / a0)
+            set_(self, "wall_cells", self.wall)
+            set_(self, "a_faces", a0)
+            return
+        dz = length / self.n
+        a_c, t_c = (np.broadcast_to(v, (self.n,)).astype(float) for v in self.tube.at(self.z))
+        set_(self, "a_cells", a_c)
+        set_(self, "tb_cells", t_c / a_c)
+        set_(self, "wall_cells", at_position(self.wall, self.z))
+        set_(self, "a_faces", np.broadcast_to(self.tube.at(np.arange(self.n + 1) * dz)[0], (self.n + 1,))
+             .astype(float))
+
+    @property
+    def graded(self) -> bool:
+        """Whether the tube or the wall varies along z."""
+        return self.tube.graded or varies(self.wall)
+
+    def section(self, z):
+        """``(wall, a, tb)`` at the positions ``z`` (m): the wall with its profiles evaluated there,
+        the undeformed radius and t/a."""
+        return _section(self.wall, self.tube, z)
 
     @property
     def dz(self) -> float:
@@ -224,18 +283,26 @@ class _System:
     def z(self):
         return (np.arange(self.n) + 0.5) * self.dz
 
+    @property
+    def cell_volumes(self):
+        r"""The cells' undeformed volumes :math:`\pi a_i^2 \Delta z` (m^3)."""
+        return math.pi * self.a_cells**2 * self.dz
+
     def stretch(self, s):
         return np.sqrt(1.0 + s)
 
     def cell_pressure(self, s):
-        r"""The cells' pressure :math:`P(\lambda) + p_e` at area strain ``s``, from the wall's strain
-        hook at :math:`\lambda - 1 = s/(1 + \sqrt{1+s})` (no rounding of :math:`1 + \varepsilon`: full
-        accuracy at tiny strains); a stretch outside the wall's range gets the public method's error."""
+        r"""The cells' pressure :math:`P_i(\lambda) + p_e` at area strain ``s`` (the tube law of each
+        cell), from the wall's strain hook at :math:`\lambda - 1 = s/(1 + \sqrt{1+s})` (no rounding
+        of :math:`1 + \varepsilon`: full accuracy at tiny strains); a stretch outside the wall's
+        range gets the public method's error."""
         strain = s / (1.0 + np.sqrt(1.0 + s))
+        wall = _aligned(self.wall_cells, strain.shape)
+        tb = self.tb_cells
         with np.errstate(all="ignore"):
-            p = self.wall._pressure_at_strain(strain, self.tb)
+            p = wall._pressure_at_strain(strain, tb)
         if not np.all(np.isfinite(p)):
-            self.wall.pressure(1.0 + strain, self.tb)        # raises the typed error
+            self.wall_cells.pressure(1.0 + strain, tb)        # raises the typed error
             raise InvalidParameterError("stretch", "stretches the wall holds", float(np.max(1.0 + strain)))
         return p + self.external
 
@@ -285,7 +352,7 @@ class _System:
         """``(p, lam, q)``: cell pressures and stretches and the ``n + 1`` face flow rates, for
         states ``s`` of shape ``(..., n)`` at times ``t`` (broadcast with ``s[..., 0]``)."""
         p, lam, _, G, lam_f = self.faces(t, s, p_chamber)
-        q = self.face_flow(self.radius * lam_f, G)
+        q = self.face_flow(self.a_faces * lam_f, G)
         t = np.broadcast_to(np.asarray(t, dtype=float), p.shape[:-1])
         if self.inlet_kind == "flow":
             q[..., 0] = _elementwise(self.inlet, t, "inlet_flow_rate")
@@ -298,7 +365,7 @@ class _System:
         chamber = self.outlet_kind == "chamber"
         p, lam, q = self.fluxes(t, y[:n], y[n] if chamber else None)
         out = np.empty(self.size)
-        out[:n] = (q[:-1] - q[1:]) / (math.pi * self.radius**2 * self.dz)
+        out[:n] = (q[:-1] - q[1:]) / self.cell_volumes
         if chamber:
             out[n] = q[-1] / self.outlet.compliance_at(y[n], self.pressure_scale)
         out[-2], out[-1] = q[0], q[-1]
@@ -335,33 +402,34 @@ class _System:
         n, m = self.n, self.size
         chamber = self.outlet_kind == "chamber"
         p, lam, h, G, lam_f = self.faces(t, y[:n], y[n] if chamber else None)
-        dp = self.wall.stiffness(lam, self.tb) / (2.0 * lam)            # dp_i/ds_i
+        dp = self.wall_cells.stiffness(lam, self.tb_cells) / (2.0 * lam)     # dp_i/ds_i
         dlam = 0.5 / lam                                                  # dlambda_i/ds_i
         weight = np.full(n + 1, 0.5)
         weight[0] = weight[-1] = 1.0
-        q_g, q_r = self.face_slopes(self.radius * lam_f, G)
-        # face j sits between cell j-1 (left) and cell j (right)
-        left = q_g[1:] / h[1:] * dp + q_r[1:] * self.radius * weight[1:] * dlam       # dq_j/ds_{j-1}, j = 1..n
-        right = -q_g[:-1] / h[:-1] * dp + q_r[:-1] * self.radius * weight[:-1] * dlam  # dq_j/ds_j, j = 0..n-1
+        a_f = np.broadcast_to(self.a_faces, (n + 1,))
+        q_g, q_r = self.face_slopes(a_f * lam_f, G)
+        # face j sits between cell j-1 (left) and cell j (right); its radius a(z_j) lam_f
+        left = q_g[1:] / h[1:] * dp + q_r[1:] * a_f[1:] * weight[1:] * dlam       # dq_j/ds_{j-1}, j = 1..n
+        right = -q_g[:-1] / h[:-1] * dp + q_r[:-1] * a_f[:-1] * weight[:-1] * dlam  # dq_j/ds_j, j = 0..n-1
         if self.inlet_kind == "flow":
             right[0] = 0.0
         if self.outlet_kind == "closed":
             left[-1] = 0.0
-        volume = math.pi * self.radius**2 * self.dz
+        volume = np.broadcast_to(self.cell_volumes, (n,))
         i = np.arange(n)
         rows = [i, i[1:], i[:-1], [m - 2], [m - 1]]
         cols = [i, i[:-1], i[1:], [0], [n - 1]]
-        vals = [(right - left) / volume, left[:-1] / volume, -right[1:] / volume, [right[0]], [left[-1]]]
+        vals = [(right - left) / volume, left[:-1] / volume[1:], -right[1:] / volume[:-1], [right[0]], [left[-1]]]
         if chamber:
             c = float(self.outlet.compliance_at(y[n], self.pressure_scale))
             step = 1e-4 * max(abs(float(y[n])), self.pressure_scale)
             dc = (float(self.outlet.compliance_at(y[n] + step, self.pressure_scale))
                   - float(self.outlet.compliance_at(y[n] - step, self.pressure_scale))) / (2.0 * step)
             dq_dpl = -q_g[-1] / h[-1]                                     # dq_n/dp_chamber
-            q_end = self.face_flow(self.radius * lam_f, G)[-1]             # the chamber's inflow
+            q_end = self.face_flow(a_f * lam_f, G)[-1]                      # the chamber's inflow
             rows += [[n], [n], [n - 1], [m - 1]]
             cols += [[n - 1], [n], [n], [n]]
-            vals += [[left[-1] / c], [dq_dpl / c - q_end * dc / c**2], [-dq_dpl / volume], [dq_dpl]]
+            vals += [[left[-1] / c], [dq_dpl / c - q_end * dc / c**2], [-dq_dpl / volume[-1]], [dq_dpl]]
         return sparse.csc_matrix((np.concatenate([np.asarray(v, dtype=float) for v in vals]),
                                   (np.concatenate(rows), np.concatenate(cols))), shape=(m, m))
 
@@ -370,11 +438,11 @@ class _System:
         n = self.n
         y = np.zeros(self.size)
         if isinstance(initial, Solution):
-            lam = np.asarray(initial.radius(self.z), dtype=float) / self.radius
+            lam = np.asarray(initial.radius(self.z), dtype=float) / self.a_cells
             p_end = float(initial.pressure(self.length))
         else:
             p0 = float(initial)
-            lam = np.full(n, 1.0 + float(self.wall.strain(p0 - self.external, self.tb)))
+            lam = np.broadcast_to(1.0 + np.asarray(self.wall_cells.strain(p0 - self.external, self.tb_cells)), (n,))
             p_end = p0
         y[:n] = lam * lam - 1.0
         if self.outlet_kind == "chamber":
@@ -519,7 +587,7 @@ class Transient:
                 raise NoSteadyStateError("flow_rate", 0.0, inlet, "a pump into a closed end or a chamber fills it "
                                          "without bound", name="the inlet flow rate")
             return None
-        tube = Tube(radius=sy.radius, thickness=sy.tb * sy.radius, length=sy.length)
+        tube = sy.tube
         common = dict(outlet_pressure=outlet, external_pressure=sy.external)   # (gauge pressures)
         if sy.inlet_kind == "pressure":
             drop = inlet - outlet
@@ -543,12 +611,17 @@ class Transient:
         if sol is None and sy.inlet_kind == "flow":
             # a stopped pump into a closed end or a chamber: mass, V(t0) + the volume pumped in
             return float(self.stored[0] + self.volume_in[-1])
-        if sol is None:
-            lam = 1.0 + float(sy.wall.strain(inlet - sy.external, sy.tb))
-            chamber = float(sy.outlet.volume_at(inlet)) if sy.outlet_kind == "chamber" else 0.0
-            return math.pi * (sy.radius * lam) ** 2 * sy.length + chamber
         x, w = np.polynomial.legendre.leggauss(64)
         z = 0.5 * sy.length * (x + 1.0)
+        if sol is None:
+            chamber = float(sy.outlet.volume_at(inlet)) if sy.outlet_kind == "chamber" else 0.0
+            if not sy.graded:
+                lam = 1.0 + float(sy.wall.strain(inlet - sy.external, sy.tb))
+                return math.pi * (sy.radius * lam) ** 2 * sy.length + chamber
+            # a graded tube at the uniform pressure: the integral of pi a(z)^2 lambda(p; z)^2
+            wall_z, a_z, tb_z = sy.section(z)
+            radius = a_z * (1.0 + wall_z.strain(inlet - sy.external, tb_z))
+            return float(0.5 * sy.length * np.sum(w * math.pi * radius**2)) + chamber
         return float(0.5 * sy.length * np.sum(w * math.pi * np.asarray(sol.radius(z)) ** 2))
 
     def settling_time(self, fraction: float = 0.9) -> float:
@@ -689,8 +762,9 @@ def _run(system: _System, times, y0, rtol, method):
 def _area_strain_scale(system):
     """The area strain at the pressure scale (at most half the wall's limit pressure: the scale is
     a magnitude, and a suction's may exceed the limit of inflation)."""
-    p = min(system.pressure_scale, 0.5 * float(system.wall.limit_pressure(system.tb)))
-    lam = 1.0 + float(system.wall.strain(p, system.tb))
+    wall, _, tb = system.section(0.0)                                  # (the inlet's tube law: a scale)
+    p = min(system.pressure_scale, 0.5 * float(wall.limit_pressure(tb)))
+    lam = 1.0 + float(wall.strain(p, tb))
     return lam * lam - 1.0
 
 
@@ -703,7 +777,8 @@ def _fields(system, times, ys):
     if system.inlet_kind == "pressure":
         p0 = _elementwise(system.inlet, times, "inlet_pressure")
     else:
-        g = system.rheology.pressure_gradient(np.abs(q[:, 0]), system.radius * lam[:, 0]) * np.sign(q[:, 0])
+        a0 = np.broadcast_to(system.a_faces, (system.n + 1,))[0]
+        g = system.rheology.pressure_gradient(np.abs(q[:, 0]), a0 * lam[:, 0]) * np.sign(q[:, 0])
         p0 = p[:, 0] + 0.5 * system.dz * g
     if system.outlet_kind == "pressure":
         pl = _elementwise(system.outlet, times, "outlet_pressure")
@@ -712,11 +787,16 @@ def _fields(system, times, ys):
     else:
         pl = p[:, -1]
     ends = np.stack([p0, pl], axis=-1)
-    lam_ends = 1.0 + system.wall.strain(ends - system.external, system.tb)
+    wall_ends, a_ends, tb_ends = system.section([0.0, system.length])      # (the wall's law at z = 0 and L)
+    lam_ends = 1.0 + wall_ends.strain(ends - system.external, tb_ends)
     pressure = np.concatenate([p0[:, None], p, pl[:, None]], axis=1)
-    stretch = np.concatenate([lam_ends[:, :1], lam, lam_ends[:, 1:]], axis=1)
-    area0 = math.pi * system.radius**2
-    stored = area0 * system.dz * np.sum(1.0 + s, axis=1)
+    radius_ends = a_ends * lam_ends
+    radius = np.concatenate([radius_ends[:, :1], system.a_cells * lam, radius_ends[:, 1:]], axis=1)
+    if system.graded:
+        stored = np.sum(system.cell_volumes * (1.0 + s), axis=1)
+    else:
+        area0 = math.pi * system.radius**2
+        stored = area0 * system.dz * np.sum(1.0 + s, axis=1)
     if chamber is not None:
         held = system.outlet.volume_at(chamber)
         if np.any(held < 0):
@@ -730,7 +810,7 @@ def _fields(system, times, ys):
     # (the chamber is part of the store: what leaves the tube into it stays)
     balance = change - (v_in - (0.0 if chamber is not None else v_out))
     scale = max(float(np.max(np.abs(change))), float(np.max(np.abs(v_in))), np.finfo(float).tiny)
-    return dict(pressure_nodes=pressure, radius_nodes=system.radius * stretch, flow_faces=q, stored=stored,
+    return dict(pressure_nodes=pressure, radius_nodes=radius, flow_faces=q, stored=stored,
                 volume_in=v_in, volume_out=v_out, chamber_pressure=chamber,
                 mass_error=float(np.max(np.abs(balance)) / scale))
 
@@ -926,15 +1006,7 @@ def _setup(rheo, wall, tube, times, inlet_pressure, inlet_flow_rate, outlet_pres
            initial, rtol, method, cells):
     if not isinstance(tube, Tube):
         raise InvalidParameterError("tube", "a tubefsi.Tube", tube)
-    if tube.graded or any(np.ndim(v) for v in (tube.radius, tube.thickness, tube.length)):
-        raise InvalidParameterError("tube", "a uniform tube of scalar radius, thickness and length", tube,
-                                    "graded tubes and arrays of tubes are not supported by evolve")
-    for kind, model in (("rheology", rheo), ("wall", wall)):
-        arrays = [f.name for f in attrs.fields(type(model)) if np.ndim(getattr(model, f.name)) > 0] \
-            if attrs.has(type(model)) else []
-        if arrays:
-            raise InvalidParameterError(kind, "a model of scalar parameters", model,
-                                        f"{arrays[0]} is an array: evolve one scene per call")
+    _check_scalars(rheo, wall, tube)
     if getattr(wall, "is_rigid", False):
         raise InvalidParameterError("wall", "a compliant wall", wall, "a rigid wall stores no volume: a transient "
                                     "needs a compliant wall or a chamber")
@@ -971,7 +1043,12 @@ def _setup(rheo, wall, tube, times, inlet_pressure, inlet_flow_rate, outlet_pres
     n = 16 if cells is None else int(cells)
     if not (2 <= n <= MAX_CELLS):
         raise InvalidParameterError("cells", f"[2, {MAX_CELLS}]", cells)
-    a, t, length = float(tube.radius), float(tube.thickness), float(tube.length)
+    length = float(tube.length)
+    # the tube's sections: the inlet's radius and t/a for the scales, the walls along z (a graded
+    # tube: 257 positions and its profiles' breakpoints) for the pressure bounds
+    a = float(tube.at(np.asarray(0.0))[0])
+    along = _positions(wall, tube, length)
+    wall_z, _, tb_z = _section(wall, tube, along)
     t0 = times[0]
     p_rest = float(_elementwise(outlet_value, t0, "outlet_pressure")) if outlet_kind == "pressure" else 0.0
     # the pressure scale: the largest boundary pressure met, or a pump's steady inlet pressure
@@ -985,7 +1062,7 @@ def _setup(rheo, wall, tube, times, inlet_pressure, inlet_flow_rate, outlet_pres
         scale = max(scale, float(np.max(np.abs(_elementwise(outlet_value, sample, "outlet_pressure") - p_ext))))
     scale = max(scale, abs(p_rest - p_ext))
     if scale == 0.0:            # nothing drives the tube (at rest at p_e): the pressure of a strain 1e-6
-        scale = 1e-6 * float(wall.small_strain_modulus(t / a))
+        scale = 1e-6 * float(np.min(wall_z.small_strain_modulus(tb_z)))
     if isinstance(initial, Solution):
         _check_initial(initial, rheo, wall, tube, p_ext)
     elif initial is not None:
@@ -1002,14 +1079,14 @@ def _setup(rheo, wall, tube, times, inlet_pressure, inlet_flow_rate, outlet_pres
         met.append(_elementwise(outlet_value, sample, "outlet_pressure"))
     low = min(float(np.min(m)) for m in met) - p_ext
     high = max(float(np.max(m)) for m in met) - p_ext
-    bound = float(wall.min_pressure(t / a))
+    bound = float(np.max(wall_z.min_pressure(tb_z)))
     if low < bound:
         raise BucklingError(bound, low, "a boundary or starting pressure minus external_pressure is below it")
-    limit = float(wall.limit_pressure(t / a))
+    limit = float(np.min(wall_z.limit_pressure(tb_z)))
     if high >= limit:
         raise NoSteadyStateError("pressure", limit, high, f"a boundary or starting transmural pressure; "
                                  f"{type(wall).__name__} cannot sustain it")
-    system = _System(rheology=rheo, wall=wall, radius=a, tb=t / a, length=length, external=p_ext, n=n,
+    system = _System(rheology=rheo, wall=wall, tube=tube, external=p_ext, n=n,
                      inlet_kind=inlet_kind, inlet=inlet, outlet_kind=outlet_kind, outlet=outlet_value,
                      pressure_scale=scale)
     start = p_rest if initial is None else initial
@@ -1018,6 +1095,41 @@ def _setup(rheo, wall, tube, times, inlet_pressure, inlet_flow_rate, outlet_pres
         return sys_.initial_state(start, t0)
 
     return system, times, y0_of, rtol, method
+
+
+def _positions(wall, tube, length):
+    """Positions along the tube where its sections are checked: z = 0 for a uniform tube; 257
+    positions and the profiles' breakpoints inside the tube for a graded one."""
+    profiles = [v for v in (tube.radius, tube.thickness) if isinstance(v, Profile)]
+    profiles += [getattr(wall, k) for k in _array_fields(type(wall)) if isinstance(getattr(wall, k), Profile)]
+    if not profiles:
+        return np.zeros(1)
+    breaks = [b for p in profiles for b in p.breakpoints if 0.0 < b < length]
+    return np.unique(np.concatenate([np.linspace(0.0, length, 257), breaks]))
+
+
+def _section(wall, tube, z):
+    """``(wall, a, tb)`` at the positions ``z``: the wall with its profiles evaluated there, the
+    undeformed radius and t/a (:meth:`_System.section` before the system exists)."""
+    z = np.asarray(z, dtype=float)
+    a, t = tube.at(z)
+    return at_position(wall, z) if varies(wall) else wall, a, t / a
+
+
+def _check_scalars(rheo, wall, tube):
+    """One scene: the tube's length, radius and thickness (numbers or profiles along z) and the
+    models' parameters (numbers; a wall's also profiles along z) not arrays. A wall whose hooks do
+    not broadcast over their parameters (``broadcasts = False``) cannot vary along z here."""
+    arrays = [f"tube.{k}" for k in ("length", "radius", "thickness")
+              if isinstance(getattr(tube, k), np.ndarray) and np.ndim(getattr(tube, k))]
+    for kind, model in (("rheology", rheo), ("wall", wall)):
+        arrays += [f"{kind}.{k}" for k in _array_fields(type(model)) if isinstance(getattr(model, k), np.ndarray)]
+    if arrays:
+        raise InvalidParameterError(arrays[0].split(".")[0], "parameters that are numbers (or profiles along z)",
+                                    None, f"{', '.join(arrays)}: array parameters are not supported by evolve")
+    if varies(wall) and not getattr(type(wall), "broadcasts", True):
+        raise InvalidParameterError("wall", "a wall whose hooks broadcast over its parameters, to vary along z",
+                                    wall, f"{type(wall).__name__} has broadcasts = False")
 
 
 def _check_initial(initial, rheo, wall, tube, p_ext):
@@ -1030,7 +1142,10 @@ def _check_initial(initial, rheo, wall, tube, p_ext):
         differs.append(f"its wall {initial.wall!r} is not {wall!r}")
     for field in ("radius", "thickness", "length"):
         mine, theirs = getattr(tube, field), getattr(other, field)
-        if other.graded or np.ndim(theirs) or float(theirs) != float(mine):
+        if isinstance(mine, Profile) or isinstance(theirs, Profile):
+            if theirs is not mine:          # (a profile compares by identity: the same tube's)
+                differs.append(f"its tube {field} {theirs!r} is not {mine!r}")
+        elif np.ndim(theirs) or float(theirs) != float(mine):
             differs.append(f"its tube {field} {theirs!r} is not {float(mine)!r}")
     if np.ndim(initial.external_pressure) or float(initial.external_pressure) != p_ext:
         differs.append(f"its external pressure {initial.external_pressure!r} Pa is not {p_ext!r}")
