@@ -1,0 +1,182 @@
+"""Batches of scenes in tubefsi.evolve: arrays of scene parameters broadcast to the scenes' shape
+and are integrated as one system (shared output times, cells and integrator tolerance, the
+Jacobian block-diagonal). Each scene of a batch is checked against the same scene run alone."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import tubefsi
+
+L = 1e-2
+TIMES = np.linspace(0.0, 0.02, 6)
+
+
+def _fluid(index=0.7):
+    return tubefsi.registry.rheologies["power-law"](consistency=0.017, index=index)
+
+
+def _wall(modulus=2e4):
+    return tubefsi.registry.walls["thick-neo-hookean"](shear_modulus=modulus)
+
+
+def _tube(length=L, radius=1e-4):
+    return tubefsi.Tube(radius=radius, thickness=0.3 * radius, length=length)
+
+
+# (batch arguments, the scene k's arguments): fluid, wall, tube, evolve keywords
+BATCHES = {
+    "inlet-pressures": (
+        lambda: (_fluid(), _wall(), _tube(), dict(inlet_pressure=np.array([1e3, 2e3, 4e3]))),
+        lambda k: (_fluid(), _wall(), _tube(), dict(inlet_pressure=[1e3, 2e3, 4e3][k]))),
+    "lengths-by-index": (
+        lambda: (_fluid(np.array([0.6, 0.8, 1.0])), _wall(), _tube(np.array([[0.5 * L], [L]])),
+                 dict(inlet_pressure=2e3, outlet="closed")),
+        lambda k: (_fluid([0.6, 0.8, 1.0][k % 3]), _wall(), _tube([0.5 * L, L][k // 3]),
+                   dict(inlet_pressure=2e3, outlet="closed"))),
+    "moduli-external-radii": (
+        lambda: (_fluid(), _wall(np.array([1e4, 3e4])), _tube(radius=np.array([1e-4, 1.5e-4])),
+                 dict(inlet_pressure=2e3, outlet_pressure=np.array([0.0, 500.0]), external_pressure=np.array([-200.0, 100.0]))),
+        lambda k: (_fluid(), _wall([1e4, 3e4][k]), _tube(radius=[1e-4, 1.5e-4][k]),
+                   dict(inlet_pressure=2e3, outlet_pressure=[0.0, 500.0][k], external_pressure=[-200.0, 100.0][k]))),
+    "pumps-into-chamber-graded": (
+        lambda: (_fluid(), tubefsi.registry.walls["thick-neo-hookean"](shear_modulus=lambda z: 2e4 * (1 + z / L)),
+                 tubefsi.Tube.tapered(length=L, radius=1.2e-4, outlet_radius=0.8e-4, thickness=3.6e-5),
+                 dict(inlet_flow_rate=np.array([1e-11, 3e-11]), initial=np.array([0.0, 300.0]),
+                      outlet=tubefsi.Chamber.linear(1e-9, 1e-13))),
+        None),
+}
+
+
+def _alone(name, k, batch_args):
+    """Scene k alone: the same models and tube objects where they are shared (a graded tube's
+    profiles compare by identity), the scene's numbers otherwise."""
+    single = BATCHES[name][1]
+    if single is not None:
+        return single(k)
+    fluid, wall, tube, kwargs = batch_args
+    return fluid, wall, tube, dict(inlet_flow_rate=[1e-11, 3e-11][k], initial=[0.0, 300.0][k], outlet=kwargs["outlet"])
+
+
+@pytest.mark.parametrize("name", list(BATCHES))
+def test_each_scene_is_the_scene_alone(name):
+    """Every scene of a batch against the same scene run alone (one run each, 16 cells, integrator
+    tolerance 1e-12). The batch's time steps are shared (chosen for all scenes at once), so the
+    two runs are not the same arithmetic: they differ by the integrator's error, not bit for bit
+    (test_one_scene_in_an_array_keeps_the_bits). Measured, relative to the scene's largest value:
+    the pressures 8e-13 to 2e-11, radii and stored volumes 2e-16 to 4e-12, the flows 5e-15 to 3e-12
+    (3e-10 inside a pumped tube, where the flow is the difference of two cells' pressures);
+    asserted 1e-9. The batch's arrays have the scenes' axes first."""
+    fluid, wall, tube, kwargs = BATCHES[name][0]()
+    run = dict(cells=16, rtol=1e-12, error_control=False)
+    batch = tubefsi.evolve(fluid, wall, tube, TIMES, **kwargs, **run)
+    assert batch.flow_faces.shape == batch.shape + (TIMES.size, 17)
+    assert batch.pressure_nodes.shape == batch.radius_nodes.shape == batch.shape + (TIMES.size, 18)
+    assert batch.inlet_flow_rate.shape == batch.stored_volume().shape == batch.shape + (TIMES.size,)
+    assert batch.z.shape == batch.shape + (18,)
+    for k in range(int(np.prod(batch.shape))):
+        f, w, t, kw = _alone(name, k, (fluid, wall, tube, kwargs))
+        alone = tubefsi.evolve(f, w, t, TIMES, **kw, **run)
+        scene = batch.scene(int(k))
+        assert scene.shape == ()
+        np.testing.assert_array_equal(scene.z, alone.z)
+        for field in ("flow_faces", "pressure_nodes", "radius_nodes", "stored"):
+            mine, theirs = getattr(scene, field), getattr(alone, field)
+            assert np.max(np.abs(mine - theirs)) <= 1e-9 * np.max(np.abs(theirs)), (field, k)
+
+
+def test_one_scene_in_an_array_keeps_the_bits():
+    """A batch of one scene (arrays of one entry) is the scalar run bit for bit (the same
+    arithmetic with a scene axis of length 1, the same steps)."""
+    run = dict(outlet="closed", cells=16, rtol=1e-8, error_control=False)
+    alone = tubefsi.evolve(_fluid(), _wall(), _tube(), TIMES, inlet_pressure=2e3, **run)
+    batch = tubefsi.evolve(_fluid(), _wall(), _tube(), TIMES, inlet_pressure=[2e3], **run)
+    assert batch.shape == (1,)
+    for field in ("flow_faces", "pressure_nodes", "radius_nodes", "stored", "volume_in"):
+        np.testing.assert_array_equal(getattr(batch, field)[0], getattr(alone, field))
+
+
+def test_error_controlled_batch_agrees_with_each_scene():
+    """With error control the batch refines for its worst scene (its estimate is the largest over
+    the scenes); each scene's inlet flow agrees with the error-controlled run alone within the two
+    estimates, and each scene conserves mass."""
+    p = np.array([1e3, 3e3])
+    batch = tubefsi.evolve(_fluid(), _wall(), _tube(), TIMES, inlet_pressure=p, rtol=1e-5)
+    assert batch.error_estimate <= 1e-5
+    assert batch.mass_error <= 1e-8
+    for k, pk in enumerate(p):
+        alone = tubefsi.evolve(_fluid(), _wall(), _tube(), TIMES, inlet_pressure=pk, rtol=1e-5)
+        scale = np.max(np.abs(alone.inlet_flow_rate[1:]))
+        gap = np.max(np.abs(batch.inlet_flow_rate[k, 1:] - alone.inlet_flow_rate[1:])) / scale
+        assert gap <= batch.error_estimate + alone.error_estimate
+
+
+def test_pump_batch_stores_what_it_delivers():
+    """Pumps of three flow rates into closed tubes: each scene's stored volume grows by exactly its
+    rate times t (mass conservation per scene, to the Newton tolerance)."""
+    rates = np.array([1e-11, 5e-11, 1e-10])
+    r = tubefsi.evolve(_fluid(), _wall(), _tube(), TIMES, inlet_flow_rate=rates, outlet="closed", cells=16,
+                       rtol=1e-6, error_control=False)
+    stored = r.stored_volume() - r.stored_volume()[:, :1]
+    np.testing.assert_allclose(stored, rates[:, None] * TIMES, rtol=0, atol=1e-6 * rates[-1] * TIMES[-1])
+
+
+def test_batch_refusals():
+    """What a batch does not do is refused with the parameter named: a starting Solution, a
+    density (the validity check is one scene's), the methods of one scene on a batch, a scene
+    index outside it, and arrays of parameters of a wall whose hooks do not broadcast."""
+    tube = _tube()
+    steady = tubefsi.solve(_fluid(), _wall(), tube, pressure_drop=1e3)
+    with pytest.raises(tubefsi.InvalidParameterError) as info:
+        tubefsi.evolve(_fluid(), _wall(), tube, TIMES, inlet_pressure=[1e3, 2e3], initial=steady)
+    assert info.value.parameter == "initial"
+    with pytest.raises(tubefsi.InvalidParameterError) as info:
+        tubefsi.evolve(_fluid(), _wall(), tube, TIMES, inlet_pressure=[1e3, 2e3], density=1e3)
+    assert info.value.parameter == "density"
+    r = tubefsi.evolve(_fluid(), _wall(), tube, TIMES, inlet_pressure=[1e3, 2e3], cells=8, error_control=False)
+    for call in (lambda: r.pressure(0.0, 0.01), r.steady, r.settling_time, r.plot, lambda: r.stored_volume(0.01)):
+        with pytest.raises(tubefsi.InvalidParameterError) as info:
+            call()
+        assert info.value.parameter == "scene"
+    for bad in (2, -1, (0, 1), True):
+        with pytest.raises(tubefsi.InvalidParameterError):
+            r.scene(bad)
+    yeoh = tubefsi.registry.walls["thick-yeoh"](c1=[1e3, 2e3], c2=50.0, c3=2.0)
+    with pytest.raises(tubefsi.InvalidParameterError, match="c1") as info:
+        tubefsi.evolve(_fluid(), yeoh, tube, TIMES, inlet_pressure=1e3)
+    assert info.value.parameter == "wall"
+
+
+@pytest.mark.parametrize("case", ["batch-chamber", "graded-pump"])
+def test_jacobian_of_batches_and_graded_tubes(case):
+    """The analytic Jacobian (block-diagonal for a batch; per-cell tube laws and face radii for a
+    graded tube) against central differences of the right-hand side at a non-uniform state."""
+    import importlib
+
+    evolve_module = importlib.import_module("tubefsi.evolve")
+    if case == "batch-chamber":
+        args = (_fluid(np.array([0.6, 1.0])), _wall(np.array([2e4, 5e4])), _tube(np.array([L, 2 * L])), [0.0, 1.0],
+                np.array([2e3, 1e3]), None, None, tubefsi.Chamber(volume=lambda p: 1e-9 + 1e-13 * p + 1e-17 * p**2),
+                np.array([0.0, 100.0]), None, 1e-6, "BDF", 6)
+    else:
+        wall = tubefsi.registry.walls["thick-neo-hookean"](shear_modulus=lambda z: 2e4 * (1 + z / L))
+        args = (_fluid(), wall, tubefsi.Tube.tapered(length=L, radius=1.2e-4, outlet_radius=0.6e-4, thickness=4e-5),
+                [0.0, 1.0], None, 1e-10, None, "closed", 0.0, None, 1e-6, "BDF", 12)
+    system, _, y0_of, _, _ = evolve_module._setup(*args)
+    n, m = system.n, system.size
+    y = y0_of(system).reshape(system.scenes, m)
+    y[:, :n] = 0.01 + 0.03 * (1.0 + np.sin(np.arange(n) + np.arange(system.scenes)[:, None]))
+    if case == "batch-chamber":
+        y[:, n] = [700.0, 300.0]
+    y = y.reshape(-1)
+    exact = system.jacobian(0.3, y).toarray()
+    differences = np.zeros_like(exact)
+    for k in range(y.size):
+        if k % m >= m - 2:                         # (the counters' columns are zero)
+            continue
+        step = 1e-6 * max(abs(y[k]), 1e-2 if k % m < n else 1e3)
+        e = np.zeros(y.size)
+        e[k] = step
+        differences[:, k] = (system.rhs(0.3, y + e) - system.rhs(0.3, y - e)) / (2 * step)
+    assert np.max(np.abs(exact - differences)) <= 1e-6 * np.max(np.abs(differences))
