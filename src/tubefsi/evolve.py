@@ -19,7 +19,10 @@ the boundary fluxes), the pressure of a cell is the wall's :math:`P(\sqrt{1+s}) 
 natural hook of every registered wall: no inversion of the tube law in the loop), the flux
 through a face is :math:`Q(-(p_{i+1} - p_i)/\Delta z, a\bar\lambda)` with the mean stretch of
 the two cells (at a boundary: the half cell to the boundary pressure, the stretch of the cell),
-second order in :math:`\Delta z`. Time: :func:`scipy.integrate.solve_ivp` (``BDF`` or
+second order in :math:`\Delta z`. A graded tube (``docs/transients.md``, "Graded tubes") has
+per cell its undeformed radius :math:`a_i = a(z_i)`, :math:`\bar t(z_i)` and wall parameters
+:math:`\theta(z_i)` (the strain :math:`s_i` relative to :math:`\pi a_i^2`, the cell's own tube law),
+and per face the undeformed radius :math:`a(z_{i+1/2})`. Time: :func:`scipy.integrate.solve_ivp` (``BDF`` or
 ``Radau``) with the exact sparse Jacobian (tridiagonal plus the chamber and the volume
 counters): the face flows' slopes :math:`\partial Q/\partial G = (\pi R^3\dot\gamma_w - 3Q)/G`,
 :math:`\partial Q/\partial R = \pi R^2\dot\gamma_w` from the rheology's shear rate at the wall
@@ -36,6 +39,12 @@ grow and the tolerance falls until their sum, relative to the history's scale (i
 at least the flow :math:`Q(p_s/L, a)` under the problem's pressure scale :math:`p_s`, or :math:`p_s` behind
 a pump: not pointwise, a relaxation's history decays to ~0), meets ``rtol``, else an :class:`~tubefsi.AccuracyWarning` states the estimate. The fields inside the tube
 are the ``4n`` run's.
+
+**Batches.** Arrays of scene parameters (boundary values, external and starting pressures, the
+tube's sizes, the models' parameters) broadcast to the scenes' shape and run as one system: the
+scenes' states one after the other, per-scene numbers as columns against the cells, a
+block-diagonal Jacobian, shared output times, cells and integrator steps; the error estimates are
+the largest over the scenes (``docs/transients.md``, "Batches of scenes").
 """
 
 from __future__ import annotations
@@ -1077,27 +1086,30 @@ def evolve(rheology, wall, tube: Tube, times, *, inlet_pressure=None, inlet_flow
     ----------
     rheology, wall : model instance, class or registered name
     tube : Tube
-        Scalar radius, thickness and length (graded tubes and arrays are not supported here).
+        Radius and thickness numbers or functions of z (a graded tube: each cell its own radius
+        and tube law, ``docs/transients.md``), or arrays (one per scene); length a number or an
+        array (one per scene). A wall's parameters may be functions of z too.
     times : array_like
         At least two increasing output times (s); the integration starts at ``times[0]`` from
         ``initial``.
-    inlet_pressure : float or callable of t, optional
-        Gauge pressure at the inlet :math:`p(0, t)` (Pa).
-    inlet_flow_rate : float or callable of t, optional
+    inlet_pressure : float, array or callable of t, optional
+        Gauge pressure at the inlet :math:`p(0, t)` (Pa); an array: one constant per scene.
+    inlet_flow_rate : float, array or callable of t, optional
         Flow rate pumped in :math:`q(0, t)` (m^3/s). Exactly one of the two inlets.
     outlet : {"open", "closed"}, Chamber or callable
         ``"open"``: the outlet pressure ``outlet_pressure`` holds at :math:`z = L`; ``"closed"``: a
         dead end, :math:`q(L) = 0`; a :class:`Chamber` or a callable :math:`V(p)` (m^3): a chamber
         filled by the outlet flow.
-    outlet_pressure : float or callable of t, optional
+    outlet_pressure : float, array or callable of t, optional
         The outlet's gauge pressure (Pa) for ``outlet="open"`` (default 0); refused with a closed
         end or a chamber (they set their own pressure).
-    external_pressure : float
+    external_pressure : float or array
         :math:`p_e` (Pa): the wall sees :math:`p - p_e`.
-    initial : None, float or Solution
+    initial : None, float, array or Solution
         ``None``: at rest at the outlet pressure (open) or at 0 (closed, chamber); a number: at rest
-        at that pressure (Pa); a steady :class:`Solution` of the same fluid, wall, tube and external
-        pressure (compared by value, else :class:`InvalidParameterError`): its profile. A starting
+        at that pressure (Pa; an array: one per scene); a steady :class:`Solution` of the same
+        fluid, wall, tube and external pressure (compared by value, a profile along z by identity,
+        else :class:`InvalidParameterError`): its profile. A starting
         or boundary pressure below the wall's buckling bound raises :class:`~tubefsi.BucklingError`.
     rtol : float
         Requested relative accuracy of the inlet history (the flow rate behind a pressure inlet,
@@ -1119,6 +1131,16 @@ def evolve(rheology, wall, tube: Tube, times, *, inlet_pressure=None, inlet_flow
     Returns
     -------
     Transient
+        Arrays of scene parameters (the boundary values above as numbers, ``external_pressure``,
+        ``initial`` as pressures, the tube's radius, thickness and length, the rheology's and the
+        wall's parameters) broadcast together to the scenes' shape ``S`` and run as one batch:
+        the result's ``shape`` is ``S``, its fields ``(*S, len(times), nodes)``, its histories
+        ``(*S, len(times))``, its nodes ``(*S, nodes)``, the cells, times and error estimates
+        (the largest over the scenes) shared; ``r.scene(k)`` is one scene. Callables of t,
+        the chamber and a wall's profiles are shared by the scenes; a starting Solution or a
+        ``density`` with a batch, arrays that do not broadcast, and array parameters of models
+        whose hooks do not broadcast (``broadcasts = False``) raise
+        :class:`~tubefsi.InvalidParameterError` naming them.
         With error control: the fields inside the tube of the finest run (``cells`` is its
         count), the boundary histories (inlet and outlet flow, pressure and radius, the chamber
         pressure, the stored volume, the volumes in and out) Richardson-extrapolated from the two
