@@ -6,8 +6,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import tubefsi
+from tubefsi.testing.profiles import scaled
 
 L = 1e-2
 TIMES = np.linspace(0.0, 0.02, 6)
@@ -180,3 +183,25 @@ def test_jacobian_of_batches_and_graded_tubes(case):
         e[k] = step
         differences[:, k] = (system.rhs(0.3, y + e) - system.rhs(0.3, y - e)) / (2 * step)
     assert np.max(np.abs(exact - differences)) <= 1e-6 * np.max(np.abs(differences))
+
+
+@settings(deadline=None, max_examples=scaled(8))
+@given(p_shape=st.sampled_from([(), (2,), (3, 1)]), length_shape=st.sampled_from([(), (1,), (2,), (1, 2)]),
+       pump=st.booleans())
+def test_shapes_broadcast(p_shape, length_shape, pump):
+    """Contract: the scenes' shape is the broadcast of the parameters' shapes (NumPy's rules), the
+    fields and histories carry it first, and scene(k) of every flat k is one scene with that
+    scene's length (a shared callable of t at the outlet)."""
+    shape = np.broadcast_shapes(p_shape, length_shape)
+    value = np.full(p_shape, 1e-11 if pump else 1e3)
+    lengths = np.full(length_shape, L) * (1.0 + np.arange(int(np.prod(length_shape))).reshape(length_shape))
+    inlet = dict(inlet_flow_rate=value) if pump else dict(inlet_pressure=value)
+    r = tubefsi.evolve(_fluid(), _wall(), _tube(lengths if length_shape else L), TIMES[:3], cells=4, rtol=1e-4,
+                       error_control=False, outlet_pressure=lambda t: 10.0 * t, **inlet)
+    assert r.shape == shape
+    assert r.pressure_nodes.shape == shape + (3, 6) and r.flow_faces.shape == shape + (3, 5)
+    assert r.inlet_pressure.shape == r.stored_volume().shape == shape + (3,)
+    for k in range(int(np.prod(shape))) if shape else ():
+        one = r.scene(k)
+        assert one.z[-1] == np.broadcast_to(lengths if length_shape else L, shape).ravel()[k]
+        np.testing.assert_array_equal(one.inlet_flow_rate, r.inlet_flow_rate.reshape(-1, 3)[k])

@@ -196,3 +196,17 @@ def test_uniform_profile_is_the_uniform_tube():
     r_u, r_g = (tubefsi.evolve(fluid, wall, t, times, **kwargs) for t in (uniform, graded))
     np.testing.assert_allclose(r_g.flow_faces, r_u.flow_faces, rtol=1e-9, atol=1e-9 * np.max(r_u.flow_faces))
     np.testing.assert_allclose(r_g.radius_nodes, r_u.radius_nodes, rtol=1e-12)
+
+
+def test_graded_steady_start_stays_steady():
+    """Started from solve's steady Solution of the same graded tube (the same tube object: a
+    profile compares by identity), the transient stays there: its inlet flow after the start is
+    solve's to the discretization (the error-controlled, extrapolated histories), and another
+    taper object with the same numbers is refused by name."""
+    fluid, wall, tube = _fluid(), _graded_wall(), _taper()
+    steady = tubefsi.solve(fluid, wall, tube, pressure_drop=1e3)
+    r = tubefsi.evolve(fluid, wall, tube, np.linspace(0.0, 0.01, 5), inlet_pressure=1e3, initial=steady, rtol=1e-6)
+    np.testing.assert_allclose(r.inlet_flow_rate[1:], steady.flow_rate, rtol=1e-5)
+    with pytest.raises(tubefsi.InvalidParameterError, match="its tube radius") as info:
+        tubefsi.evolve(fluid, wall, _taper(), [0.0, 0.01], inlet_pressure=1e3, initial=steady)
+    assert info.value.parameter == "initial"
