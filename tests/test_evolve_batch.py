@@ -205,3 +205,13 @@ def test_shapes_broadcast(p_shape, length_shape, pump):
         one = r.scene(k)
         assert one.z[-1] == np.broadcast_to(lengths if length_shape else L, shape).ravel()[k]
         np.testing.assert_array_equal(one.inlet_flow_rate, r.inlet_flow_rate.reshape(-1, 3)[k])
+
+
+def test_a_bad_entry_is_named():
+    """A non-finite entry of an array of scene values is refused naming the parameter and the entry."""
+    with pytest.raises(tubefsi.InvalidParameterError, match=r"entry \(1,\)") as info:
+        tubefsi.evolve(_fluid(), _wall(), _tube(), TIMES, inlet_pressure=[1e3, np.nan, 2e3])
+    assert info.value.parameter == "inlet_pressure"
+    with pytest.raises(tubefsi.InvalidParameterError, match=r"entry \(0, 1\)") as info:
+        tubefsi.evolve(_fluid(), _wall(), _tube(), TIMES, inlet_pressure=1e3, external_pressure=[[0.0, np.inf]])
+    assert info.value.parameter == "external_pressure"

@@ -57,7 +57,7 @@ import numpy as np
 
 from ._keywords import checked_keywords
 from ._lazy import lazy_module
-from ._validation import as_array, as_scalar, positive_scalar, real_array
+from ._validation import as_scalar, positive_scalar, real_array
 from .fields import _array_fields, _replace, at_position, broadcast_model, varies
 from .errors import (AccuracyWarning, BucklingError, ConvergenceError, InvalidParameterError, ModelValidityWarning,
                      NoSteadyStateError, TubefsiError, warn_user)
@@ -197,13 +197,25 @@ def _one(function, x, name, argument):
     return float(v)
 
 
+def _finite(name, value, admissible):
+    """``value`` as a float array of finite numbers (one per scene, or one number); a non-finite
+    entry raises :class:`InvalidParameterError` naming ``name`` and the entry."""
+    v = real_array(name, value, admissible)
+    if not np.all(np.isfinite(v)):
+        if v.ndim == 0:
+            raise InvalidParameterError(name, admissible, float(v))
+        where = tuple(int(i) for i in np.argwhere(~np.isfinite(v))[0])
+        raise InvalidParameterError(name, admissible, float(v[where]), f"entry {where} of an array of shape {v.shape}")
+    return v
+
+
 def _boundary(name, value):
     """``(function of t, scenes' shape)``: a callable (shared by the scenes; its shape ``()``), a
     number (constant) or an array of numbers (one constant per scene, its values flattened: the
     function takes times of shape ``(..., S)``)."""
     if callable(value):
         return value, ()
-    v = as_array(name, value, "a finite number, an array of them (one per scene) or a callable of t", np.isfinite)
+    v = _finite(name, value, "a finite number, an array of them (one per scene) or a callable of t")
     if v.ndim == 0:
         v = float(v)
         return (lambda t: v + 0.0 * np.asarray(t, dtype=float)), ()
@@ -1288,15 +1300,14 @@ def _setup(rheo, wall, tube, times, inlet_pressure, inlet_flow_rate, outlet_pres
         outlet_kind, outlet_value = "chamber", Chamber(volume=outlet)
     else:
         raise InvalidParameterError("outlet", "'open', 'closed', a Chamber or a callable V(p)", outlet)
-    p_ext = as_array("external_pressure", external_pressure, "finite numbers (Pa)", np.isfinite)
+    p_ext = _finite("external_pressure", external_pressure, "finite numbers (Pa), one or one per scene")
     if cells is not None and (isinstance(cells, (bool, np.bool_)) or not isinstance(cells, (int, np.integer))):
         raise InvalidParameterError("cells", f"an integer in [2, {MAX_CELLS}]", cells)
     n = 16 if cells is None else int(cells)
     if not (2 <= n <= MAX_CELLS):
         raise InvalidParameterError("cells", f"[2, {MAX_CELLS}]", cells)
     if initial is not None and not isinstance(initial, Solution):
-        initial = as_array("initial", initial, "None, finite pressures (Pa) or a steady Solution of the same tube",
-                           np.isfinite)
+        initial = _finite("initial", initial, "None, finite pressures (Pa) or a steady Solution of the same tube")
     shape = _scene_shape(rheo, wall, tube, {inlet_name: inlet_shape, "outlet_pressure": outlet_shape,
                                             "external_pressure": p_ext.shape,
                                             "initial": np.shape(initial) if isinstance(initial, np.ndarray) else ()})
