@@ -627,9 +627,11 @@ class Transient:
     ``shape`` is their broadcast shape, the fields are ``(*shape, len(times), nodes)``, the
     histories ``(*shape, len(times))``, ``z`` and ``z_faces`` ``(*shape, nodes)`` (each scene its
     own length); the cells, the output times and the error estimates (the largest over the scenes)
-    are shared. :meth:`scene` gives one scene as a :class:`Transient` of its own, with every method;
-    on a batch the methods of one scene (fields at ``(z, t)``, the steady state, settling times,
-    export, plots) raise :class:`~tubefsi.InvalidParameterError` pointing there."""
+    are shared. :meth:`steady` (one solve of the scenes' shape), :meth:`steady_volume` and
+    :meth:`settling_time` are vectorized over the scenes (arrays of their shape); :meth:`scene`
+    gives one scene as a :class:`Transient` of its own, with every method; on a batch the methods
+    that read one scene's fields (at ``(z, t)``, export, plots) raise
+    :class:`~tubefsi.InvalidParameterError` pointing there."""
 
     #: The output times (s).
     times: np.ndarray = attrs.field(repr=False)
@@ -775,86 +777,109 @@ class Transient:
         return float(out) if out.ndim == 0 else out
 
     # -------------------------------------------------------------- the steady state
+    def _per_scene(self, value):
+        """A per-scene number of the system (flat ``(S,)`` for a batch) in the scenes' shape."""
+        return value if self.shape == () else np.asarray(value).reshape(self.shape)
+
     def steady(self) -> Solution | None:
         """The steady state of the boundary values at the last output time.
 
         - open outlet: a :class:`Solution` of :func:`~tubefsi.solve` with the final inlet pressure
-          (a pressure drop to the final outlet pressure) or the final pump flow rate;
+          (a pressure drop to the final outlet pressure) or the final pump flow rate (a batch: one
+          solve of the scenes' shape);
         - closed end or chamber behind a pressure inlet: None (no flow; the pressure is uniform,
           the final inlet pressure);
         - closed end or chamber behind a pump that has stopped (final flow rate 0): None (no flow;
           the volume held is what was pumped in, see :meth:`steady_volume`);
         - a pump still running into a closed end or a chamber: no steady state,
-          :class:`~tubefsi.NoSteadyStateError`."""
-        self._one_scene("steady()")
+          :class:`~tubefsi.NoSteadyStateError` (a batch: naming the first such scene)."""
         sy = self._system
         inlet, outlet = self._final
+        where = _scene_text(self.shape)
         if sy.outlet_kind != "pressure":
-            if sy.inlet_kind == "flow" and inlet != 0.0:
-                raise NoSteadyStateError("flow_rate", 0.0, inlet, "a pump into a closed end or a chamber fills it "
-                                         "without bound", name="the inlet flow rate")
+            running = np.ravel(inlet) != 0.0
+            if sy.inlet_kind == "flow" and np.any(running):
+                k = int(np.argmax(running))
+                raise NoSteadyStateError("flow_rate", 0.0, float(np.ravel(inlet)[k]), "a pump into a closed end or a "
+                                         f"chamber fills it without bound{where(k)}", name="the inlet flow rate")
             return None
-        tube = sy.tube
-        common = dict(outlet_pressure=outlet, external_pressure=sy.external)   # (gauge pressures)
+        common = dict(outlet_pressure=outlet, external_pressure=self._per_scene(sy.external))   # (gauge pressures)
         if sy.inlet_kind == "pressure":
             drop = inlet - outlet
-            if drop < 0:
+            if np.any(drop < 0):
+                k = int(np.argmax(np.ravel(drop) < 0))
                 raise InvalidParameterError("inlet_pressure", "a final inlet pressure >= the outlet pressure "
-                                            "(for the steady state)", inlet)
-            return solve(sy.rheology, sy.wall, tube, pressure_drop=drop, **common)
-        if inlet < 0:
-            raise InvalidParameterError("inlet_flow_rate", "a final flow rate >= 0 (for the steady state)", inlet)
-        return solve(sy.rheology, sy.wall, tube, flow_rate=inlet, **common)
+                                            "(for the steady state)", float(np.ravel(inlet)[k]), where(k).strip())
+            return solve(sy.rheology, sy.wall, sy.tube, pressure_drop=drop, **common)
+        if np.any(np.asarray(inlet) < 0):
+            k = int(np.argmax(np.ravel(inlet) < 0))
+            raise InvalidParameterError("inlet_flow_rate", "a final flow rate >= 0 (for the steady state)",
+                                        float(np.ravel(inlet)[k]), where(k).strip())
+        return solve(sy.rheology, sy.wall, sy.tube, flow_rate=inlet, **common)
 
-    def steady_volume(self) -> float:
-        """The stored volume of :meth:`steady` (m^3): :math:`\\int_0^L \\pi R^2 dz` by 64-point
-        Gauss–Legendre quadrature of the steady profile (open outlet), the tube and chamber at the
-        final inlet pressure (a pressure inlet into a closed end or a chamber), or
-        :math:`V(t_0) + \\int q_{in}\\,dt` (a stopped pump into a closed end or a chamber: what was
-        pumped in stays). Raises :class:`~tubefsi.NoSteadyStateError` where :meth:`steady` does."""
-        self._one_scene("steady_volume()")
+    def steady_volume(self):
+        """The stored volume of :meth:`steady` (m^3; a batch: an array of the scenes' shape):
+        :math:`\\int_0^L \\pi R^2 dz` by 64-point Gauss–Legendre quadrature of the steady profile
+        (open outlet), the tube (:math:`\\pi a(z)^2\\lambda(p_{in}; z)^2` integrated alike where
+        graded) and the chamber at the final inlet pressure (a pressure inlet into a closed end or
+        a chamber), or :math:`V(t_0) + \\int q_{in}\\,dt` (a stopped pump into a closed end or a
+        chamber: what was pumped in stays). Raises :class:`~tubefsi.NoSteadyStateError` where
+        :meth:`steady` does."""
         sy = self._system
         inlet, _ = self._final
         sol = self.steady()
         if sol is None and sy.inlet_kind == "flow":
             # a stopped pump into a closed end or a chamber: mass, V(t0) + the volume pumped in
-            return float(self.stored[0] + self.volume_in[-1])
+            held = self.stored[..., 0] + self.volume_in[..., -1]
+            return float(held) if self.shape == () else held
         x, w = np.polynomial.legendre.leggauss(64)
-        z = 0.5 * sy.length * (x + 1.0)
         if sol is None:
-            chamber = float(sy.outlet.volume_at(inlet)) if sy.outlet_kind == "chamber" else 0.0
-            if not sy.graded:
+            chamber = sy.outlet.volume_at(inlet) if sy.outlet_kind == "chamber" else 0.0
+            if not sy.graded and self.shape == ():
                 lam = 1.0 + float(sy.wall.strain(inlet - sy.external, sy.tb))
-                return math.pi * (sy.radius * lam) ** 2 * sy.length + chamber
-            # a graded tube at the uniform pressure: the integral of pi a(z)^2 lambda(p; z)^2
+                return math.pi * (sy.radius * lam) ** 2 * sy.length + float(chamber)
+            # the tube at the uniform pressure: the integral of pi a(z)^2 lambda(p; z)^2 (per scene,
+            # the positions (S, 64) and the scenes' numbers as columns)
+            z = 0.5 * sy._column(sy.length) * (x + 1.0)
             wall_z, a_z, tb_z = sy.section(z)
-            radius = a_z * (1.0 + wall_z.strain(inlet - sy.external, tb_z))
-            return float(0.5 * sy.length * np.sum(w * math.pi * radius**2)) + chamber
-        return float(0.5 * sy.length * np.sum(w * math.pi * np.asarray(sol.radius(z)) ** 2))
+            radius = a_z * (1.0 + wall_z.strain(sy._column(np.ravel(inlet) if self.shape else inlet)
+                                                - sy._column(sy.external), tb_z))
+            volume = 0.5 * sy.length * np.sum(w * math.pi * radius**2, axis=-1)
+            return float(volume) + float(chamber) if self.shape == () else self._per_scene(volume) + chamber
+        if self.shape == ():
+            z = 0.5 * sy.length * (x + 1.0)
+            return float(0.5 * sy.length * np.sum(w * math.pi * np.asarray(sol.radius(z)) ** 2))
+        # a batch: the nodes (64, *shape) against the Solution of the scenes' shape
+        length = self._per_scene(sy.length)
+        nodes = (x + 1.0).reshape((64,) + (1,) * len(self.shape))
+        radius = np.asarray(sol.radius(0.5 * length * nodes))
+        return 0.5 * length * np.tensordot(w, math.pi * radius**2, axes=(0, 0))
 
-    def settling_time(self, fraction: float = 0.9) -> float:
+    def settling_time(self, fraction: float = 0.9):
         r"""The time (s, from ``times[0]``) after which the stored volume stays within
         ``(1 - fraction)`` of its change to the steady state, :math:`|V(t) - V_\infty| \le
         (1 - f)|V_\infty - V(t_0)|` (linear interpolation between output times); ``inf`` if that
         is not reached by the last output time. The steady state is that of the boundary values at
         the last output time (:meth:`steady`, :meth:`steady_volume`); a pump still running into a
-        closed end or a chamber has none: :class:`~tubefsi.NoSteadyStateError`."""
-        self._one_scene("settling_time()")
+        closed end or a chamber has none: :class:`~tubefsi.NoSteadyStateError`. A batch: an array
+        of the scenes' shape."""
         f = as_scalar("fraction", fraction, "(0, 1)", lambda v: (v > 0) & (v < 1))
-        v_inf = self.steady_volume()
+        v_inf = np.asarray(self.steady_volume())[..., None]
         dev = np.abs(self.stored - v_inf)
-        band = (1.0 - f) * abs(v_inf - self.stored[0])
-        if band == 0.0:
-            return 0.0
-        outside = np.flatnonzero(dev > band)
-        if outside.size == 0:
-            return 0.0
-        k = int(outside[-1])
-        if k == self.times.size - 1:
-            return math.inf
-        d0, d1 = dev[k], dev[k + 1]
-        w = (d0 - band) / (d0 - d1) if d0 != d1 else 1.0
-        return float(self.times[k] + w * (self.times[k + 1] - self.times[k]) - self.times[0])
+        band = (1.0 - f) * np.abs(v_inf - self.stored[..., :1])
+        outside = dev > band
+        count = self.times.size
+        # the last output time outside the band, per scene (-1: none)
+        last = np.where(np.any(outside, axis=-1), count - 1 - np.argmax(outside[..., ::-1], axis=-1), -1)
+        k = np.clip(last, 0, count - 2)[..., None]
+        d0, d1 = np.take_along_axis(dev, k, -1)[..., 0], np.take_along_axis(dev, k + 1, -1)[..., 0]
+        b = band[..., 0]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            w = np.where(d0 != d1, (d0 - b) / (d0 - d1), 1.0)
+        t0, t1 = self.times[k[..., 0]], self.times[k[..., 0] + 1]
+        out = np.where(last == count - 1, math.inf, t0 + w * (t1 - t0) - self.times[0])
+        out = np.where((b == 0.0) | (last < 0), 0.0, out)
+        return float(out) if self.shape == () else out
 
     # -------------------------------------------------------------- output
     def to_xarray(self):
@@ -1149,8 +1174,8 @@ def evolve(rheology, wall, tube: Tube, times, *, inlet_pressure=None, inlet_flow
         the result's ``shape`` is ``S``, its fields ``(*S, len(times), nodes)``, its histories
         ``(*S, len(times))``, its nodes ``(*S, nodes)``, the cells, times and error estimates
         (the largest over the scenes) shared; ``r.scene(k)`` is one scene. Callables of t,
-        the chamber and a wall's profiles are shared by the scenes; a starting Solution or a
-        ``density`` with a batch, arrays that do not broadcast, and array parameters of models
+        the chamber, ``density`` and a wall's profiles are shared by the scenes; a starting
+        Solution with a batch, arrays that do not broadcast, and array parameters of models
         whose hooks do not broadcast (``broadcasts = False``) raise
         :class:`~tubefsi.InvalidParameterError` naming them.
         With error control: the fields inside the tube of the finest run (``cells`` is its
@@ -1165,9 +1190,6 @@ def evolve(rheology, wall, tube: Tube, times, *, inlet_pressure=None, inlet_flow
     system, times, y0_of, rtol, method = _setup(rheo, wall_model, tube, times, inlet_pressure, inlet_flow_rate,
                                                 outlet_pressure, outlet, external_pressure, initial, rtol, method,
                                                 cells)
-    if density is not None and system.shape != ():
-        raise InvalidParameterError("density", "None for a batch of scenes (the validity check is one scene's: "
-                                    "evolve that scene alone)", density)
     n = system.n
     if error_control and 4 * n > MAX_CELLS:
         raise InvalidParameterError("cells", f"[2, {MAX_CELLS // 4}] with error control (its finest run has four "
@@ -1469,29 +1491,36 @@ def _check_initial(initial, rheo, wall, tube, p_ext):
 def _check_validity(result: Transient, density: float) -> None:
     r"""Warn where the quasi-steady, inertia-free model fails: the Womersley number
     :math:`a\sqrt{\rho/(\mu t_c)}` with the apparent viscosity at the inlet's largest flow and the
-    process time :math:`t_c` (the 50 % settling time, else the span), and :math:`Re\,a/L`."""
+    process time :math:`t_c` (the 50 % settling time, else the span), and :math:`Re\,a/L`; a batch:
+    per scene, the warning naming the largest and its scene."""
     sy = result._system
-    k = int(np.argmax(np.abs(result.inlet_flow_rate)))
-    q = abs(float(result.inlet_flow_rate[k]))
-    if q == 0.0:
+    flows = np.abs(result.inlet_flow_rate).reshape(sy.scenes, -1)
+    k = np.argmax(flows, axis=-1)[:, None]
+    q = np.take_along_axis(flows, k, -1)[:, 0]
+    r = np.take_along_axis(result.radius_nodes[..., 0].reshape(sy.scenes, -1), k, -1)[:, 0]
+    moving = q > 0.0
+    if not np.any(moving):
         return
-    r = float(result.radius_nodes[k, 0])
-    g = float(sy.rheology.pressure_gradient(q, r))
+    q, r = np.where(moving, q, 1.0), r            # (a scene at rest: no flow, nothing to check)
+    g = np.broadcast_to(sy.scene_rheology.pressure_gradient(q, r), q.shape)
     tau_w = 0.5 * g * r
     rate = 4.0 * q / (math.pi * r**3)
     mu = tau_w / rate
     try:
-        t_c = result.settling_time(0.5)
+        t_c = np.ravel(result.settling_time(0.5)).astype(float)
     except (InvalidParameterError, NoSteadyStateError):
-        t_c = math.inf
-    if not math.isfinite(t_c) or t_c <= 0:
-        t_c = float(result.times[-1] - result.times[0])
-    womersley = sy.radius * math.sqrt(density / (mu * t_c))
+        t_c = np.full(sy.scenes, math.inf)
+    t_c = np.where(np.isfinite(t_c) & (t_c > 0), t_c, float(result.times[-1] - result.times[0]))
+    womersley = np.where(moving, sy.radius * np.sqrt(density / (mu * t_c)), 0.0)
     velocity = q / (math.pi * r * r)
-    reduced_re = 8.0 * density * velocity**2 / tau_w * r / sy.length
-    if womersley > WOMERSLEY:
-        warn_user(f"evolve: the Womersley number a*sqrt(rho/(mu t_c)) = {womersley:.3g} exceeds {WOMERSLEY} "
-                  f"(t_c = {t_c:.3g} s): fluid inertia is not negligible on this time scale", ModelValidityWarning)
-    if reduced_re > REDUCED_REYNOLDS:
-        warn_user(f"evolve: the reduced Reynolds number Re a/L = {reduced_re:.3g} exceeds {REDUCED_REYNOLDS}: "
-                  "inertia is not negligible", ModelValidityWarning)
+    reduced_re = np.where(moving, 8.0 * density * velocity**2 / tau_w * r / sy.length, 0.0)
+    where = _scene_text(result.shape)
+    j = int(np.argmax(womersley))
+    if womersley[j] > WOMERSLEY:
+        warn_user(f"evolve: the Womersley number a*sqrt(rho/(mu t_c)) = {womersley[j]:.3g} exceeds {WOMERSLEY} "
+                  f"(t_c = {t_c[j]:.3g} s){where(j)}: fluid inertia is not negligible on this time scale",
+                  ModelValidityWarning)
+    j = int(np.argmax(reduced_re))
+    if reduced_re[j] > REDUCED_REYNOLDS:
+        warn_user(f"evolve: the reduced Reynolds number Re a/L = {reduced_re[j]:.3g} exceeds {REDUCED_REYNOLDS}"
+                  f"{where(j)}: inertia is not negligible", ModelValidityWarning)
