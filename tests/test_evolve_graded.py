@@ -210,3 +210,21 @@ def test_graded_steady_start_stays_steady():
     with pytest.raises(tubefsi.InvalidParameterError, match="its tube radius") as info:
         tubefsi.evolve(fluid, wall, _taper(), [0.0, 0.01], inlet_pressure=1e3, initial=steady)
     assert info.value.parameter == "initial"
+
+
+def test_cli_evolve_of_a_taper(tmp_path):
+    """``tubefsi evolve --tube ...,outlet_radius=..,outlet_thickness=..`` (the command line's
+    linear taper) writes the histories of the same graded call."""
+    from tubefsi.cli import main
+
+    status = main(["evolve", "--rheology", "power-law:consistency=0.017,index=0.7", "--wall",
+                   "thick-neo-hookean:shear_modulus=2e4", "--tube",
+                   "radius=1.2e-4,thickness=3.6e-5,length=1e-2,outlet_radius=0.8e-4,outlet_thickness=2.4e-5",
+                   "--inlet-pressure", "1e3",
+                   "--t-end", "0.01", "--steps", "5", "--rtol", "1e-3", "--output", str(tmp_path / "h.csv")])
+    assert status == 0
+    table = np.loadtxt(tmp_path / "h.csv", delimiter=",", skiprows=1)
+    r = tubefsi.evolve(_fluid(), tubefsi.registry.walls["thick-neo-hookean"](shear_modulus=2e4), _taper(),
+                       np.linspace(0.0, 0.01, 5), inlet_pressure=1e3, rtol=1e-3)
+    # (the same taper but for the rounding of the outlet thickness: Tube.tapered's t0 aL/a0)
+    np.testing.assert_allclose(table[:, 1], r.inlet_flow_rate, rtol=1e-9)
