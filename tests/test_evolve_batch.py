@@ -250,3 +250,12 @@ def test_validity_of_a_batch_names_the_scene():
     with pytest.warns(tubefsi.ModelValidityWarning, match=r"Womersley.*scene \(1,\)"):
         tubefsi.evolve(fluid, wall, tube, np.linspace(0.0, 4e-3, 11), inlet_pressure=1e-3, density=1e3, cells=16,
                        rtol=1e-2, error_control=False)
+
+
+def test_a_scene_beyond_the_wall_is_named():
+    """The pressure bounds are checked per scene (the thick neo-Hookean wall at t/a = 0.3: buckling
+    below -246 Pa, a limit pressure 5.2 kPa from its tube law): the error names the scene."""
+    with pytest.raises(tubefsi.BucklingError, match=r"scene \(1,\) of shape \(2,\)"):
+        tubefsi.evolve(_fluid(), _wall(), _tube(), TIMES, inlet_pressure=[1e3, -1e9])
+    with pytest.raises(tubefsi.NoSteadyStateError, match=r"scene \(0, 1\) of shape \(1, 2\)"):
+        tubefsi.evolve(_fluid(), _wall(), _tube(), TIMES, inlet_pressure=[[1e3, 1e9]])
