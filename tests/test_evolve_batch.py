@@ -62,7 +62,8 @@ def _alone(name, k, batch_args):
     return fluid, wall, tube, dict(inlet_flow_rate=[1e-11, 3e-11][k], initial=[0.0, 300.0][k], outlet=kwargs["outlet"])
 
 
-@pytest.mark.parametrize("name", list(BATCHES))
+@pytest.mark.parametrize("name", [pytest.param(b, marks=[pytest.mark.slow] if b == "lengths-by-index" else [])
+                                  for b in BATCHES])
 def test_each_scene_is_the_scene_alone(name):
     """Every scene of a batch against the same scene run alone (one run each, 16 cells, integrator
     tolerance 1e-12). The batch's time steps are shared (chosen for all scenes at once), so the
@@ -105,11 +106,11 @@ def test_error_controlled_batch_agrees_with_each_scene():
     the scenes); each scene's inlet flow agrees with the error-controlled run alone within the two
     estimates, and each scene conserves mass."""
     p = np.array([1e3, 3e3])
-    batch = tubefsi.evolve(_fluid(), _wall(), _tube(), TIMES, inlet_pressure=p, rtol=1e-5)
-    assert batch.error_estimate <= 1e-5
+    batch = tubefsi.evolve(_fluid(), _wall(), _tube(), TIMES, inlet_pressure=p, rtol=1e-4)
+    assert batch.error_estimate <= 1e-4
     assert batch.mass_error <= 1e-8
     for k, pk in enumerate(p):
-        alone = tubefsi.evolve(_fluid(), _wall(), _tube(), TIMES, inlet_pressure=pk, rtol=1e-5)
+        alone = tubefsi.evolve(_fluid(), _wall(), _tube(), TIMES, inlet_pressure=pk, rtol=1e-4)
         scale = np.max(np.abs(alone.inlet_flow_rate[1:]))
         gap = np.max(np.abs(batch.inlet_flow_rate[k, 1:] - alone.inlet_flow_rate[1:])) / scale
         assert gap <= batch.error_estimate + alone.error_estimate
