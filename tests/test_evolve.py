@@ -201,11 +201,14 @@ def test_bad_input_names_the_parameter(kwargs, name):
         tubefsi.evolve(fluid, wall, tube, [0.0, 1e-3], **kwargs)
 
 
-def test_array_parameters_are_refused():
+def test_array_parameters_that_do_not_broadcast_are_refused():
+    """Arrays of scene parameters broadcast together (tests/test_evolve_batch.py); two that do not
+    are refused, the second named."""
     tube, fluid, _, _, _ = _linear_setup()
     wall = tubefsi.registry.walls["thin-linear"](youngs_modulus=[1e6, 2e6], poisson_ratio=0.5)
-    with pytest.raises(tubefsi.InvalidParameterError, match="youngs_modulus"):
-        tubefsi.evolve(fluid, wall, tube, [0.0, 1e-3], inlet_pressure=1.0)
+    with pytest.raises(tubefsi.InvalidParameterError, match="wall.youngs_modulus has shape") as info:
+        tubefsi.evolve(fluid, wall, tube, [0.0, 1e-3], inlet_pressure=[1.0, 2.0, 3.0])
+    assert info.value.parameter == "inlet_pressure"
 
 
 def test_bad_times():

@@ -94,7 +94,7 @@ def _raises(p):
     (dict(times=0.1), "times"),
     (dict(initial="x"), "initial"),
     (dict(density=-1.0), "density"),
-    (dict(external_pressure=np.array([1.0, 2.0])), "external_pressure"),
+    (dict(external_pressure=np.array([1.0, 2.0]), inlet_pressure=np.array([1e3, 2e3, 3e3])), "external_pressure"),
     (dict(inlet_pressure="1e4"), "inlet_pressure"),
     (dict(cells=16.5), "cells"),
     (dict(outlet="closed", outlet_pressure=0.0), "outlet_pressure"),
