@@ -169,3 +169,22 @@ def test_pressure_above_the_limit_is_no_steady_state():
         tubefsi.evolve(FLUID, WALL, TUBE, TIMES, inlet_pressure=1.2 * limit, rtol=1e-2)
     assert not isinstance(info.value, tubefsi.BucklingError)
     assert info.value.limit == pytest.approx(limit)
+
+
+def test_a_run_started_at_its_steady_state_has_settled_at_once():
+    """Started from ``solve``'s steady profile of the same boundary values, nothing changes (the
+    exact answer: settled at 0); the discrete volume differs from the steady profile's quadrature
+    by far less than the run's accuracy, which once made the band of a zero change unreachable."""
+    steady = tubefsi.solve(FLUID, WALL, TUBE, pressure_drop=2e4)
+    r = tubefsi.evolve(FLUID, WALL, TUBE, np.linspace(0.0, 0.05, 11), inlet_pressure=2e4, initial=steady, rtol=1e-4)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", tubefsi.AccuracyWarning)
+        assert [r.settling_time(f) for f in (0.5, 0.9, 0.99)] == [0.0, 0.0, 0.0]
+
+
+def test_a_band_below_the_runs_accuracy_warns():
+    """A step of 1 % with a band of 1e-7 of it: narrower than a run at rtol 1e-3 resolves."""
+    steady = tubefsi.solve(FLUID, WALL, TUBE, pressure_drop=2e4)
+    r = tubefsi.evolve(FLUID, WALL, TUBE, np.linspace(0.0, 0.05, 11), inlet_pressure=2.02e4, initial=steady, rtol=1e-3)
+    with pytest.warns(tubefsi.AccuracyWarning, match="narrower than the run's accuracy"):
+        assert math.isfinite(r.settling_time(1.0 - 1e-7))

@@ -50,6 +50,7 @@ the largest over the scenes (``docs/transients.md``, "Batches of scenes").
 from __future__ import annotations
 
 import math
+import warnings
 from typing import Callable
 
 import attrs
@@ -862,11 +863,28 @@ class Transient:
         is not reached by the last output time. The steady state is that of the boundary values at
         the last output time (:meth:`steady`, :meth:`steady_volume`); a pump still running into a
         closed end or a chamber has none: :class:`~tubefsi.NoSteadyStateError`. A batch: an array
-        of the scenes' shape."""
+        of the scenes' shape.
+
+        The band is never narrower than the run's accuracy, :math:`\epsilon V_s` with
+        :math:`\epsilon` the :attr:`error_estimate` (the integrator's tolerance without error
+        control) and :math:`V_s` the stored volume's scale (the tube's volume change at the
+        problem's pressure scale, plus a chamber's): a volume that close to the steady one is
+        settled as far as the run can tell. So a
+        run started at its own steady state has settled at 0, and where
+        :math:`(1 - f)|V_\infty - V(t_0)|` is narrower than that (a change the run resolves, a
+        band it does not) the time is that of the accuracy band, with an
+        :class:`~tubefsi.AccuracyWarning`."""
         f = as_scalar("fraction", fraction, "(0, 1)", lambda v: (v > 0) & (v < 1))
         v_inf = np.asarray(self.steady_volume())[..., None]
         dev = np.abs(self.stored - v_inf)
-        band = (1.0 - f) * np.abs(v_inf - self.stored[..., :1])
+        accuracy = self.error_estimate if math.isfinite(self.error_estimate) else self.integrator_rtol
+        floor = accuracy * np.reshape(_volume_scale(self._system), np.shape(v_inf))
+        change = np.abs(v_inf - self.stored[..., :1])
+        if np.any(((1.0 - f) * change < floor) & (change > floor)):
+            warnings.warn(f"settling_time({f:g}): the band {1.0 - f:.3g} of the volume's change is narrower than "
+                          f"the run's accuracy ({accuracy:.2g} of the steady volume); the time to within that "
+                          "accuracy is given: lower rtol for a narrower band", AccuracyWarning, stacklevel=2)
+        band = np.maximum((1.0 - f) * change, floor)
         outside = dev > band
         count = self.times.size
         # the last output time outside the band, per scene (-1: none)
@@ -1096,6 +1114,18 @@ def _difference(a, b, floor=0.0):
     relaxation) is measured against the flow or pressure the problem drives, not against noise."""
     scale = np.maximum(np.maximum(np.max(np.abs(b), axis=-1), floor), np.finfo(float).tiny)
     return float(np.max(np.max(np.abs(a - b), axis=-1) / scale))     # (a batch: the largest over the scenes)
+
+
+def _volume_scale(system):
+    """The stored volume's scale (m^3, per scene for a batch): the inlet section's area strain at
+    the pressure scale (:func:`_area_strain_scale`) times the tube's volume, plus a chamber's volume
+    change over the pressure scale."""
+    scale = math.pi * np.asarray(system.radius) ** 2 * system.length * np.abs(_area_strain_scale(system))
+    if system.outlet_kind == "chamber":
+        ps = np.asarray(system.pressure_scale, dtype=float)
+        scale = scale + np.abs(np.asarray(system.outlet.volume_at(ps), dtype=float)
+                               - np.asarray(system.outlet.volume_at(0.0 * ps), dtype=float))
+    return float(scale) if system.shape == () else np.asarray(scale, dtype=float)
 
 
 def _history_scale(system):
