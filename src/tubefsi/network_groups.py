@@ -211,20 +211,19 @@ class _Groups:
             radius_out[index] = np.broadcast_to(_radius_at(tube, tube.length) * sol.scene.outlet_stretch, index.shape)
         return p_in, radius_in, radius_out
 
-    def apparent_viscosity(self, q, mu):
-        """Per tube, the Newtonian viscosity with the fluid's pressure gradient at ``|q|`` in the
-        undeformed tube (``mu`` where q = 0; a graded tube: in the uniform tube of its Poiseuille
-        mean radius)."""
+    def apparent_viscosity(self, q, mu, stretch):
+        """Per tube, the Newtonian viscosity with the fluid's pressure gradient at ``|q|`` in the tube
+        of its radius times ``stretch`` (one per tube; ``mu`` where q = 0; a graded tube: the
+        uniform tube of its Poiseuille mean radius), :math:`\\mu = \\pi R^4 G(|q|, R)/(8|q|)`."""
         out = mu.copy()
         for part in self.parts:
             index, fluid = part.index, part.fluid
             qi = np.abs(q[index])
             ok = qi > 0
             if np.any(ok):
-                a = self.radius[index]
-                g = np.asarray(fluid.pressure_gradient(np.where(ok, qi, 1.0), part.tube.radius if part.reverse is None
-                                                       else a), dtype=float)
-                g = np.broadcast_to(g, index.shape)
+                a = self.radius[index] * stretch[index]
+                g = np.broadcast_to(np.asarray(fluid.pressure_gradient(np.where(ok, qi, 1.0), a), dtype=float),
+                                    index.shape)
                 value = g * math.pi * a**4 / (8 * np.where(ok, qi, 1.0))
                 out[index] = np.where(ok & np.isfinite(value) & (value > 0), value, mu[index])
         return out
