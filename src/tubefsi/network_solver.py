@@ -46,7 +46,6 @@ throughput (the total flow that enters the network); otherwise :class:`Convergen
 from __future__ import annotations
 
 import math
-import operator
 
 import numpy as np
 import scipy.sparse as sp
@@ -87,12 +86,11 @@ class _Solver:
                 raise InvalidParameterError("node", "a node of some tube", node, "it has a boundary condition "
                                             "but no tube")
         self.net = net
-        self.tubes = list(net._tubes.values())
         self.nodes = list(net._nodes)
         index = net._nodes
+        self.tubes = net._tubes.columns(index)          # (columns: no Python object per tube)
         n_nodes, n_tubes = len(self.nodes), len(self.tubes)
-        self.U, self.V = (np.fromiter(map(index.__getitem__, map(operator.attrgetter(end), self.tubes)), np.intp,
-                                      n_tubes) for end in ("u", "v"))
+        self.U, self.V = self.tubes.U, self.tubes.V
         # the boundary conditions, node by node (one indexing per kind)
         self.fixed = np.zeros(n_nodes, dtype=bool)
         self.p_fixed = np.zeros(n_nodes)
