@@ -197,6 +197,16 @@ class _Columns:
     def __iter__(self):
         return map(self.__getitem__, range(len(self.names)))
 
+    def by_batch(self):
+        """``(batch, index)`` per batch that still has tubes, in the order of their first tubes:
+        the positions ``index`` of its tubes."""
+        present, first = np.unique(self.which, return_index=True)
+        order = np.argsort(self.which, kind="stable")
+        bounds = np.searchsorted(self.which[order], present)
+        ends = np.append(bounds[1:], order.size)
+        for j in np.argsort(first, kind="stable").tolist():
+            yield self.batches[int(present[j])], order[bounds[j]:ends[j]]
+
 
 @attrs.frozen(eq=False)
 class _Part:
