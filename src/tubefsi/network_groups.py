@@ -256,17 +256,24 @@ class _Groups:
     def __init__(self, tubes, subset):
         # the batches' groups (a graded batch: its very models; a uniform one: its wall and fluid
         # classes and fixed parameters), then each tube of the subset in its batch's group
+        # (one key per distinct triple of models: batches of add_tube calls often share them)
         keys: dict = {}
-        group_of = np.empty(len(tubes.batches), dtype=np.intp)
-        graded = []
-        for b, batch in enumerate(tubes.batches):
-            key = ("graded", id(batch.wall), id(batch.tube), id(batch.rheology)) if batch.graded else \
-                ((type(batch.wall), _fixed(batch.wall)), (type(batch.rheology), _fixed(batch.rheology)))
-            if key not in keys:
-                keys[key] = len(keys)
-                graded.append(batch.graded)
-            group_of[b] = keys[key]
+        by_models: dict = {}
         chosen = np.flatnonzero(subset)
+        group_of = np.zeros(len(tubes.batches), dtype=np.intp)
+        graded = []
+        for b in np.unique(tubes.which[chosen]).tolist():        # (the batches of the subset only)
+            batch = tubes.batches[b]
+            ids = (id(batch.wall), id(batch.tube), id(batch.rheology))
+            g = by_models.get(ids)
+            if g is None:
+                key = ("graded", ids) if batch.graded else \
+                    ((type(batch.wall), _fixed(batch.wall)), (type(batch.rheology), _fixed(batch.rheology)))
+                if key not in keys:
+                    keys[key] = len(keys)
+                    graded.append(batch.graded)
+                g = by_models[ids] = keys[key]
+            group_of[b] = g
         group = group_of[tubes.which[chosen]]
         order = np.argsort(group, kind="stable")
         bounds = np.searchsorted(group[order], np.arange(len(keys) + 1))
@@ -496,24 +503,30 @@ def _column(values):
 def _gather(tubes, index, which, fields) -> dict:
     """field -> the values of that parameter of the ``which`` model of the tubes ``index`` (of
     :class:`_Columns` ``tubes``): a float where all agree, else an array aligned with ``index``.
-    One value per batch of scalars, one indexing per batch of arrays."""
+    One read per distinct model of scalars (the batches of add_tube calls often share one), one
+    indexing per batch of arrays (an add_tubes call)."""
     present, inverse = np.unique(tubes.which[index], return_inverse=True)
     inverse = inverse.ravel()
-    batches = [tubes.batches[b] for b in present.tolist()]
+    scalars: dict = {}                 # id(model) -> (model, positions in present)
+    arrays = []
+    for j, b in enumerate(present.tolist()):
+        batch = tubes.batches[b]
+        model = getattr(batch, which)
+        if batch.rows is None:
+            scalars.setdefault(id(model), (model, []))[1].append(j)
+        else:
+            arrays.append((j, model, batch.rows))
     out = {}
     for f in fields:
-        scalar = np.zeros(present.size)
-        arrays = []
-        for j, batch in enumerate(batches):
-            value = getattr(getattr(batch, which), f)
-            if isinstance(value, np.ndarray) and value.ndim:
-                arrays.append((j, value, batch.rows))
-            else:
-                scalar[j] = value
-        column = scalar[inverse]
-        for j, value, rows in arrays:
+        column = np.zeros(present.size)
+        for model, at in scalars.values():
+            column[at] = getattr(model, f)
+        column = column[inverse]
+        for j, model, rows in arrays:
             at = np.flatnonzero(inverse == j)
-            column[at] = value[rows[tubes.place[index[at]]]]
+            value = getattr(model, f)
+            column[at] = value[rows[tubes.place[index[at]]]] if isinstance(value, np.ndarray) and value.ndim \
+                else value
         out[f] = _column(column)
     return out
 
