@@ -237,12 +237,15 @@ class _Solver:
 
     def _stretch(self, p):
         """Per tube, its wall's hoop stretch at the mean of its end pressures ``p`` (the start only;
-        1 where ``p`` is not below every node's bound: beyond one, no steady state may exist, and
-        the tubes stay rigid)."""
+        1 where ``p`` is not below every node's bound, or beyond what a wall's tube law reaches: no
+        steady state may exist there, and the tubes stay rigid)."""
         if not np.all(p < self.p_limit):
             return np.ones(self.n_tubes)
         mid = 0.5 * (p[self.U] + p[self.V])
-        return 1.0 + self.feed_groups.strain(mid) + self.groups.strain(mid)
+        try:
+            return 1.0 + self.feed_groups.strain(mid) + self.groups.strain(mid)
+        except NoSteadyStateError:          # (a tube law that peaks below its limit pressure)
+            return np.ones(self.n_tubes)
 
     # ------------------------------------------------------------------ Newton
     def _edges(self, p):
