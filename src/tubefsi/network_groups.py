@@ -197,6 +197,10 @@ class _Columns:
     def __iter__(self):
         return map(self.__getitem__, range(len(self.names)))
 
+    def present(self, index):
+        """The positions of the batches that hold some of the tubes ``index``, in increasing order."""
+        return np.flatnonzero(np.bincount(self.which[index], minlength=len(self.batches)))
+
     def by_batch(self):
         """``(batch, index)`` per batch that still has tubes, in the order of their first tubes:
         the positions ``index`` of its tubes."""
@@ -262,7 +266,7 @@ class _Groups:
         chosen = np.flatnonzero(subset)
         group_of = np.zeros(len(tubes.batches), dtype=np.intp)
         graded = []
-        for b in np.unique(tubes.which[chosen]).tolist():        # (the batches of the subset only)
+        for b in tubes.present(chosen).tolist():        # (the batches of the subset only)
             batch = tubes.batches[b]
             ids = (id(batch.wall), id(batch.tube), id(batch.rheology))
             g = by_models.get(ids)
@@ -505,8 +509,10 @@ def _gather(tubes, index, which, fields) -> dict:
     :class:`_Columns` ``tubes``): a float where all agree, else an array aligned with ``index``.
     One read per distinct model of scalars (the batches of add_tube calls often share one), one
     indexing per batch of arrays (an add_tubes call)."""
-    present, inverse = np.unique(tubes.which[index], return_inverse=True)
-    inverse = inverse.ravel()
+    present = tubes.present(index)
+    position = np.zeros(len(tubes.batches), dtype=np.intp)
+    position[present] = np.arange(present.size)
+    inverse = position[tubes.which[index]]          # per tube, its batch's position in present
     scalars: dict = {}                 # id(model) -> (model, positions in present)
     arrays = []
     for j, b in enumerate(present.tolist()):
@@ -534,7 +540,7 @@ def _gather(tubes, index, which, fields) -> dict:
 def _stack(tubes, index, which):
     """One model whose array parameters hold the values of the tubes ``index`` (a scalar where all
     agree): their batches' model itself where they all share it, with scalar parameters."""
-    batches = [tubes.batches[b] for b in np.unique(tubes.which[index]).tolist()]
+    batches = [tubes.batches[b] for b in tubes.present(index).tolist()]
     model = getattr(batches[0], which)
     if all(getattr(b, which) is model and b.rows is None for b in batches):
         return model
