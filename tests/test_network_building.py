@@ -109,6 +109,50 @@ def test_bulk_equals_one_by_one_for_compliant_tubes():
     assert edge["external_pressure"] == p_e[0]
 
 
+def test_batches_tubes_between_them_and_a_removal_inside_one_equal_one_by_one():
+    # the tubes are stored per add_tubes / add_tube call: a network built from three calls, with a
+    # tube removed from inside the first, must be the network built one tube at a time
+    rng = np.random.default_rng(5)
+    n = 14
+    child = np.arange(1, n + 1)
+    parent = (child - 1) // 2
+    moduli = rng.uniform(3e3, 6e3, n)
+    radii = rng.uniform(0.8e-4, 1.2e-4, n)
+    fluid = rheologies["power-law"](consistency=0.01, index=0.8)
+    leaves = sorted(set(child.tolist()) - set(parent.tolist()))
+
+    def wall(mu):
+        return walls["thick-neo-hookean"](shear_modulus=mu)
+
+    def finish(net):
+        net.set_pressure(0, 400.0)
+        for leaf in leaves:
+            net.set_pressure(leaf, 0.0)
+        return net.solve()
+
+    one = Network(rheology=fluid)
+    for k in range(n):
+        one.add_tube(int(parent[k]), int(child[k]), wall(moduli[k]), Tube(radius=radii[k], thickness=3e-5, length=1e-2))
+    mixed = Network(rheology=fluid)
+    first = list(range(7))
+    mixed.add_tubes(parent[first].tolist() + [0], child[first].tolist() + [1], wall(np.append(moduli[first], 5e3)),
+                    Tube(radius=np.append(radii[first], 1e-4), thickness=3e-5, length=1e-2),
+                    names=[(int(parent[k]), int(child[k])) for k in first] + ["extra"])
+    mixed.add_tube(int(parent[7]), int(child[7]), wall(moduli[7]), Tube(radius=radii[7], thickness=3e-5, length=1e-2))
+    rest = list(range(8, n))
+    mixed.add_tubes(parent[rest], child[rest], wall(moduli[rest]), Tube(radius=radii[rest], thickness=3e-5, length=1e-2))
+    mixed.remove_tube("extra")
+    a, b = finish(one), finish(mixed)
+    assert a.tube_names == b.tube_names == mixed.tube_names and a.nodes == b.nodes
+    np.testing.assert_allclose(b.flow_rates, a.flow_rates, rtol=1e-13)
+    np.testing.assert_allclose(b.pressures, a.pressures, rtol=1e-13)
+    # a tube asked for by name carries its own entries (the last batch's fourth tube: tube 11)
+    name = (int(parent[11]), int(child[11]))
+    assert mixed._tubes[name].models()[0].shear_modulus == moduli[11]
+    assert b.solution(name).tube.radius == radii[11]
+    assert b.solution(name).flow_rate == pytest.approx(a.flow_rate[name], rel=1e-12)
+
+
 @pytest.mark.parametrize("call, parameter", [
     (lambda net, t: net.add_tubes(["a", "b"], ["b"], RIGID, t), "v"),
     (lambda net, t: net.add_tubes([], [], RIGID, t), "v"),

@@ -28,7 +28,7 @@ def _tree():
 def test_a_warm_start_gives_the_same_answer_in_fewer_iterations():
     net = _tree().set_pressure(0, 800.0)
     previous = net.solve()
-    net.set_pressure(0, 802.0)                        # the next point of a sweep
+    net.set_pressure(0, 800.1)                        # the next point of a fine sweep
     cold = net.solve()
     warm = net.solve(initial=previous)
     np.testing.assert_allclose(warm.pressures, cold.pressures, rtol=1e-13)

@@ -7,20 +7,19 @@ evaluation of its tubes by groups in :mod:`tubefsi.network_groups`, its results 
 from __future__ import annotations
 
 import copy
-import itertools
 import operator
 from collections.abc import Hashable
 
-import attrs
 import numpy as np
 
 from ._keywords import checked_keywords
 from ._progress import bar
 from ._validation import as_array, as_scalar
 from .errors import InvalidParameterError
-from .fields import broadcast_model, varies, _array_fields, parameter_shape
+from .fields import broadcast_model, varies, parameter_shape
 from .geometry import Tube
 from .network_fit import fit_network
+from .network_groups import _Tubes
 from .network_solution import NetworkSolution, _hashable
 from .network_solver import _Solver
 from .rheology.base import Rheology
@@ -28,40 +27,6 @@ from .scene import resolve
 from .walls.base import WallModel
 
 __all__ = ["Network", "NetworkSolution"]
-
-
-@attrs.define(eq=False)
-class _Tube:
-    """One tube. ``row`` is None for a tube of :meth:`Network.add_tube`; for a tube of
-    :meth:`Network.add_tubes` it is the tube's entry in the flat (1-D) array parameters of the
-    models it shares with the other tubes of that call."""
-
-    name: object
-    u: object
-    v: object
-    wall: object
-    tube: Tube
-    rheology: object
-    external_pressure: float = 0.0
-    row: object = None
-
-    @property
-    def graded(self) -> bool:
-        """Whether its radius, thickness or a wall parameter varies along it (a graded tube: never
-        from :meth:`Network.add_tubes`)."""
-        return self.tube.graded or varies(self.wall)
-
-    def models(self):
-        """This tube's wall, tube and fluid, each with scalar parameters."""
-        if self.row is None:
-            return self.wall, self.tube, self.rheology
-        return tuple(_entry(m, self.row) for m in (self.wall, self.tube, self.rheology))
-
-
-def _entry(model, row):
-    """``model`` with its flat array parameters taken at ``row`` (validated scalars)."""
-    arrays = {f: float(v[row]) for f in _array_fields(type(model)) if isinstance(v := getattr(model, f), np.ndarray)}
-    return attrs.evolve(model, **arrays) if arrays else model
 
 
 class Network:
@@ -90,7 +55,7 @@ class Network:
     @checked_keywords
     def __init__(self, rheology: Rheology | type[Rheology] | str | None = None):
         self.rheology = None if rheology is None else resolve("rheology", rheology)
-        self._tubes: dict = {}
+        self._tubes = _Tubes()
         self._nodes: dict = {}
         self._pressure: dict = {}
         self._inflow: dict = {}
@@ -131,7 +96,7 @@ class Network:
             raise InvalidParameterError("external_pressure", "a number (one tube per add_tube)", external_pressure)
         for node in (u, v):
             self._nodes.setdefault(node, len(self._nodes))
-        self._tubes[name] = _Tube(name, u, v, wall, tube, fluid, float(p_e))
+        self._tubes.add([name], [u], [v], wall, tube, fluid, [float(p_e)], None)
         return self
 
     def _models(self, wall, tube, rheology):
@@ -167,7 +132,7 @@ class Network:
         if any(map(operator.eq, u, v)):                   # (a loop: found in C, then named)
             k = next(k for k, (a, b) in enumerate(zip(u, v)) if a == b)
             raise InvalidParameterError(f"v[{k}]", "a node other than u[k]", v[k], "a tube joins two distinct nodes")
-        taken = self._tubes.keys()
+        taken = self._tubes.names()
         if len(set(names)) != n or not taken.isdisjoint(names):       # (set operations: one pass in C)
             seen = set()
             for k, name in enumerate(names):
@@ -189,14 +154,13 @@ class Network:
         p_e = as_array("external_pressure", external_pressure, "the real numbers", np.isfinite)
         if p_e.shape not in ((), (n,)):
             raise InvalidParameterError("external_pressure", f"a number or an array of length {n}", p_e.shape)
-        p_e = np.broadcast_to(p_e.astype(float), (n,)).tolist()
+        p_e = np.broadcast_to(p_e.astype(float), (n,))
         shared = parameter_shape(wall) == parameter_shape(tube) == parameter_shape(fluid) == ()
         nodes = self._nodes
         fresh = [node for node in dict.fromkeys(u + v) if node not in nodes]
         nodes.update(zip(fresh, range(len(nodes), len(nodes) + len(fresh))))
-        rows = itertools.repeat(None, n) if shared else range(n)
-        self._tubes.update(zip(names, map(_Tube, names, u, v, itertools.repeat(wall, n), itertools.repeat(tube, n),
-                                          itertools.repeat(fluid, n), p_e, rows)))
+        # one batch of columns: no Python object per tube (a tube is made when asked for by name)
+        self._tubes.add(names, u, v, wall, tube, fluid, p_e, None if shared else np.arange(n))
         return self
 
     @checked_keywords
@@ -206,10 +170,8 @@ class Network:
         t = self._tubes.pop(name, None) if _hashable(name) else None
         if t is None:
             raise InvalidParameterError("name", "the name of a tube of the network", name)
-        used = set()
-        for other in self._tubes.values():
-            used.add(other.u)
-            used.add(other.v)
+        u, v = self._tubes.ends()
+        used = set(u).union(v)
         gone = [node for node in (t.u, t.v) if node not in used]
         if gone:
             for node in gone:
@@ -469,8 +431,9 @@ class Network:
     def _snapshot(self):
         """A copy that later changes to this network do not reach (the solution keeps it)."""
         new = copy.copy(self)
-        for name in ("_tubes", "_nodes", "_pressure", "_inflow", "_resistance", "positions"):
+        for name in ("_nodes", "_pressure", "_inflow", "_resistance", "positions"):
             setattr(new, name, dict(getattr(self, name)))
+        new._tubes = self._tubes.copy()
         return new
 
 

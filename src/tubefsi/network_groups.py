@@ -1,21 +1,30 @@
-r"""The tubes of a :class:`~tubefsi.Network` evaluated by groups (``docs/network.md``): tubes that share
-their wall and fluid classes are stacked into one model with array parameters and solved in one broadcast
-:func:`tubefsi.solve` per Newton iteration. :func:`_gather` and :func:`_stack` build those arrays from
-the tubes of :meth:`Network.add_tube` and :meth:`Network.add_tubes` alike.
+r"""The tubes of a :class:`~tubefsi.Network`, stored and evaluated (``docs/network.md``).
+
+Stored: :class:`_Tubes`, the mapping tube name -> :class:`_Tube` of a network, keeps the tubes of
+each :meth:`Network.add_tubes` call (and each :meth:`Network.add_tube`) together as one
+:class:`_Batch` of columns: their names, nodes, external pressures and the models whose array
+parameters hold one entry per tube. A :class:`_Tube` is made when one is asked for by name; the
+solver reads the columns (:meth:`_Tubes.columns`), so that 10^5 tubes added from arrays cost no
+Python object each.
+
+Evaluated: tubes that share their wall and fluid classes are stacked into one model with array
+parameters and solved in one broadcast :func:`tubefsi.solve` per Newton iteration
+(:class:`_Groups`, from the columns).
 """
 
 from __future__ import annotations
 
+import bisect
 import itertools
 import math
-import operator
+from collections.abc import MutableMapping
 
 import attrs
 import numpy as np
 
 from . import validity
 from .errors import NoSteadyStateError
-from .fields import _array_fields
+from .fields import _array_fields, varies
 from .couplers.graded import _breakpoints
 from .geometry import Tube
 from .profiles import Profile
@@ -24,9 +33,183 @@ from .solve import max_flow_rate as tubefsi_max_flow
 from .solve import solve_unchecked
 
 
-#: a network tube's models, external pressure and row (``network._Tube``), read by ``map`` over many tubes
-_WALL, _TUBE, _FLUID = (operator.attrgetter(f) for f in ("wall", "tube", "rheology"))
-_EXTERNAL, _ROW = operator.attrgetter("external_pressure"), operator.attrgetter("row")
+@attrs.define(eq=False)
+class _Tube:
+    """One tube. ``row`` is None for a tube whose models have scalar parameters (one of
+    :meth:`Network.add_tube`, or of an :meth:`Network.add_tubes` call of scalars); otherwise it is
+    the tube's entry in the flat (1-D) array parameters of the models it shares with the other
+    tubes of that call."""
+
+    name: object
+    u: object
+    v: object
+    wall: object
+    tube: Tube
+    rheology: object
+    external_pressure: float = 0.0
+    row: object = None
+
+    @property
+    def graded(self) -> bool:
+        """Whether its radius, thickness or a wall parameter varies along it (a graded tube: never
+        from :meth:`Network.add_tubes`)."""
+        return self.tube.graded or varies(self.wall)
+
+    def models(self):
+        """This tube's wall, tube and fluid, each with scalar parameters."""
+        if self.row is None:
+            return self.wall, self.tube, self.rheology
+        return tuple(_entry(m, self.row) for m in (self.wall, self.tube, self.rheology))
+
+
+def _entry(model, row):
+    """``model`` with its flat array parameters taken at ``row`` (validated scalars)."""
+    arrays = {f: float(v[row]) for f in _array_fields(type(model)) if isinstance(v := getattr(model, f), np.ndarray)}
+    return attrs.evolve(model, **arrays) if arrays else model
+
+
+@attrs.frozen(eq=False)
+class _Batch:
+    """Tubes added together: their ``names``, end nodes ``u`` and ``v`` (lists), ``external``
+    pressures (an array), one wall, tube and fluid, and ``rows`` (None where the models' parameters
+    are scalars, else per tube its entry in their flat array parameters)."""
+
+    names: list
+    u: list
+    v: list
+    wall: object
+    tube: Tube
+    rheology: object
+    external: np.ndarray
+    rows: np.ndarray | None
+
+    def member(self, k) -> _Tube:
+        """Tube ``k`` of the batch."""
+        return _Tube(self.names[k], self.u[k], self.v[k], self.wall, self.tube, self.rheology,
+                     float(self.external[k]), None if self.rows is None else int(self.rows[k]))
+
+    @property
+    def graded(self) -> bool:
+        return self.tube.graded or varies(self.wall)
+
+
+class _Tubes(MutableMapping):
+    """A network's tubes: tube name -> :class:`_Tube`, in the order they were added, stored as
+    :class:`_Batch` es. Every tube has a *slot*, a number never reused: a batch holds the slots
+    ``start, start + 1, ...`` (``_starts`` lists each batch's first), and the mapping name -> slot
+    gives the order and which tubes are still there (a removed one only leaves it; a tube set by
+    name anew is a batch of its own in the same place of the order)."""
+
+    def __init__(self):
+        self._slot: dict = {}
+        self._batches: list = []
+        self._starts: list = []
+        self._next = 0
+
+    def add(self, names, u, v, wall, tube, rheology, external, rows):
+        """Add the tubes ``names`` (new names) as one batch (see :class:`_Batch`)."""
+        n = len(names)
+        self._batches.append(_Batch(names, u, v, wall, tube, rheology, np.asarray(external, dtype=float), rows))
+        self._starts.append(self._next)
+        self._slot.update(zip(names, range(self._next, self._next + n)))
+        self._next += n
+
+    def _locate(self, slot):
+        b = bisect.bisect_right(self._starts, slot) - 1
+        return self._batches[b], slot - self._starts[b]
+
+    def __getitem__(self, name) -> _Tube:
+        batch, k = self._locate(self._slot[name])
+        return batch.member(k)
+
+    def __setitem__(self, name, t: _Tube):
+        rows = None if t.row is None else np.array([t.row])
+        batch = _Batch([name], [t.u], [t.v], t.wall, t.tube, t.rheology, np.array([float(t.external_pressure)]), rows)
+        self._batches.append(batch)
+        self._starts.append(self._next)
+        self._slot[name] = self._next         # (an existing name keeps its place in the order)
+        self._next += 1
+
+    def __delitem__(self, name):
+        del self._slot[name]
+
+    def __iter__(self):
+        return iter(self._slot)
+
+    def __len__(self):
+        return len(self._slot)
+
+    def __contains__(self, name):
+        return name in self._slot
+
+    def names(self):
+        """The tube names as a (set-like) view."""
+        return self._slot.keys()
+
+    def copy(self) -> _Tubes:
+        """A copy that later additions and removals do not reach (the batches are shared: they are
+        never changed)."""
+        new = _Tubes()
+        new._slot, new._batches, new._starts, new._next = dict(self._slot), list(self._batches), list(self._starts), \
+            self._next
+        return new
+
+    def ends(self):
+        """``(u, v)``: the end nodes of every tube, as lists in the tubes' order."""
+        slots = list(self._slot.values())
+        u_all = list(itertools.chain.from_iterable(b.u for b in self._batches))
+        v_all = list(itertools.chain.from_iterable(b.v for b in self._batches))
+        return list(map(u_all.__getitem__, slots)), list(map(v_all.__getitem__, slots))
+
+    def columns(self, index) -> _Columns:
+        """The tubes as :class:`_Columns`, their nodes numbered by ``index`` (node -> position)."""
+        n = len(self._slot)
+        slots = np.fromiter(self._slot.values(), np.intp, n)
+        starts = np.asarray(self._starts, dtype=np.intp)
+        which = np.searchsorted(starts, slots, side="right") - 1
+        # per slot (every batch in order, so that a slot is its position), then the live ones
+        ends = [np.fromiter(map(index.get, itertools.chain.from_iterable(getattr(b, end) for b in self._batches),
+                                itertools.repeat(-1)), np.intp, self._next)[slots] for end in ("u", "v")]
+        external = np.concatenate([b.external for b in self._batches])[slots]
+        return _Columns(list(self._slot), tuple(self._batches), which, slots - starts[which], ends[0], ends[1], external)
+
+
+@attrs.frozen(eq=False)
+class _Columns:
+    """The tubes of a network, in its order, as columns: ``names``, the ``batches``, per tube the
+    position of its batch (``which``) and its place in it (``place``), the positions of its nodes
+    (``U``, ``V``) and its external pressure. ``columns[i]`` is tube ``i`` as a :class:`_Tube`."""
+
+    names: list
+    batches: tuple
+    which: np.ndarray
+    place: np.ndarray
+    U: np.ndarray
+    V: np.ndarray
+    external: np.ndarray
+
+    def __len__(self):
+        return len(self.names)
+
+    def __getitem__(self, i) -> _Tube:
+        return self.batches[int(self.which[i])].member(int(self.place[i]))
+
+    def __iter__(self):
+        return map(self.__getitem__, range(len(self.names)))
+
+    def present(self, index):
+        """The positions of the batches that hold some of the tubes ``index``, in increasing order."""
+        return np.flatnonzero(np.bincount(self.which[index], minlength=len(self.batches)))
+
+    def by_batch(self):
+        """``(batch, index)`` per batch that still has tubes, in the order of their first tubes:
+        the positions ``index`` of its tubes."""
+        present, first = np.unique(self.which, return_index=True)
+        order = np.argsort(self.which, kind="stable")
+        bounds = np.searchsorted(self.which[order], present)
+        ends = np.append(bounds[1:], order.size)
+        for j in np.argsort(first, kind="stable").tolist():
+            yield self.batches[int(present[j])], order[bounds[j]:ends[j]]
 
 
 @attrs.frozen(eq=False)
@@ -75,30 +258,40 @@ class _Groups:
     graded-tube engine (:class:`tubefsi.couplers.Graded`) from whichever end its flow enters."""
 
     def __init__(self, tubes, subset):
-        # one dict lookup per tube: the models' identities -> the group they belong to (a graded
-        # tube's: its very models; a uniform one's: its wall and fluid classes and fixed parameters)
-        groups: dict = {}
+        # the batches' groups (a graded batch: its very models; a uniform one: its wall and fluid
+        # classes and fixed parameters), then each tube of the subset in its batch's group
+        # (one key per distinct triple of models: batches of add_tube calls often share them)
+        keys: dict = {}
         by_models: dict = {}
-        for i in np.flatnonzero(subset).tolist():      # (the tubes of the subset only)
-            t = tubes[i]
-            ids = (id(t.wall), id(t.tube), id(t.rheology))
-            found = by_models.get(ids)
-            if found is None:
-                key = ("graded", ids) if t.graded else \
-                    ((type(t.wall), _fixed(t.wall)), (type(t.rheology), _fixed(t.rheology)))
-                found = by_models[ids] = groups.setdefault(key, ([], t.graded))[0]
-            found.append(i)
+        chosen = np.flatnonzero(subset)
+        group_of = np.zeros(len(tubes.batches), dtype=np.intp)
+        graded = []
+        for b in tubes.present(chosen).tolist():        # (the batches of the subset only)
+            batch = tubes.batches[b]
+            ids = (id(batch.wall), id(batch.tube), id(batch.rheology))
+            g = by_models.get(ids)
+            if g is None:
+                key = ("graded", ids) if batch.graded else \
+                    ((type(batch.wall), _fixed(batch.wall)), (type(batch.rheology), _fixed(batch.rheology)))
+                if key not in keys:
+                    keys[key] = len(keys)
+                    graded.append(batch.graded)
+                g = by_models[ids] = keys[key]
+            group_of[b] = g
+        group = group_of[tubes.which[chosen]]
+        order = np.argsort(group, kind="stable")
+        bounds = np.searchsorted(group[order], np.arange(len(keys) + 1))
+        members = [chosen[order[bounds[g]:bounds[g + 1]]] for g in range(len(keys))]
         self.parts = []
-        for index in (index for index, graded in groups.values() if not graded):
-            members = [tubes[i] for i in index]
-            wall = _stack(members, "wall")
-            fluid = _stack(members, "rheology")
-            tube = Tube(**_gather(members, "tube", ("radius", "thickness", "length")))
-            self.parts.append(_Part(np.asarray(index), fluid, wall, tube, _column(list(map(_EXTERNAL, members)))))
-        for index in (index for index, graded in groups.values() if graded):
+        for index in (index for index, g in zip(members, graded) if index.size and not g):
+            wall = _stack(tubes, index, "wall")
+            fluid = _stack(tubes, index, "rheology")
+            tube = Tube(**_gather(tubes, index, "tube", ("radius", "thickness", "length")))
+            self.parts.append(_Part(index, fluid, wall, tube, _column(tubes.external[index])))
+        for index in (index for index, g in zip(members, graded) if index.size and g):
             t = tubes[index[0]]
-            self.parts.append(_Part(np.asarray(index), t.rheology, t.wall, t.tube,
-                                    _column([tubes[i].external_pressure for i in index]), _reversed(t.wall, t.tube)))
+            self.parts.append(_Part(index, t.rheology, t.wall, t.tube, _column(tubes.external[index]),
+                                    _reversed(t.wall, t.tube)))
         n = len(tubes)
         self.limit = np.zeros(n)
         self.radius = np.zeros(n)            # a uniform tube's radius; a graded tube's Poiseuille mean
@@ -211,20 +404,19 @@ class _Groups:
             radius_out[index] = np.broadcast_to(_radius_at(tube, tube.length) * sol.scene.outlet_stretch, index.shape)
         return p_in, radius_in, radius_out
 
-    def apparent_viscosity(self, q, mu):
-        """Per tube, the Newtonian viscosity with the fluid's pressure gradient at ``|q|`` in the
-        undeformed tube (``mu`` where q = 0; a graded tube: in the uniform tube of its Poiseuille
-        mean radius)."""
+    def apparent_viscosity(self, q, mu, stretch):
+        """Per tube, the Newtonian viscosity with the fluid's pressure gradient at ``|q|`` in the tube
+        of its radius times ``stretch`` (one per tube; ``mu`` where q = 0; a graded tube: the
+        uniform tube of its Poiseuille mean radius), :math:`\\mu = \\pi R^4 G(|q|, R)/(8|q|)`."""
         out = mu.copy()
         for part in self.parts:
             index, fluid = part.index, part.fluid
             qi = np.abs(q[index])
             ok = qi > 0
             if np.any(ok):
-                a = self.radius[index]
-                g = np.asarray(fluid.pressure_gradient(np.where(ok, qi, 1.0), part.tube.radius if part.reverse is None
-                                                       else a), dtype=float)
-                g = np.broadcast_to(g, index.shape)
+                a = self.radius[index] * stretch[index]
+                g = np.broadcast_to(np.asarray(fluid.pressure_gradient(np.where(ok, qi, 1.0), a), dtype=float),
+                                    index.shape)
                 value = g * math.pi * a**4 / (8 * np.where(ok, qi, 1.0))
                 out[index] = np.where(ok & np.isfinite(value) & (value > 0), value, mu[index])
         return out
@@ -312,35 +504,44 @@ def _column(values):
     return float(a[0]) if np.all(a == a[0]) else a
 
 
-def _gather(members, which, fields) -> dict:
-    """field -> the members' values of that parameter of their ``which`` model (a float where all
-    agree, else an array aligned with ``members``). Tubes added together by
-    :meth:`Network.add_tubes` share one model: their entries are taken at their rows, in one
-    indexing per model rather than one lookup per tube."""
-    models = list(map(operator.attrgetter(which), members))
-    first = models[0]
-    if all(map(operator.is_, models, itertools.repeat(first))):     # one model (one add_tubes call, or shared)
-        by_model = {id(first): (first, slice(None), list(map(_ROW, members)))}
-    else:
-        by_model = {}
-        for j, (m, model) in enumerate(zip(members, models)):
-            entry = by_model.get(id(model))
-            if entry is None:
-                entry = by_model[id(model)] = (model, [], [])
-            entry[1].append(j)
-            entry[2].append(m.row)
-    out = {f: np.empty(len(members)) for f in fields}
-    for model, positions, rows in by_model.values():
-        rows = np.asarray(rows) if rows[0] is not None else rows     # (one conversion for every field)
-        for f in fields:
+def _gather(tubes, index, which, fields) -> dict:
+    """field -> the values of that parameter of the ``which`` model of the tubes ``index`` (of
+    :class:`_Columns` ``tubes``): a float where all agree, else an array aligned with ``index``.
+    One read per distinct model of scalars (the batches of add_tube calls often share one), one
+    indexing per batch of arrays (an add_tubes call)."""
+    present = tubes.present(index)
+    position = np.zeros(len(tubes.batches), dtype=np.intp)
+    position[present] = np.arange(present.size)
+    inverse = position[tubes.which[index]]          # per tube, its batch's position in present
+    scalars: dict = {}                 # id(model) -> (model, positions in present)
+    arrays = []
+    for j, b in enumerate(present.tolist()):
+        batch = tubes.batches[b]
+        model = getattr(batch, which)
+        if batch.rows is None:
+            scalars.setdefault(id(model), (model, []))[1].append(j)
+        else:
+            arrays.append((j, model, batch.rows))
+    out = {}
+    for f in fields:
+        column = np.zeros(present.size)
+        for model, at in scalars.values():
+            column[at] = getattr(model, f)
+        column = column[inverse]
+        for j, model, rows in arrays:
+            at = np.flatnonzero(inverse == j)
             value = getattr(model, f)
-            out[f][positions] = value[rows] if isinstance(value, np.ndarray) and value.ndim else value
-    return {f: _column(column) for f, column in out.items()}
+            column[at] = value[rows[tubes.place[index[at]]]] if isinstance(value, np.ndarray) and value.ndim \
+                else value
+        out[f] = _column(column)
+    return out
 
 
-def _stack(members, which):
-    """One model whose array parameters hold the members' values (a scalar where all agree)."""
-    first = getattr(members[0], which)
-    if all(getattr(m, which) is first and m.row is None for m in members):
-        return first
-    return attrs.evolve(first, **_gather(members, which, _array_fields(type(first))))
+def _stack(tubes, index, which):
+    """One model whose array parameters hold the values of the tubes ``index`` (a scalar where all
+    agree): their batches' model itself where they all share it, with scalar parameters."""
+    batches = [tubes.batches[b] for b in tubes.present(index).tolist()]
+    model = getattr(batches[0], which)
+    if all(getattr(b, which) is model and b.rows is None for b in batches):
+        return model
+    return attrs.evolve(model, **_gather(tubes, index, which, _array_fields(type(model))))

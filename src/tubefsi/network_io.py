@@ -89,12 +89,13 @@ def _check_openbf_walls(network):
     """Refuse a wall the table cannot hold: the table keeps only ``E`` (and ``h``), and reading
     it back makes :func:`openbf_wall`, so any other linear wall (a ``poisson_ratio`` other than
     1/2, a thick wall) would come back as a different tube law."""
-    for tube in network._tubes.values():
-        wall = tube.wall
+    tubes = network._tubes.columns(network._nodes)
+    for batch, index in tubes.by_batch():        # (one check per add_tubes call: its tubes share a wall)
+        wall = batch.wall
         ratio = np.asarray(getattr(wall, "poisson_ratio", math.nan), dtype=float)
         if type(wall) is not _walls["thin-linear"] or not np.all(ratio == 0.5):
             raise InvalidParameterError(
-                f"tube {tube.name!r}", "openBF's wall, walls['thin-linear'] with poisson_ratio=0.5 (the table "
+                f"tube {tubes.names[int(index[0])]!r}", "openBF's wall, walls['thin-linear'] with poisson_ratio=0.5 (the table "
                 "keeps only E and h, and reading it makes that wall: another wall would come back as a "
                 "different tube law; write_vtp writes any network, for viewing)", wall)
 
@@ -405,26 +406,23 @@ def _geometry(network) -> dict:
     tube on its own."""
     if not isinstance(network, Network):
         raise InvalidParameterError("network", "a tubefsi.Network", network)
-    tubes = list(network._tubes.values())
+    tubes = network._tubes.columns(network._nodes)
     n = len(tubes)
-    out = {"name": [t.name for t in tubes], "u": [t.u for t in tubes], "v": [t.v for t in tubes],
-           "p_ext": np.array([t.external_pressure for t in tubes], dtype=float)}
+    nodes = list(network._nodes)
+    out = {"name": list(tubes.names), "u": list(map(nodes.__getitem__, tubes.U.tolist())),
+           "v": list(map(nodes.__getitem__, tubes.V.tolist())), "p_ext": np.array(tubes.external, dtype=float)}
     for key in ("a0", "a1", "t0", "t1", "length", "E"):
         out[key] = np.empty(n)
-    groups: dict = {}
-    for k, t in enumerate(tubes):
-        groups.setdefault((id(t.tube), id(t.wall)), []).append(k)
-    for members in groups.values():
-        index = np.asarray(members)
-        first = tubes[members[0]]
-        if first.tube.graded:
-            for k in members:
+    for batch, index in tubes.by_batch():
+        if batch.graded:
+            for k in index.tolist():
                 wall, tube, _ = tubes[k].models()
                 a0, a1, t0, t1, length = _ends(tube)
                 out["a0"][k], out["a1"][k], out["t0"][k], out["t1"][k], out["length"][k] = a0, a1, t0, t1, length
                 out["E"][k] = float(getattr(wall, "youngs_modulus", math.nan))
             continue
-        rows = np.array([tubes[k].row or 0 for k in members])
+        first = batch                   # (its tubes share its models: one indexing each)
+        rows = np.zeros(index.size, dtype=int) if batch.rows is None else batch.rows[tubes.place[index]]
 
         def take(value):
             a = np.asarray(value, dtype=float)

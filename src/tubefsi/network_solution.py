@@ -11,7 +11,6 @@ from __future__ import annotations
 import csv
 import json
 import math
-import operator
 import os
 from collections.abc import Hashable
 
@@ -76,7 +75,8 @@ class NetworkSolution:
 
     net: object
     nodes: list
-    tubes: list
+    #: the tubes as columns (``network_groups._Columns``: ``tubes[i]`` is tube ``i``)
+    tubes: object
     p: np.ndarray = attrs.field(converter=_frozen)
     q: np.ndarray = attrs.field(converter=_frozen)
     radius_u: np.ndarray = attrs.field(converter=_frozen)
@@ -111,7 +111,7 @@ class NetworkSolution:
 
     @property
     def tube_names(self) -> list:
-        return self._once("tube_names", lambda: list(map(operator.attrgetter("name"), self.tubes)))
+        return self._once("tube_names", lambda: list(self.tubes.names))
 
     @property
     def tube_index(self) -> dict:
@@ -221,7 +221,9 @@ class NetworkSolution:
         (Pa), ``radius_u``, ``radius_v`` (deformed inner radii at the two ends, m), ``length`` (m),
         ``pressure_drop`` (Pa), ``strain_u``, ``strain_v``, ``wall_shear_stress_u``,
         ``wall_shear_stress_v`` (Pa) and, given ``density`` (kg/m^3), ``reynolds_number``."""
-        table = {"name": self.tube_names, "u": [t.u for t in self.tubes], "v": [t.v for t in self.tubes],
+        nodes = self.nodes
+        table = {"name": self.tube_names, "u": list(map(nodes.__getitem__, self.U.tolist())),
+                 "v": list(map(nodes.__getitem__, self.V.tolist())),
                  "flow_rate": self.q.tolist(), "pressure_u": self.p[self.U].tolist(),
                  "pressure_v": self.p[self.V].tolist(), "radius_u": self.radius_u.tolist(),
                  "radius_v": self.radius_v.tolist(), "length": self.length.tolist(),

@@ -18,10 +18,11 @@ and :math:`\partial q/\partial p_{out}` of each tube (``docs/theory.md``, sectio
 evaluated in one broadcast :func:`tubefsi.solve` per iteration and per group of tubes that
 share their wall and fluid classes (their parameters stacked into arrays).
 
-Globalization: the start is the rigid Newtonian network (each tube a Hagen–Poiseuille
-conductance :math:`\pi a^4/(8\mu L)` at the fluid's apparent viscosity, refined by two
-Picard sweeps, the last with each tube's conductance times :math:`(1+\varepsilon)^4`, its wall's
-hoop strain at the mean of its end pressures); every Newton step is cut to stay inside
+Globalization: the start is a Newtonian network (each tube a Hagen–Poiseuille conductance
+:math:`\pi R^4/(8\mu L)`, rigid at the viscosity at 1/s, then refined by three Picard sweeps,
+each with the tube inflated to :math:`R = a(1+\varepsilon)` by its wall's hoop strain at the mean
+of its end pressures and the fluid's apparent viscosity in it: the secant :math:`|q|/(L\,G(|q|, R))`);
+every Newton step is cut to stay inside
 :math:`0 \le p_i < p_{lim}` (a step goes at most 90 % of the way to a tube's limit pressure or
 to zero) and then halved until the residual norm :math:`\|F\|_2` decreases (Armijo). The derivative of a tube without flow is
 degenerate — :math:`\partial q/\partial p \to 0` for a shear-thinning fluid, :math:`\infty` for a
@@ -45,7 +46,6 @@ throughput (the total flow that enters the network); otherwise :class:`Convergen
 from __future__ import annotations
 
 import math
-import operator
 
 import numpy as np
 import scipy.sparse as sp
@@ -59,9 +59,9 @@ from .network_solution import NetworkSolution, _hashable
 
 #: Jacobian conductances are clipped to [_CLIP, 1/_CLIP] times the rigid start conductance
 _CLIP = 1e-8
-#: linear solves of the rigid start: the first at the viscosity at 1/s, then Picard sweeps on the
-#: apparent viscosity, the last with the tubes inflated (``_Solver._rigid_start``)
-_SWEEPS = 3
+#: linear solves of the start: the rigid tubes at the viscosity at 1/s, then Picard sweeps, each with
+#: the tubes inflated at their mean pressures and the apparent viscosity there (``_Solver._rigid_start``)
+_SWEEPS = 4
 #: fraction of the way to a bound (a limit pressure, zero) that one Newton step may go
 _TO_BOUND = 0.9
 #: a tube whose pressure drop is below this times the largest pressure counts as without flow
@@ -86,12 +86,11 @@ class _Solver:
                 raise InvalidParameterError("node", "a node of some tube", node, "it has a boundary condition "
                                             "but no tube")
         self.net = net
-        self.tubes = list(net._tubes.values())
         self.nodes = list(net._nodes)
         index = net._nodes
+        self.tubes = net._tubes.columns(index)          # (columns: no Python object per tube)
         n_nodes, n_tubes = len(self.nodes), len(self.tubes)
-        self.U, self.V = (np.fromiter(map(index.__getitem__, map(operator.attrgetter(end), self.tubes)), np.intp,
-                                      n_tubes) for end in ("u", "v"))
+        self.U, self.V = self.tubes.U, self.tubes.V
         # the boundary conditions, node by node (one indexing per kind)
         self.fixed = np.zeros(n_nodes, dtype=bool)
         self.p_fixed = np.zeros(n_nodes)
@@ -207,21 +206,21 @@ class _Solver:
         return self.source + self.g_out * (self.p_distal - p)
 
     def _rigid_start(self):
-        """Pressures of the rigid Newtonian network (apparent viscosities, two Picard sweeps, the
-        last with the tubes inflated by their walls' strains at the pressures of the one before), and
-        the rigid conductances (the Jacobian's reference scale)."""
+        """Pressures of the start (Picard sweeps on the Newtonian network of each tube's apparent
+        conductance: the rigid tube at the viscosity at 1/s, then each tube inflated by its wall's
+        strain at the mean of its end pressures of the sweep before, at the fluid's apparent
+        viscosity in that inflated tube at the flow of the sweep before), and the last sweep's
+        conductances (the Jacobian's reference scale)."""
         a, length = self.radius, self.length
         mu = np.where(self.feeder, self.feed_groups.nominal_viscosity(self.n_tubes),
                       self.groups.nominal_viscosity(self.n_tubes))
         good = np.isfinite(mu) & (mu > 0)
         mu = np.where(good, mu, np.median(mu[good]) if np.any(good) else 1e-3)
+        stretch = np.ones(self.n_tubes)
         p = self.p_fixed.copy()
         for sweep in range(_SWEEPS):
-            c = rigid = math.pi * a**4 / (8 * mu * length)
-            if sweep == _SWEEPS - 1 and np.all(p < self.p_limit):
-                # inflated by the pressures of the sweep before, where they are below every bound
-                # (beyond one, no steady state may exist: the start stays rigid)
-                c = rigid * self._inflation(p)
+            radius = a * stretch
+            c = math.pi * radius**4 / (8 * mu * length)
             rhs = self._supplied(np.zeros_like(p))
             # K p = s with K the weighted Laplacian; move the fixed columns to the right
             known = np.where(self.fixed, self.p_fixed, 0.0)
@@ -229,17 +228,24 @@ class _Solver:
             rhs += np.bincount(self.V, flow, len(self.nodes)) - np.bincount(self.U, flow, len(self.nodes))
             jac = self._jacobian(c, -c)
             p[self.free] = self._linear_solve(jac, -rhs[self.free]) if self.free.size else p[self.free]
-            q = c * (p[self.U] - p[self.V])
             if sweep < _SWEEPS - 1:
-                mu = self.feed_groups.apparent_viscosity(q, self.groups.apparent_viscosity(q, mu))
+                q = c * (p[self.U] - p[self.V])
+                stretch = self._stretch(p)
+                mu = self.feed_groups.apparent_viscosity(q, self.groups.apparent_viscosity(q, mu, stretch), stretch)
         self._unknowns(~self.fixed & ~self.feeds)
-        return p, rigid
+        return p, c
 
-    def _inflation(self, p):
-        """Per tube, the factor by which its inflation raises its conductance at the pressures
-        ``p``: the mean of :math:`(R/a)^4` at its two ends (the start only)."""
+    def _stretch(self, p):
+        """Per tube, its wall's hoop stretch at the mean of its end pressures ``p`` (the start only;
+        1 where ``p`` is not below every node's bound, or beyond what a wall's tube law reaches: no
+        steady state may exist there, and the tubes stay rigid)."""
+        if not np.all(p < self.p_limit):
+            return np.ones(self.n_tubes)
         mid = 0.5 * (p[self.U] + p[self.V])
-        return (1.0 + self.feed_groups.strain(mid) + self.groups.strain(mid)) ** 4
+        try:
+            return 1.0 + self.feed_groups.strain(mid) + self.groups.strain(mid)
+        except NoSteadyStateError:          # (a tube law that peaks below its limit pressure)
+            return np.ones(self.n_tubes)
 
     # ------------------------------------------------------------------ Newton
     def _edges(self, p):
