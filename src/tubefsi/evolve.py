@@ -28,8 +28,9 @@ stress, the cells' :math:`dp/ds` from the wall's stiffness; about two right-hand
 **Error control.** The inlet history (the flow rate for a pressure inlet, the pressure for a pump)
 is computed on ``n``, ``2n`` and ``4n`` cells at the integrator tolerance :math:`\tau/10`; the
 reported boundary histories are the Richardson extrapolation :math:`E_{2n,4n} = h_{4n} + (h_{4n} -
-h_{2n})/3` (third order), the space estimate :math:`|E_{n,2n} - E_{2n,4n}|` (the coarser
-extrapolation's error, conservative for the reported one); the time estimate is
+h_{2n})/3` (third order), the space estimate :math:`\tfrac13|E_{n,2n} - E_{2n,4n}|` (the difference
+is the coarser extrapolation's error minus the reported one's: at an order :math:`p \ge 2` the
+reported one's is at most :math:`1/(2^p - 1) \le 1/3` of it); the time estimate is
 :math:`\tfrac53|h_{n,\tau} - h_{n,\tau/10}|` (the error of a run at :math:`\tau`, conservative for the
 reported runs at :math:`\tau/10`; :math:`\tfrac53` bounds the extrapolation's weights). The cells
 grow and the tolerance falls until their sum, relative to the history's scale (its largest value,
@@ -859,9 +860,10 @@ def evolve(rheology, wall, tube: Tube, times, *, inlet_pressure=None, inlet_flow
         loose, coarse, middle, fine = run(n, tol), run(n, 0.1 * tol), run(2 * n, 0.1 * tol), run(4 * n, 0.1 * tol)
         h1, h2, h4 = (_monitored(system, f, times) for f in (coarse, middle, fine))
         floor = _history_scale(system)
-        # space: the Richardson extrapolations of the pairs (n, 2n) and (2n, 4n); their difference is
-        # the error of the coarser pair's, conservative for the reported finer pair's (third order)
-        e_space = _difference(_extrapolated(h1, h2), _extrapolated(h2, h4), floor)
+        # space: the Richardson extrapolations of the pairs (n, 2n) and (2n, 4n); their difference d
+        # is the coarser pair's error minus the finer pair's: for an order p >= 2 (third order
+        # asymptotically) the finer pair's error is at most d / (2^p - 1) <= d / 3
+        e_space = _difference(_extrapolated(h1, h2), _extrapolated(h2, h4), floor) / 3.0
         # time: the error of the run at tol, conservative for the reported ones at tol/10; the
         # extrapolation (4 h_4n - h_2n)/3 adds the time errors of two runs with weights 4/3 and 1/3
         e_time = 5.0 / 3.0 * _difference(_monitored(system, loose, times), h1, floor)
