@@ -146,7 +146,7 @@ class Chamber:
             p = np.asarray(p, dtype=float)
             c = (8.0 * (self.volume_at(p + h) - self.volume_at(p - h))
                  - (self.volume_at(p + 2 * h) - self.volume_at(p - 2 * h))) / (12.0 * h)
-        if not np.all(np.asarray(c) > 0):
+        if not (np.asarray(c) > 0).all():
             raise InvalidParameterError("chamber compliance", "dV/dp > 0 (an increasing V(p))", float(np.min(c)))
         return c
 
@@ -163,7 +163,7 @@ def _elementwise(function, t, name, argument="t"):
             out = np.broadcast_to(out, t.shape).astype(float)
     except Exception:                     # (a function of one number: called point by point below)
         out = np.array([_one(function, float(x), name, argument) for x in t.ravel()]).reshape(t.shape)
-    if not np.all(np.isfinite(out)):
+    if not np.isfinite(out).all():
         k = int(np.argmin(np.isfinite(out).ravel()))
         raise InvalidParameterError(name, "finite values", float(out.ravel()[k]),
                                     f"at {argument} = {float(t.ravel()[k]):.6g}")
@@ -184,6 +184,13 @@ def _one(function, x, name, argument):
         raise InvalidParameterError(name, "a callable returning one finite number", None,
                                     f"at {argument} = {x:.6g} it returned an array of shape {v.shape}")
     return float(v)
+
+
+def _broadcast(values, shape):
+    """``values`` as a float array of ``shape`` (a view; no call to broadcast_to where the shape
+    already fits: the right-hand side's one state)."""
+    values = np.asarray(values, dtype=float)
+    return values if values.shape == shape else np.broadcast_to(values, shape)
 
 
 def _boundary(name, value):
@@ -235,7 +242,7 @@ class _System:
         strain = s / (1.0 + np.sqrt(1.0 + s))
         with np.errstate(all="ignore"):
             p = self.wall._pressure_at_strain(strain, self.tb)
-        if not np.all(np.isfinite(p)):
+        if not np.isfinite(p).all():
             self.wall.pressure(1.0 + strain, self.tb)        # raises the typed error
             raise InvalidParameterError("stretch", "stretches the wall holds", float(np.max(1.0 + strain)))
         return p + self.external
@@ -246,11 +253,14 @@ class _System:
         gradients here are the scheme's own; the checks cost more than the flow law of a power
         law). A flow beyond the doubles gets the public method's typed error."""
         g = np.abs(gradient)
-        q = np.zeros(g.shape)
         live = g > 0
         with np.errstate(all="ignore"):
-            q[live] = self.rheology._flow_rate(radius[live], g[live])
-        if not np.all(np.isfinite(q)):
+            if live.all():                # (the usual case: no masked copies)
+                q = self.rheology._flow_rate(radius, g)
+            else:
+                q = np.zeros(g.shape)
+                q[live] = self.rheology._flow_rate(radius[live], g[live])
+        if not np.isfinite(q).all():
             self.rheology.flow_rate(radius, g)          # raises the typed error
             raise InvalidParameterError("pressure gradient", "gradients of a finite flow", float(np.max(g)))
         return np.copysign(q, gradient)
@@ -264,7 +274,7 @@ class _System:
         lam = self.stretch(s)
         p = self.cell_pressure(s)
         lead = p.shape[:-1]
-        t = np.broadcast_to(np.asarray(t, dtype=float), lead)
+        t = _broadcast(t, lead)
         if self.inlet_kind == "pressure":
             p0 = _elementwise(self.inlet, t, "inlet_pressure")
         else:
@@ -272,13 +282,13 @@ class _System:
         if self.outlet_kind == "pressure":
             pl = _elementwise(self.outlet, t, "outlet_pressure")
         elif self.outlet_kind == "chamber":
-            pl = np.broadcast_to(p_chamber, lead)
+            pl = _broadcast(p_chamber, lead)
         else:
             pl = p[..., -1]
         P = np.concatenate([np.asarray(p0)[..., None], p, np.asarray(pl)[..., None]], axis=-1)
         h = np.full(self.n + 1, self.dz)
         h[0] = h[-1] = 0.5 * self.dz
-        G = -np.diff(P, axis=-1) / h
+        G = (P[..., :-1] - P[..., 1:]) / h
         lam_f = np.concatenate([lam[..., :1], 0.5 * (lam[..., :-1] + lam[..., 1:]), lam[..., -1:]], axis=-1)
         return p, lam, h, G, lam_f
 
@@ -287,7 +297,7 @@ class _System:
         states ``s`` of shape ``(..., n)`` at times ``t`` (broadcast with ``s[..., 0]``)."""
         p, lam, _, G, lam_f = self.faces(t, s, p_chamber)
         q = self.face_flow(self.radius * lam_f, G)
-        t = np.broadcast_to(np.asarray(t, dtype=float), p.shape[:-1])
+        t = _broadcast(t, p.shape[:-1])
         if self.inlet_kind == "flow":
             q[..., 0] = _elementwise(self.inlet, t, "inlet_flow_rate")
         if self.outlet_kind == "closed":
