@@ -328,14 +328,24 @@ class _System:
 
         (the rheology's flow hook and its shear rate at the wall stress; Newtonian:
         :math:`\pi R^4/8\mu` and :math:`4Q/R`). At rest (:math:`G = 0`, where the first is a limit)
-        both are taken at a gradient of :math:`10^{-8}` of the problem's scale: the Jacobian steers
-        Newton's iteration, the residual stays exact."""
-        floor = 1e-8 * self.pressure_scale / self.length
-        g = np.maximum(np.abs(gradient), floor)
+        both are taken at a gradient of :math:`10^{-8}` of the problem's scale :math:`p_s/L`. Below
+        :math:`10^{-5}\,p_s/L` the first is at least its value there: a shear-thinning law's slope
+        vanishes at rest (:math:`Q \propto G^{1/n}`), and Newton's iteration with it overshoots
+        where a front reaches resting cells (it failed and rebuilt the Jacobian every other step on
+        fine grids; a shear-thickening law's slope, growing towards rest, is kept). The Jacobian
+        steers Newton's iteration; the residual stays exact."""
+        scale = self.pressure_scale / self.length
+        g = np.maximum(np.abs(gradient), 1e-8 * scale)
         q = self.face_flow(radius, g)
         rate = self.rheology.shear_rate(0.5 * g * radius)
         d_gradient = (math.pi * radius**3 * rate - 3.0 * q) / g
         d_radius = np.copysign(math.pi * radius**2 * rate, gradient)
+        low = g < 1e-5 * scale
+        if low.any():
+            g_low, r_low = np.full(int(np.sum(low)), 1e-5 * scale), radius[low]
+            slope = (math.pi * r_low**3 * self.rheology.shear_rate(0.5 * g_low * r_low)
+                     - 3.0 * self.face_flow(r_low, g_low)) / g_low
+            d_gradient[low] = np.maximum(d_gradient[low], slope)
         return d_gradient, d_radius
 
     def jacobian(self, t, y):
