@@ -46,8 +46,8 @@ def _series(kind, t, conductance, diffusivity, p_in):
 @pytest.mark.parametrize("outlet", ["open", "closed"])
 def test_linear_limit_against_fourier_series(outlet, rtol):
     """The error-controlled inlet flow (boundary histories extrapolated from 2n and 4n cells)
-    against the series: within rtol and within the estimate (measured: 0.03 to 0.5 of it from
-    rtol 1e-3 to 1e-7)."""
+    against the series: within rtol and within the estimate (its sharpness:
+    tests/test_evolve_estimate.py)."""
     tube, fluid, wall, conductance, diffusivity = _linear_setup()
     p_in = 1e-3                                          # strain 1e-8: the nonlinearity is ~4e-8
     times = np.linspace(0.0, 4e-3, 41)

@@ -237,3 +237,33 @@ def test_jacobian_against_central_differences(fluid_kind, boundary):
         e[k] = step
         differences[:, k] = (system.rhs(0.3, y + e) - system.rhs(0.3, y - e)) / (2 * step)
     assert np.max(np.abs(exact - differences)) <= 1e-6 * np.max(np.abs(differences))
+
+
+@pytest.mark.parametrize("index", [0.7, 1.0, 1.3])
+def test_jacobian_slope_at_rest(index):
+    """At rest (G = 0) the face flow's slope dq/dG steers Newton's iteration: a power law's
+    closed form dQ/dG = Q/(nG), Q = pi n/(3n+1) R^3 (GR/2m)^(1/n), taken at 1e-5 of the scale's
+    gradient p_s/L for a shear-thinning law (its slope vanishes at rest), at 1e-8 of it otherwise
+    (Newtonian: the same; shear-thickening: the larger slope nearer rest, kept); above 1e-5 p_s/L
+    the exact slope."""
+    import importlib
+
+    evolve_module = importlib.import_module("tubefsi.evolve")
+    m = 0.017
+    fluid = tubefsi.registry.rheologies["power-law"](consistency=m, index=index)
+    wall = tubefsi.registry.walls["thick-neo-hookean"](shear_modulus=2e4)
+    tube = tubefsi.Tube(radius=1e-4, thickness=3e-5, length=1e-2)
+    system, _, _, _, _ = evolve_module._setup(fluid, wall, tube, [0.0, 1.0], 2e3, None, None, "open", 0.0, None,
+                                              1e-6, "BDF", 8)
+    scale = 2e3 / tube.length
+    radius = np.full(3, 1.1e-4)
+    gradient = np.array([0.0, 3e-6 * scale, 0.3 * scale])
+
+    def slope(g):                                    # the closed form
+        q = math.pi * index / (3 * index + 1) * radius[0] ** 3 * (g * radius[0] / (2 * m)) ** (1 / index)
+        return q / (index * g)
+
+    at_rest = slope(1e-5 * scale) if index < 1 else slope(1e-8 * scale)
+    expected = [at_rest, max(slope(3e-6 * scale), slope(1e-5 * scale)), slope(0.3 * scale)]
+    d_gradient, _ = system.face_slopes(radius, gradient)
+    np.testing.assert_allclose(d_gradient, expected, rtol=1e-12)

@@ -31,8 +31,9 @@ stress, the cells' :math:`dp/ds` from the wall's stiffness; about two right-hand
 **Error control.** The inlet history (the flow rate for a pressure inlet, the pressure for a pump)
 is computed on ``n``, ``2n`` and ``4n`` cells at the integrator tolerance :math:`\tau/10`; the
 reported boundary histories are the Richardson extrapolation :math:`E_{2n,4n} = h_{4n} + (h_{4n} -
-h_{2n})/3` (third order), the space estimate :math:`|E_{n,2n} - E_{2n,4n}|` (the coarser
-extrapolation's error, conservative for the reported one); the time estimate is
+h_{2n})/3` (third order), the space estimate :math:`\tfrac13|E_{n,2n} - E_{2n,4n}|` (the difference
+is the coarser extrapolation's error minus the reported one's: at an order :math:`p \ge 2` the
+reported one's is at most :math:`1/(2^p - 1) \le 1/3` of it); the time estimate is
 :math:`\tfrac53|h_{n,\tau} - h_{n,\tau/10}|` (the error of a run at :math:`\tau`, conservative for the
 reported runs at :math:`\tau/10`; :math:`\tfrac53` bounds the extrapolation's weights). The cells
 grow and the tolerance falls until their sum, relative to the history's scale (its largest value,
@@ -158,7 +159,7 @@ class Chamber:
             p = np.asarray(p, dtype=float)
             c = (8.0 * (self.volume_at(p + h) - self.volume_at(p - h))
                  - (self.volume_at(p + 2 * h) - self.volume_at(p - 2 * h))) / (12.0 * h)
-        if not np.all(np.asarray(c) > 0):
+        if not (np.asarray(c) > 0).all():
             raise InvalidParameterError("chamber compliance", "dV/dp > 0 (an increasing V(p))", float(np.min(c)))
         return c
 
@@ -175,7 +176,7 @@ def _elementwise(function, t, name, argument="t"):
             out = np.broadcast_to(out, t.shape).astype(float)
     except Exception:                     # (a function of one number: called point by point below)
         out = np.array([_one(function, float(x), name, argument) for x in t.ravel()]).reshape(t.shape)
-    if not np.all(np.isfinite(out)):
+    if not np.isfinite(out).all():
         k = int(np.argmin(np.isfinite(out).ravel()))
         raise InvalidParameterError(name, "finite values", float(out.ravel()[k]),
                                     f"at {argument} = {float(t.ravel()[k]):.6g}")
@@ -208,6 +209,13 @@ def _finite(name, value, admissible):
         where = tuple(int(i) for i in np.argwhere(~np.isfinite(v))[0])
         raise InvalidParameterError(name, admissible, float(v[where]), f"entry {where} of an array of shape {v.shape}")
     return v
+
+
+def _broadcast(values, shape):
+    """``values`` as a float array of ``shape`` (a view; no call to broadcast_to where the shape
+    already fits: the right-hand side's one state)."""
+    values = np.asarray(values, dtype=float)
+    return values if values.shape == shape else np.broadcast_to(values, shape)
 
 
 def _boundary(name, value):
@@ -412,7 +420,7 @@ class _System:
         tb = self.tb_cells
         with np.errstate(all="ignore"):
             p = wall._pressure_at_strain(strain, tb)
-        if not np.all(np.isfinite(p)):
+        if not np.isfinite(p).all():
             self.wall_cells.pressure(1.0 + strain, tb)        # raises the typed error
             raise InvalidParameterError("stretch", "stretches the wall holds", float(np.max(1.0 + strain)))
         return p + self._column(self.external)
@@ -423,16 +431,19 @@ class _System:
         gradients here are the scheme's own; the checks cost more than the flow law of a power
         law). A flow beyond the doubles gets the public method's typed error."""
         g = np.abs(gradient)
-        radius = np.broadcast_to(radius, g.shape)
-        q = np.zeros(g.shape)
+        radius = _broadcast(radius, g.shape)
         live = g > 0
         rheology = _aligned(self.face_rheology, g.shape)
-        if rheology is not self.face_rheology:          # (per-scene parameters: at the live faces)
-            rheology = _replace(rheology, {k: v[live] for k in _array_fields(type(rheology))
-                                           if isinstance(v := getattr(rheology, k), np.ndarray)})
         with np.errstate(all="ignore"):
-            q[live] = rheology._flow_rate(radius[live], g[live])
-        if not np.all(np.isfinite(q)):
+            if live.all():                # (the usual case: no masked copies)
+                q = rheology._flow_rate(radius, g)
+            else:
+                if rheology is not self.face_rheology:          # (per-scene parameters: at the live faces)
+                    rheology = _replace(rheology, {k: v[live] for k in _array_fields(type(rheology))
+                                                   if isinstance(v := getattr(rheology, k), np.ndarray)})
+                q = np.zeros(g.shape)
+                q[live] = rheology._flow_rate(radius[live], g[live])
+        if not np.isfinite(q).all():
             self.face_rheology.flow_rate(radius, g)          # raises the typed error
             raise InvalidParameterError("pressure gradient", "gradients of a finite flow", float(np.max(g)))
         return np.copysign(q, gradient)
@@ -446,7 +457,7 @@ class _System:
         lam = self.stretch(s)
         p = self.cell_pressure(s)
         lead = p.shape[:-1]
-        t = np.broadcast_to(np.asarray(t, dtype=float), lead)
+        t = _broadcast(t, lead)
         if self.inlet_kind == "pressure":
             p0 = _elementwise(self.inlet, t, "inlet_pressure")
         else:
@@ -454,14 +465,14 @@ class _System:
         if self.outlet_kind == "pressure":
             pl = _elementwise(self.outlet, t, "outlet_pressure")
         elif self.outlet_kind == "chamber":
-            pl = np.broadcast_to(p_chamber, lead)
+            pl = _broadcast(p_chamber, lead)
         else:
             pl = p[..., -1]
         P = np.concatenate([np.asarray(p0)[..., None], p, np.asarray(pl)[..., None]], axis=-1)
         ends = np.ones(self.n + 1)
         ends[0] = ends[-1] = 0.5
         h = self._column(self.dz) * ends
-        G = -np.diff(P, axis=-1) / h
+        G = (P[..., :-1] - P[..., 1:]) / h
         lam_f = np.concatenate([lam[..., :1], 0.5 * (lam[..., :-1] + lam[..., 1:]), lam[..., -1:]], axis=-1)
         return p, lam, h, G, lam_f
 
@@ -470,7 +481,7 @@ class _System:
         states ``s`` of shape ``(..., S, n)`` (``(..., n)``) at times ``t`` (broadcast with ``s[..., 0]``)."""
         p, lam, _, G, lam_f = self.faces(t, s, p_chamber)
         q = self.face_flow(self.a_faces * lam_f, G)
-        t = np.broadcast_to(np.asarray(t, dtype=float), p.shape[:-1])
+        t = _broadcast(t, p.shape[:-1])
         if self.inlet_kind == "flow":
             q[..., 0] = _elementwise(self.inlet, t, "inlet_flow_rate")
         if self.outlet_kind == "closed":
@@ -508,14 +519,30 @@ class _System:
 
         (the rheology's flow hook and its shear rate at the wall stress; Newtonian:
         :math:`\pi R^4/8\mu` and :math:`4Q/R`). At rest (:math:`G = 0`, where the first is a limit)
-        both are taken at a gradient of :math:`10^{-8}` of the problem's scale: the Jacobian steers
-        Newton's iteration, the residual stays exact."""
-        floor = 1e-8 * self._column(self.pressure_scale / self.length)
-        g = np.maximum(np.abs(gradient), floor)
+        both are taken at a gradient of :math:`10^{-8}` of the problem's scale :math:`p_s/L`. Below
+        :math:`10^{-5}\,p_s/L` the first is at least its value there: a shear-thinning law's slope
+        vanishes at rest (:math:`Q \propto G^{1/n}`), and Newton's iteration with it overshoots
+        where a front reaches resting cells (it failed and rebuilt the Jacobian every other step on
+        fine grids; a shear-thickening law's slope, growing towards rest, is kept). The Jacobian
+        steers Newton's iteration; the residual stays exact."""
+        scale = self._column(self.pressure_scale / self.length)
+        g = np.maximum(np.abs(gradient), 1e-8 * scale)
         q = self.face_flow(radius, g)
         rate = self.face_rheology.shear_rate(0.5 * g * radius)
         d_gradient = (math.pi * radius**3 * rate - 3.0 * q) / g
         d_radius = np.copysign(math.pi * radius**2 * rate, gradient)
+        low = g < 1e-5 * scale
+        if low.any():
+            if self.shape == ():          # (one scene: at the low faces only)
+                g_low, r_low = np.full(int(np.sum(low)), 1e-5 * scale), radius[low]
+                slope = (math.pi * r_low**3 * self.face_rheology.shear_rate(0.5 * g_low * r_low)
+                         - 3.0 * self.face_flow(r_low, g_low)) / g_low
+                d_gradient[low] = np.maximum(d_gradient[low], slope)
+            else:                         # (a batch: every face, the parameters per scene as columns)
+                g_low = np.broadcast_to(1e-5 * scale, g.shape)
+                slope = (math.pi * radius**3 * self.face_rheology.shear_rate(0.5 * g_low * radius)
+                         - 3.0 * self.face_flow(radius, g_low)) / g_low
+                d_gradient = np.where(low, np.maximum(d_gradient, slope), d_gradient)
         return d_gradient, d_radius
 
     def jacobian(self, t, y):
@@ -1243,9 +1270,10 @@ def evolve(rheology, wall, tube: Tube, times, *, inlet_pressure=None, inlet_flow
         loose, coarse, middle, fine = run(n, tol), run(n, 0.1 * tol), run(2 * n, 0.1 * tol), run(4 * n, 0.1 * tol)
         h1, h2, h4 = (_monitored(system, f, times) for f in (coarse, middle, fine))
         floor = _history_scale(system)
-        # space: the Richardson extrapolations of the pairs (n, 2n) and (2n, 4n); their difference is
-        # the error of the coarser pair's, conservative for the reported finer pair's (third order)
-        e_space = _difference(_extrapolated(h1, h2), _extrapolated(h2, h4), floor)
+        # space: the Richardson extrapolations of the pairs (n, 2n) and (2n, 4n); their difference d
+        # is the coarser pair's error minus the finer pair's: for an order p >= 2 (third order
+        # asymptotically) the finer pair's error is at most d / (2^p - 1) <= d / 3
+        e_space = _difference(_extrapolated(h1, h2), _extrapolated(h2, h4), floor) / 3.0
         # time: the error of the run at tol, conservative for the reported ones at tol/10; the
         # extrapolation (4 h_4n - h_2n)/3 adds the time errors of two runs with weights 4/3 and 1/3
         e_time = 5.0 / 3.0 * _difference(_monitored(system, loose, times), h1, floor)
