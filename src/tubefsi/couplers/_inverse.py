@@ -501,9 +501,15 @@ def inlet_log_stretch(engine, scene, dp, index):
     if polish.size == 0:
         return v
     sub = index[polish]
+    # each point's last evaluation, whose error estimate stands for the answer's where Newton's
+    # last step from it was quadratically small (else the answer is evaluated once more)
+    last_value, last_error = np.zeros(sub.size), np.zeros(sub.size)
+    last_ok = np.ones(sub.size, dtype=bool)
 
     def F(x, i):
-        return engine.pressure_rise(scene, x, sub[i], warn=False)
+        rise = engine.rise_from_outlet(scene, x, sub[i])
+        last_value[i], last_error[i], last_ok[i] = rise.value, rise.error, rise.converged
+        return rise.value
 
     def dF(x, i):
         return engine._slope(scene.at(sub[i]), x)
@@ -514,9 +520,15 @@ def inlet_log_stretch(engine, scene, dp, index):
     small = dp[polish] <= _SMALL_DROP * np.abs(np.asarray(pts.outlet_pressure) + np.zeros(dp.shape))[polish]
     if np.any(small):
         guess[small] = dp[polish][small] / dF(np.zeros(int(np.count_nonzero(small))), np.flatnonzero(small))
+    evaluated = np.zeros(sub.size, dtype=bool)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        w, _ = solve_increasing(F, dF, dp[polish], guess=guess, max_step=2.0, log=True)
-    engine.pressure_rise(scene, w, sub)          # the answer's own error estimate
+        w, _ = solve_increasing(F, dF, dp[polish], guess=guess, max_step=2.0, log=True, evaluated=evaluated,
+                                quadratic=_QUADRATIC_STEP)
+    again = np.flatnonzero(~evaluated)
+    if again.size:                               # the answer's own error estimate where Newton ended elsewhere
+        F(w[again], again)
+    warn_unconverged("the pressure rise from the outlet",
+                     Integral(value=last_value, error=last_error, converged=last_ok, panels=np.zeros(sub.size, dtype=int)))
     v = v.copy()
     v[polish] = w
     return v

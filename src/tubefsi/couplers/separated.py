@@ -192,7 +192,7 @@ class SeparatedVariables(Coupler):
         pts = scene.at(index)
         if np.ndim(scene.outlet_pressure) == 0 and scene.outlet_pressure == 0.0:
             return pts.wall._pressure_at_log_stretch(v, np.expm1(v), pts.tb)
-        rise = self.integrate(scene, lambda u, i: self._slope(scene.at(index[i], column=True), u), v, index)
+        rise = self.rise_from_outlet(scene, v, index)
         if warn:
             warn_unconverged("the pressure rise from the outlet", rise)
         zero_out = np.asarray(pts.outlet_pressure) == 0.0
@@ -200,6 +200,11 @@ class SeparatedVariables(Coupler):
             direct = pts.wall._pressure_at_log_stretch(v, np.expm1(v), pts.tb)
             return np.where(zero_out, direct, rise.value)
         return rise.value
+
+    def rise_from_outlet(self, scene: Scene, v, index) -> Integral:
+        r""":math:`\int_0^v sP'(s)\,du` at the points ``index``, with its error estimate: the
+        pressure rise from a loaded outlet (:meth:`pressure_rise`)."""
+        return self.integrate(scene, lambda u, i: self._slope(scene.at(index[i], column=True), u), v, index)
 
     def _warn_near_a_lock(self, scene: Scene, v, index, rise):
         r"""An ``AccuracyWarning`` where the pressure drop cannot be known to the contract from the
