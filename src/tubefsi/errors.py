@@ -157,6 +157,10 @@ class ConvergenceError(TubefsiError, ArithmeticError):
 
 
 def _short(value) -> str:
+    if isinstance(value, (tuple, list)):      # a name such as ("in", "j"), a short list: as written
+        text = repr(value)
+        if len(text) <= 60:
+            return text
     try:
         a = np.asarray(value)
     except Exception:          # noqa: BLE001 (a ragged list: the error must still be raised, with its words)
