@@ -630,7 +630,11 @@ def write_network_table(network, path, *, thickness="auto", comment=None):
     each line after ``#``; a name starting with ``#`` is quoted (the reader would take its line
     for a comment), as one with a comma or a quote is. Returns the path."""
     columns = network_table(network, thickness=thickness)
-    with open(path, "w", newline="", encoding="utf-8") as fh:
+    try:
+        fh = open(path, "w", newline="", encoding="utf-8")
+    except OSError as err:
+        raise InvalidParameterError("path", "a file that can be written", str(path), str(err)) from None
+    with fh:
         for line in ([] if comment is None else str(comment).splitlines()):
             fh.write(f"# {line}\n")
         writer = csv.writer(fh, lineterminator="\n")
@@ -814,7 +818,10 @@ def write_vtp(network_or_solution, path, *, positions=None):
     for key, values in cells.items():
         _data_array(cell_data, key, np.asarray(values, dtype=float))
     ET.indent(root)
-    ET.ElementTree(root).write(path, encoding="utf-8", xml_declaration=True)
+    try:
+        ET.ElementTree(root).write(path, encoding="utf-8", xml_declaration=True)
+    except OSError as err:
+        raise InvalidParameterError("path", "a file that can be written", str(path), str(err)) from None
     return path
 
 
@@ -985,15 +992,15 @@ def read_vtp(path, *, rheology=None, wall=None):
             continue
         net.set_position(node, tuple(float(c) for c in (xyz[i, :2] if flat else xyz[i, :3])))
         bc = {key: float(point_data[key][i]) for key in _NODE_DATA if key in point_data}
-        try:
-            if math.isfinite(bc.get("fixed_pressure", math.nan)):
-                net.set_pressure(node, bc["fixed_pressure"])
-            if math.isfinite(bc.get("inflow", math.nan)):
-                net.set_inflow(node, bc["inflow"])
-            if math.isfinite(bc.get("resistance", math.nan)):
-                p_d = bc.get("distal_pressure", 0.0)
-                net.set_resistance(node, bc["resistance"], distal_pressure=p_d if math.isfinite(p_d) else 0.0)
-        except InvalidParameterError as err:           # the file and the point, then what was wrong there
-            raise InvalidParameterError(f"{label}, point {i} (node {node!r}), point data {err.parameter}",
-                                        err.admissible, err.value) from None
+        for key, setter in (("fixed_pressure", net.set_pressure), ("inflow", net.set_inflow),
+                            ("resistance", net.set_resistance)):
+            if not math.isfinite(bc.get(key, math.nan)):
+                continue
+            p_d = bc.get("distal_pressure", math.nan)
+            try:
+                setter(node, bc[key], *([p_d if math.isfinite(p_d) else 0.0] if key == "resistance" else []))
+            except InvalidParameterError as err:       # the file, the point and its array, then what was wrong
+                raise InvalidParameterError(f"{label}, point {i} (node {node!r}), point data {key!r}",
+                                            err.admissible, bc[key] if err.parameter != "node" else err.value,
+                                            err.args[0].split("; ", 1)[1] if "; " in err.args[0] else "") from None
     return net
