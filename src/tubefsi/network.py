@@ -133,7 +133,7 @@ class Network:
         if n == 0:
             raise InvalidParameterError("u", "a sequence of at least one node name", u)
         if len(v) != n:
-            raise InvalidParameterError("v", f"a sequence of {n} node names, as long as u", f"{len(v)} names")
+            raise InvalidParameterError("v", f"a sequence of {n} node names, as long as u", None, f"it has {len(v)}")
         names = list(zip(u, v)) if names is None else _names_of("names", names)
         if len(names) != n:
             raise InvalidParameterError("names", f"{n} names, one per tube", len(names))
