@@ -332,7 +332,7 @@ class Network:
                 net.set_inflow(node, data[inflow])
             if "resistance" in data:
                 net.set_resistance(node, data["resistance"], data.get("distal_pressure", 0.0))
-            if pos in data:
+            if pos in data and node in net._nodes:     # (a node in no tube is not drawn)
                 net.set_position(node, data[pos])
         return net
 
