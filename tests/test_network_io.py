@@ -521,14 +521,21 @@ def sampled_linear(a0, a1, length):
     return tubefsi.sampled([0.0, length], [a0, a1], kind="linear")
 
 
-def test_a_profile_the_files_cannot_hold_is_refused_or_warned(tmp_path):
-    """A thickness neither linear nor empirical along the tube: the table refuses it (naming the
-    tube and the field), a .vtp read back warns (it holds the two ends only)."""
+@pytest.mark.parametrize("graded, field", [("thickness", "thickness"), ("modulus", "wall youngs_modulus")])
+def test_a_profile_the_files_cannot_hold_is_refused_or_warned(tmp_path, graded, field):
+    """A thickness neither linear nor empirical along the tube, or a modulus that varies along
+    it: the table refuses it (naming the tube and the field), a .vtp read back warns (it holds
+    the two ends only). A graded modulus once raised a plain TypeError from float()."""
     net = tubefsi.Network(rheology=NEWTONIAN)
-    thickness = tubefsi.Profile(lambda z: 2e-4 * (1 + 100 * np.asarray(z) ** 2))
-    net.add_tube(1, 2, network_io.openbf_wall(4e5), tubefsi.Tube(length=0.1, radius=2e-3, thickness=thickness),
-                 name="bulge")
-    with pytest.raises(InvalidParameterError, match="tube 'bulge', thickness"):
+    if graded == "thickness":
+        wall = network_io.openbf_wall(4e5)
+        tube = tubefsi.Tube(length=0.1, radius=2e-3, thickness=tubefsi.Profile(
+            lambda z: 2e-4 * (1 + 100 * np.asarray(z) ** 2)))
+    else:
+        wall = network_io.openbf_wall(tubefsi.sampled([0.0, 0.1], [4e5, 2e5], kind="linear"))
+        tube = tubefsi.Tube(length=0.1, radius=2e-3, thickness=2e-4)
+    net.add_tube(1, 2, wall, tube, name="bulge")
+    with pytest.raises(InvalidParameterError, match=f"tube 'bulge', {field}"):
         network_io.network_table(net)
     path = network_io.write_vtp(net, tmp_path / "b.vtp")
     with pytest.warns(UserWarning, match="cell 0"):

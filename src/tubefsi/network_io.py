@@ -485,6 +485,16 @@ def _ends(tube):
     return float(a[0]), float(a[-1]), float(t[0]), float(t[-1]), length, radius_law, thickness_law
 
 
+def _modulus(wall, length):
+    """``(E at the inlet, law)`` of a wall's ``youngs_modulus`` (NaN without one): the law
+    :data:`OTHER` where it varies along the tube (the files hold one number per tube)."""
+    modulus = getattr(wall, "youngs_modulus", math.nan)
+    if not isinstance(modulus, Profile):
+        return float(modulus), LINEAR
+    values = np.broadcast_to(np.asarray(modulus(_PROBES * length), dtype=float), _PROBES.shape)
+    return float(values[0]), LINEAR if np.all(values == values[0]) else OTHER
+
+
 def _geometry(network) -> dict:
     """Per tube, in the network's order: ``name``, ``u``, ``v`` (lists) and the arrays ``a0``,
     ``a1`` (radius at the two ends), ``t0``, ``t1`` (thickness), ``length``, ``E`` (the wall's
@@ -500,14 +510,14 @@ def _geometry(network) -> dict:
            "v": list(map(nodes.__getitem__, tubes.V.tolist())), "p_ext": np.array(tubes.external, dtype=float)}
     for key in ("a0", "a1", "t0", "t1", "length", "E"):
         out[key] = np.empty(n)
-    out["radius_law"], out["thickness_law"] = np.full(n, LINEAR), np.full(n, LINEAR)
+    out["radius_law"], out["thickness_law"], out["modulus_law"] = (np.full(n, LINEAR) for _ in range(3))
     for batch, index in tubes.by_batch():
         if batch.graded:
             for k in index.tolist():
                 wall, tube, _ = tubes[k].models()
                 (out["a0"][k], out["a1"][k], out["t0"][k], out["t1"][k], out["length"][k], out["radius_law"][k],
                  out["thickness_law"][k]) = _ends(tube)
-                out["E"][k] = float(getattr(wall, "youngs_modulus", math.nan))
+                out["E"][k], out["modulus_law"][k] = _modulus(wall, out["length"][k])
             continue
         first = batch                   # (its tubes share its models: one indexing each)
         rows = np.zeros(index.size, dtype=int) if batch.rows is None else batch.rows[tubes.place[index]]
@@ -556,6 +566,10 @@ def network_table(network, *, thickness="auto") -> dict:
         raise InvalidParameterError(f"tube {g['name'][k]!r}", "a wall with a youngs_modulus (the table form holds "
                                     "linear elastic walls)", type(network._tubes[g["name"][k]].wall).__name__)
     _check_openbf_walls(network)
+    if np.any(g["modulus_law"] == OTHER):
+        k = int(np.flatnonzero(g["modulus_law"] == OTHER)[0])
+        raise InvalidParameterError(f"tube {g['name'][k]!r}, wall youngs_modulus", "one number along the tube (the "
+                                    "table's E(Pa) holds one per vessel)", "a modulus that varies along it")
     for key, what in (("radius_law", "radius"), ("thickness_law", "thickness")):
         if np.any(g[key] == OTHER):
             k = int(np.flatnonzero(g[key] == OTHER)[0])
@@ -719,7 +733,7 @@ def tree_layout(network, *, root=None) -> dict:
 # ---------------------------------------------------------------------------- VTK polylines
 #: cell arrays of the geometry (per tube) and of a solution (NetworkSolution attribute names)
 _GEOMETRY = ("radius", "radius_proximal", "radius_distal", "thickness_proximal", "thickness_distal", "length",
-             "youngs_modulus", "external_pressure", "radius_law", "thickness_law")
+             "youngs_modulus", "external_pressure", "radius_law", "thickness_law", "modulus_law")
 _RESULTS = {"flow_rate": "flow_rates", "pressure_drop": "pressure_drops", "radius_u": "radius_u",
             "radius_v": "radius_v", "strain_u": "strain_u", "strain_v": "strain_v",
             "wall_shear_stress_u": "wall_shear_stress_u", "wall_shear_stress_v": "wall_shear_stress_v"}
@@ -771,7 +785,8 @@ def write_vtp(network_or_solution, path, *, positions=None):
     ``thickness_distal``, ``length`` (m), ``youngs_modulus`` (Pa, NaN for a wall without one),
     ``external_pressure`` (Pa), ``radius_law`` and ``thickness_law`` (how the profile runs
     between the two ends: 0 linear, 1 the :func:`empirical_thickness` of the radius, 2 another
-    law, which :func:`read_vtp` makes linear with a warning); given a solution also ``flow_rate`` (m^3/s), ``pressure_drop``
+    law, which :func:`read_vtp` makes linear with a warning), ``modulus_law`` (2 where the
+    ``youngs_modulus``, its inlet value here, varies along the tube); given a solution also ``flow_rate`` (m^3/s), ``pressure_drop``
     (Pa), ``radius_u``, ``radius_v`` (deformed, m), ``strain_u``, ``strain_v``,
     ``wall_shear_stress_u``, ``wall_shear_stress_v`` (Pa). Point data: the boundary conditions
     ``fixed_pressure``, ``inflow``, ``resistance``, ``distal_pressure`` (NaN where a node has
@@ -791,7 +806,7 @@ def write_vtp(network_or_solution, path, *, positions=None):
         raise InvalidParameterError("network_or_solution", "a network with at least one tube", network_or_solution)
     xyz = _positions(network, positions)
     cells = dict(zip(_GEOMETRY, (0.5 * (g["a0"] + g["a1"]), g["a0"], g["a1"], g["t0"], g["t1"], g["length"], g["E"],
-                                 g["p_ext"], g["radius_law"], g["thickness_law"])))
+                                 g["p_ext"], g["radius_law"], g["thickness_law"], g["modulus_law"])))
     connectivity = np.array([[index[a] for a in g["u"]], [index[b] for b in g["v"]]], dtype=np.int64).T
     if solution is not None:
         for key, attribute in _RESULTS.items():
@@ -959,12 +974,14 @@ def read_vtp(path, *, rheology=None, wall=None):
     shared = np.isin(pairs, pairs[first[counts > 1]])
     names_of = [(u[k], v[k], k) if shared[k] else (u[k], v[k]) for k in range(n_tubes)]
     thickness_law = cell("thickness_law", np.zeros(n_tubes))
-    approximated = (cell("radius_law", np.zeros(n_tubes)) == OTHER) | (thickness_law == OTHER)
+    approximated = ((cell("radius_law", np.zeros(n_tubes)) == OTHER) | (thickness_law == OTHER)
+                    | (cell("modulus_law", np.zeros(n_tubes)) == OTHER))
     if np.any(approximated):
         k = int(np.flatnonzero(approximated)[0])
-        warn_user(f"read_vtp: {label}, cell {k} (and {int(np.sum(approximated)) - 1} more): its radius or thickness "
-                  "ran along the tube by a law the file does not hold (radius_law or thickness_law 2); it is read "
-                  "as linear between the two ends, another tube than the one written", UserWarning)
+        warn_user(f"read_vtp: {label}, cell {k} (and {int(np.sum(approximated)) - 1} more): its radius, thickness or "
+                  "modulus ran along the tube by a law the file does not hold (radius_law or thickness_law 2, or a "
+                  "youngs_modulus that varies along it, modulus_law 2); it is read as linear between the two "
+                  "ends (the modulus as its inlet value), another tube than the one written", UserWarning)
     by_rule = thickness_law == EMPIRICAL
     graded = (rp != rd) | (hp != hd) | by_rule
     net = Network(rheology=rheology)
