@@ -493,6 +493,22 @@ def test_any_text_name_reads_back_or_is_refused(tmp_path_factory, names):
     assert tubefsi.read_network_table(path, rheology=NEWTONIAN).tube_names == names
 
 
+@settings(max_examples=25, deadline=None)
+@given(st.lists(st.one_of(st.text(min_size=1, max_size=6), st.integers(-10**6, 10**6)), min_size=4, max_size=4,
+                unique=True))
+def test_any_node_name_reads_back_or_is_refused(tmp_path_factory, nodes):
+    """The same contract for node names (text or integers; "nan" once read back as an empty
+    cell)."""
+    net = _openbf_y(nodes=tuple(nodes))
+    path = tmp_path_factory.mktemp("nodes") / "n.csv"
+    try:
+        network_io.write_network_table(net, path)
+    except InvalidParameterError as err:
+        assert "node name" in str(err)
+        return
+    assert tubefsi.read_network_table(path, rheology=NEWTONIAN).nodes == nodes
+
+
 def test_a_linear_thickness_along_a_taper_round_trips_through_the_table(tmp_path):
     """A Tube.tapered with a linear thickness could not be written by default ("a constant wall
     thickness (got array of shape (2,))"), and thickness=False read it back with the empirical

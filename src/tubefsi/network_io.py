@@ -217,7 +217,7 @@ class _Table:
                 out.append(int(cell))
                 continue
             text = str(cell).strip() if cell is not None else ""
-            if text == "" or text == "nan":
+            if text == "" or (isinstance(cell, (float, np.floating)) and math.isnan(cell)):   # (a DataFrame's NaN)
                 if empty:
                     out.append(None)
                     continue
