@@ -186,6 +186,9 @@ BAD = [
     ("Name, sn, tn, l(m), Rp(m)\nx, 1, 2, 0.1, 0.001\n", "E(Pa)"),
     ("Name, sn, tn, l(m), Rp(m), E(Pa), R1\nx, 1, 2, 0.1, 0.001, 4e5, -5\n", "bad.csv, line 2, column 'R1'"),
     ("", "bad.csv"),
+    ("Name, sn, tn, l(m), Rp(m), E(Pa), h(m), hd(m)\nx, 1, 2, 0.1, 0.001, 4e5, , 1e-4\n", "bad.csv, line 2, column 'hd(m)'"),
+    ("Name, sn, tn, l(m), Rp(m), E(Pa), hd(m)\nx, 1, 2, 0.1, 0.001, 4e5, 1e-4\n", "bad.csv must be a column h(m)"),
+    ("Name, sn, tn, l(m), Rp(m), E(Pa), R1, Pd(Pa)\nx, 1, 2, 0.1, 0.001, 4e5, 0, 5\n", "bad.csv, line 2, column 'Pd(Pa)'"),
 ]
 
 

@@ -401,6 +401,9 @@ def read_network_table(source, *, rheology=None, wall=None, thickness=None, dist
     if np.any(by_rule) and not np.all(np.isfinite(h0) & (h0 > 0)):
         k = int(np.flatnonzero(~(np.isfinite(h0) & (h0 > 0)))[0])
         raise table.error("rp", k, "a radius whose thickness(radius) is a positive number", rp[k])
+    if np.any(by_rule & ~np.isnan(hd)):
+        k = int(np.flatnonzero(by_rule & ~np.isnan(hd))[0])
+        raise table.error("hd", k, "an empty cell where h(m) is empty (the thickness rule's vessel)", hd[k])
     h1 = np.where(np.isnan(hd), h0, hd)            # the distal thickness of a vessel whose h is given
     tapered = (rp != rd) | (~by_rule & (h1 != h0))
 
