@@ -38,7 +38,7 @@ def _y():
     (lambda n: n.set_position("a", (1,)), r"xy must be a point \(x, y\) or \(x, y, z\)"),
     (lambda n: n.set_position("a", (1.0, np.nan)), r"xy must be a point"),
     (lambda n: n.set_position("a", "xy"), r"xy must be a point"),
-    (lambda n: n.set_position("nowhere", (0, 0)), r"node must be a node of the network .*\(got 'nowhere'\)"),
+    (lambda n: n.set_position(["a"], (0, 0)), r"node must be a hashable node name \(got \['a'\]\)"),
 ])
 def test_mistakes_name_the_argument_and_show_names_as_names(call, message):
     """Tuple names were shown as "array of shape (2,)", set_pressures' count as the shape of the

@@ -279,10 +279,11 @@ class Network:
 
     @checked_keywords
     def set_position(self, node: Hashable, xy: tuple[float, float]) -> Network:
-        """Place ``node`` (a node of the network) at ``xy = (x, y)`` or ``(x, y, z)`` (m, finite)
-        for the plot (which draws x and y) and the ``.vtp`` file."""
-        if not _hashable(node) or node not in self._nodes:
-            raise InvalidParameterError("node", "a node of the network (add its tubes first)", node)
+        """Place ``node`` at ``xy = (x, y)`` or ``(x, y, z)`` (m, finite) for the plot (which draws
+        x and y) and the ``.vtp`` file. A node may be placed before its tubes are added; the
+        position of a node that is in no tube is not used."""
+        if not _hashable(node):
+            raise InvalidParameterError("node", "a hashable node name", node)
         try:
             point = np.asarray(xy, dtype=float)
         except (TypeError, ValueError):
@@ -332,7 +333,7 @@ class Network:
                 net.set_inflow(node, data[inflow])
             if "resistance" in data:
                 net.set_resistance(node, data["resistance"], data.get("distal_pressure", 0.0))
-            if pos in data and node in net._nodes:     # (a node in no tube is not drawn)
+            if pos in data:
                 net.set_position(node, data[pos])
         return net
 
