@@ -789,12 +789,12 @@ def write_vtp(network_or_solution, path, *, positions=None):
     ``external_pressure`` (Pa), ``radius_law`` and ``thickness_law`` (how the profile runs
     between the two ends: 0 linear, 1 the :func:`empirical_thickness` of the radius, 2 another
     law, which :func:`read_vtp` makes linear with a warning), ``modulus_law`` (2 where the
-    ``youngs_modulus``, its inlet value here, varies along the tube); given a solution also ``flow_rate`` (m^3/s), ``pressure_drop``
-    (Pa), ``radius_u``, ``radius_v`` (deformed, m), ``strain_u``, ``strain_v``,
+    ``youngs_modulus``, its inlet value here, varies along the tube); given a solution also
+    ``flow_rate`` (m^3/s), ``pressure_drop`` (Pa), ``radius_u``, ``radius_v`` (deformed, m), ``strain_u``, ``strain_v``,
     ``wall_shear_stress_u``, ``wall_shear_stress_v`` (Pa). Point data: the boundary conditions
     ``fixed_pressure``, ``inflow``, ``resistance``, ``distal_pressure`` (NaN where a node has
-    none), ``node`` (the node names, where they are all integers, NumPy's too) and, given a solution,
-    ``pressure`` (Pa). Returns the path."""
+    none), ``node`` (the node names, where they are all integers, NumPy's too) and, given a
+    solution, ``pressure`` (Pa). Returns the path."""
     if isinstance(network_or_solution, NetworkSolution):
         solution, network = network_or_solution, network_or_solution.net
     elif isinstance(network_or_solution, Network):
@@ -1006,11 +1006,20 @@ def read_vtp(path, *, rheology=None, wall=None):
                                     thickness=float(hp[k]), outlet_thickness=float(hd[k]))
             net.add_tube(u[k], v[k], make_wall(float(modulus[k]), float(hp[k]), float(rp[k])), tube,
                          name=names_of[k], external_pressure=float(p_ext[k]))
-    flat = xyz.shape[1] < 3 or not np.any(xyz[:, 2])       # (x, y) unless a point has a z
-    for i, node in enumerate(names):
-        if node not in net._nodes:
-            continue
-        net.set_position(node, tuple(float(c) for c in (xyz[i, :2] if flat else xyz[i, :3])))
+    used = np.array([node in net._nodes for node in names], dtype=bool)
+    if not np.all(np.isfinite(xyz[used])):
+        i = int(np.flatnonzero(used & ~np.all(np.isfinite(xyz), axis=1))[0])
+        raise InvalidParameterError(f"{label}, point {i}, Points", "finite coordinates (m)", xyz[i].tolist())
+    flat = xyz.shape[1] < 3 or not np.any(xyz[used, 2])       # (x, y) unless a point has a z
+    points = xyz[:, :2] if flat else xyz[:, :3]
+    # the positions in one pass (checked above, as set_position checks one)
+    net.positions.update((node, tuple(p)) for node, p, keep in zip(names, points.tolist(), used) if keep)
+    with_bc = np.zeros(len(names), dtype=bool)
+    for key in ("fixed_pressure", "inflow", "resistance"):
+        if key in point_data:
+            with_bc |= np.isfinite(point_data[key])
+    for i in np.flatnonzero(used & with_bc).tolist():
+        node = names[i]
         bc = {key: float(point_data[key][i]) for key in _NODE_DATA if key in point_data}
         for key, setter in (("fixed_pressure", net.set_pressure), ("inflow", net.set_inflow),
                             ("resistance", net.set_resistance)):
