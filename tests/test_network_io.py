@@ -645,3 +645,14 @@ def test_xarray_keeps_numpy_integer_node_names():
     data = net.set_pressure(np.int64(1), 10.0).set_pressure(np.int64(3), 0.0).solve().to_xarray()
     assert data["node"].dtype.kind == "i" and data["node"].values.tolist() == [1, 2, 3]
     assert data["u"].dtype.kind == "i"
+
+
+def test_a_point_that_is_not_finite_names_the_file_and_point(tmp_path):
+    net = _openbf_y().set_pressure(1, 100.0).set_pressure(3, 0.0).set_pressure(4, 0.0)
+    root = ET.fromstring((tmp_path / "y.vtp").read_text() if network_io.write_vtp(net, tmp_path / "y.vtp") else "")
+    points = root.find("PolyData/Piece/Points/DataArray")
+    points.attrib.update(format="ascii", type="Float64")
+    points.text = "0 0 0  1 0 0  2 nan 0  2 -1 0"
+    (tmp_path / "bad.vtp").write_bytes(ET.tostring(root))
+    with pytest.raises(InvalidParameterError, match=r"bad.vtp, point 2, Points must be finite coordinates"):
+        network_io.read_vtp(tmp_path / "bad.vtp", rheology=NEWTONIAN)
