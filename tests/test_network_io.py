@@ -475,6 +475,7 @@ def test_default_and_numpy_names_read_back_as_the_same_keys(tmp_path):
     (("a", ("x", "y"), "c"), (1, 2, 3, 4), r"tube name \('x', 'y'\)"),  # a tuple other than (u, v)
     (("a", "b", "c"), (1, 2, "3", 4), "node name '3'"),
     (("a", "b", "c"), (1, 2, 3.5, 4), "node name 3.5"),
+    (("a", "b", "c"), (1, 2, "3.0", 4), "node name '3.0'"),            # reads back as the node 3
 ])
 def test_names_the_table_would_read_back_as_others_are_refused(tmp_path, names, nodes, what):
     with pytest.raises(InvalidParameterError, match=what):
@@ -656,3 +657,16 @@ def test_a_point_that_is_not_finite_names_the_file_and_point(tmp_path):
     (tmp_path / "bad.vtp").write_bytes(ET.tostring(root))
     with pytest.raises(InvalidParameterError, match=r"bad.vtp, point 2, Points must be finite coordinates"):
         network_io.read_vtp(tmp_path / "bad.vtp", rheology=NEWTONIAN)
+
+
+def test_a_node_written_as_a_float_is_the_integer_node(tmp_path):
+    """A file that writes node 2 as "2.0" in one row (a spreadsheet's habit) had the nodes 2 and
+    '2.0', two nodes where the table means one: the tree came apart silently."""
+    text = "Name,sn,tn,l(m),Rp(m),E(Pa),R1\na,1,2,0.1,0.001,4e5,0\nb,2.0,3,0.1,0.001,4e5,1e9\n"
+    net = tubefsi.read_network_table(_write(tmp_path / "f.csv", text), rheology=NEWTONIAN)
+    assert net.nodes == [1, 2, 3]
+
+
+def _write(path, text):
+    path.write_text(text, encoding="utf-8")
+    return path

@@ -199,7 +199,7 @@ class _Table:
 
     def names(self, key, empty=False):
         """Column ``key`` as node or vessel names: integers where a cell is one (an integral
-        float of a DataFrame included, 1.0 -> 1), else its text; with ``empty``, an empty cell
+        float of a DataFrame, or the text "1.0" of a file, included: 1.0 -> 1), else its text; with ``empty``, an empty cell
         is None."""
         cells = self.columns[key]
         if all(isinstance(c, str) for c in cells):     # a file's column: integers at once where all are
@@ -222,8 +222,14 @@ class _Table:
                     out.append(None)
                     continue
                 raise self.error(key, k, "a name (not empty)", "an empty cell")
-            out.append(int(text) if re.fullmatch(r"[+-]?\d+", text) else text)
+            integer = _INTEGER.fullmatch(text)        # "2" and "2.0" are the node 2
+            out.append(int(integer.group(1)) if integer else text)
         return out
+
+
+#: a cell that names an integer node or vessel: digits, and a point with zeros only ("2.0", as a
+#: spreadsheet writes an integer)
+_INTEGER = re.compile(r"([+-]?\d+)(?:\.0*)?")
 
 
 def _column_key(raw):
@@ -630,11 +636,12 @@ def _table_name(kind, name, default=None):
         return None
     if isinstance(name, (int, np.integer)) and not isinstance(name, (bool, np.bool_)):
         return int(name)
-    if isinstance(name, str) and name and name == name.strip() and not re.fullmatch(r"[+-]?\d+", name) \
+    if isinstance(name, str) and name and name == name.strip() and not _INTEGER.fullmatch(name) \
             and "\n" not in name and "\r" not in name:
         return name
     raise InvalidParameterError(
-        f"{kind} name {name!r}", "an integer or text that reads back as itself (not an integer's digits, no "
+        f"{kind} name {name!r}", "an integer or text that reads back as itself (not an integer's digits, such "
+        "as '12' or '12.0', no "
         "surrounding blanks or line breaks)" + (", or the default name (u, v)" if kind == "tube" else "") +
         ": the table writes names as text", name)
 
