@@ -35,6 +35,10 @@ def _y():
                                                            "it has 1"),
     (lambda n: n.add_tube(["a"], "c", WALL, TUBE), r"u must be a hashable node name .*\(got \['a'\]\)"),
     (lambda n: n.add_tube("a", "c", WALL, TUBE, name=["x"]), r"name must be a hashable name"),
+    (lambda n: n.add_tubes(np.array([["x", "y"]]), ["z"], WALL, TUBE), r"u must be a 1-D sequence of names "
+                                                                       r"\(got array of shape \(1, 2\)\)"),
+    (lambda n: n.add_tubes(["x", "y"], ["z", "w"], WALL, TUBE, external_pressure=[1.0, 2.0, 3.0]),
+     r"external_pressure must be a number or an array of length 2 \(got array of shape \(3,\)\)"),
     (lambda n: n.set_position("a", (1,)), r"xy must be a point \(x, y\) or \(x, y, z\)"),
     (lambda n: n.set_position("a", (1.0, np.nan)), r"xy must be a point"),
     (lambda n: n.set_position("a", "xy"), r"xy must be a point"),

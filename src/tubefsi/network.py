@@ -161,7 +161,7 @@ class Network:
         wall, tube, fluid = models
         p_e = as_array("external_pressure", external_pressure, "the real numbers", np.isfinite)
         if p_e.shape not in ((), (n,)):
-            raise InvalidParameterError("external_pressure", f"a number or an array of length {n}", p_e.shape)
+            raise InvalidParameterError("external_pressure", f"a number or an array of length {n}", p_e)
         p_e = np.broadcast_to(p_e.astype(float), (n,))
         shared = parameter_shape(wall) == parameter_shape(tube) == parameter_shape(fluid) == ()
         nodes = self._nodes
@@ -478,7 +478,7 @@ def _names_of(label, values) -> list:
     """Node or tube names given as a sequence or an array, as a list of plain Python objects."""
     if isinstance(values, np.ndarray):
         if values.ndim != 1:
-            raise InvalidParameterError(label, "a 1-D sequence of names", values.shape)
+            raise InvalidParameterError(label, "a 1-D sequence of names", values)
         return values.tolist()
     if isinstance(values, (str, bytes)) or not hasattr(values, "__len__"):
         raise InvalidParameterError(label, "a sequence of names (a list or a 1-D array)", values)
