@@ -155,7 +155,7 @@ def test_batches_tubes_between_them_and_a_removal_inside_one_equal_one_by_one():
 
 @pytest.mark.parametrize("call, parameter", [
     (lambda net, t: net.add_tubes(["a", "b"], ["b"], RIGID, t), "v"),
-    (lambda net, t: net.add_tubes([], [], RIGID, t), "v"),
+    (lambda net, t: net.add_tubes([], [], RIGID, t), "u"),
     (lambda net, t: net.add_tubes("ab", "bc", RIGID, t), "u"),
     (lambda net, t: net.add_tubes(["a", "b"], ["b", "b"], RIGID, t), r"v\[1\]"),
     (lambda net, t: net.add_tubes(["a", "a"], ["b", "b"], RIGID, t), r"names\[1\]"),

@@ -186,6 +186,9 @@ BAD = [
     ("Name, sn, tn, l(m), Rp(m)\nx, 1, 2, 0.1, 0.001\n", "E(Pa)"),
     ("Name, sn, tn, l(m), Rp(m), E(Pa), R1\nx, 1, 2, 0.1, 0.001, 4e5, -5\n", "bad.csv, line 2, column 'R1'"),
     ("", "bad.csv"),
+    ("Name, sn, tn, l(m), Rp(m), E(Pa), h(m), hd(m)\nx, 1, 2, 0.1, 0.001, 4e5, , 1e-4\n", "bad.csv, line 2, column 'hd(m)'"),
+    ("Name, sn, tn, l(m), Rp(m), E(Pa), hd(m)\nx, 1, 2, 0.1, 0.001, 4e5, 1e-4\n", "bad.csv must be a column h(m)"),
+    ("Name, sn, tn, l(m), Rp(m), E(Pa), R1, Pd(Pa)\nx, 1, 2, 0.1, 0.001, 4e5, 0, 5\n", "bad.csv, line 2, column 'Pd(Pa)'"),
 ]
 
 
@@ -255,7 +258,8 @@ def test_vtp_integer_nodes_and_bad_files(tmp_path):
                                      wall=lambda E, h, R: walls["thin-linear"](youngs_modulus=1e6, poisson_ratio=0.5))
     path = network_io.write_vtp(net, tmp_path / "y.vtp", positions={1: (0, 0), 2: (1, 0), 3: (2, 1), 4: (2, -1, 0.5)})
     again = network_io.read_vtp(path, rheology=NEWTONIAN, wall=walls["thin-linear"](youngs_modulus=1e6, poisson_ratio=0.5))
-    assert again.nodes == [1, 2, 3, 4] and again.positions[3] == (2.0, 1.0)
+    assert again.nodes == [1, 2, 3, 4] and again.positions[3] == (2.0, 1.0, 0.0)   # (a point has a z: 3-D)
+    assert again.positions[4] == (2.0, -1.0, 0.5)
     assert network_io.network_table(again)["Rp(m)"] == network_io.network_table(net)["Rp(m)"]
     bad = tmp_path / "bad.vtp"
     vtk_file = Path(__file__).parent / "data" / "y_written_by_vtk_ascii.vtp"
@@ -343,7 +347,8 @@ def test_random_tables_round_trip(tmp_path_factory, n, data):
 
 @pytest.mark.parametrize("wall", [walls["thin-linear"](youngs_modulus=1e6, poisson_ratio=0.3),
                                   walls["thick-linear"](youngs_modulus=1e6, poisson_ratio=0.5),
-                                  walls["thin-neo-hookean"](shear_modulus=3e5)])
+                                  walls["thin-neo-hookean"](shear_modulus=3e5),
+                                  walls["thin-linear"](youngs_modulus=1e6, poisson_ratio=0.5, end_condition="open")])
 def test_the_table_refuses_a_wall_it_would_read_back_as_another(tmp_path, wall):
     """The table keeps E and h only and reading makes openBF's wall (thin linear, nu = 1/2): a
     thin linear wall with nu = 0.3 once came back with nu = 1/2 (its strain 11 % smaller), a thick
@@ -384,9 +389,284 @@ def test_a_tapered_vessel_round_trips_through_vtp(tmp_path):
     path = network_io.write_vtp(net, tmp_path / "taper.vtp")
     again = network_io.read_vtp(path, rheology=NEWTONIAN)
     again.set_inflow(0, 1e-6).set_pressure(1, 0.0)
-    table = network_io.network_table(again, thickness=False)
+    with pytest.warns(UserWarning, match="reads back as another network"):     # (a thickness not openBF's)
+        table = network_io.network_table(again, thickness=False)
     assert (table["Rp(m)"], table["Rd(m)"], table["l(m)"]) == ([2e-3], [1e-3], [0.1])
     a_p, a_d, mu, length = 2e-3, 1e-3, 3.5e-3, 0.1
     resistance = 8 * mu * length * (a_p**2 + a_p * a_d + a_d**2) / (3 * np.pi * a_p**3 * a_d**3)
     for network, inlet in ((net, "in"), (again, 0)):
         assert abs(network.solve().pressure[inlet] / (resistance * 1e-6) - 1) < 1e-9
+
+
+# ---------------------------------------------------------------------------- round trips that once changed the network
+def _same_solve(a, b, a_inlet, b_inlet, q=1e-6):
+    """Both networks fed ``q`` at their inlets and solved: the same node pressures and tube
+    flow rates, by name (a network read back from a file is the network written)."""
+    ra, rb = a.set_inflow(a_inlet, q).solve(), b.set_inflow(b_inlet, q).solve()
+    assert rb.nodes == ra.nodes and rb.tube_names == ra.tube_names
+    np.testing.assert_allclose(rb.pressures, ra.pressures, rtol=1e-13, atol=0)
+    np.testing.assert_allclose(rb.flow_rates, ra.flow_rates, rtol=1e-12, atol=1e-22)
+    return ra, rb
+
+
+def _openbf_y(names=("a", "b", "c"), nodes=(1, 2, 3, 4)):
+    wall = network_io.openbf_wall(2e5)
+    tube = tubefsi.Tube(radius=1e-3, thickness=2e-4, length=0.05)
+    net = tubefsi.Network(rheology=NEWTONIAN)
+    n1, n2, n3, n4 = nodes
+    net.add_tube(n1, n2, wall, tube, name=names[0])
+    net.add_tube(n2, n3, wall, tube, name=names[1])
+    net.add_tube(n2, n4, wall, tube, name=names[2])
+    return net
+
+
+def test_distal_pressures_are_written_and_read_back(tmp_path):
+    """set_resistance(3, 1e9, distal_pressure=700) was written as R1 only and read back with a
+    distal pressure of 0 (the inlet pressure 700 Pa lower), silently. Now a column Pd(Pa) holds
+    each outlet's distal pressure; the network read back solves to the same pressures."""
+    net = _openbf_y()
+    net.set_resistance(3, 1e9, distal_pressure=700.0).set_resistance(4, 2e9, distal_pressure=0.0)
+    path = network_io.write_network_table(net, tmp_path / "y.csv")
+    assert network_io.network_table(net)["Pd(Pa)"] == [0.0, 700.0, 0.0]
+    again = tubefsi.read_network_table(path, rheology=NEWTONIAN)
+    assert again._resistance == {3: (1e9, 700.0), 4: (2e9, 0.0)}
+    ra, _ = _same_solve(net, again, 1, 1)
+    # the outlet's balance (p_3 - 700) / R = q_b: the distal pressure is in the solution
+    assert (ra.pressure[3] - 700.0) / 1e9 == pytest.approx(ra.flow_rate["b"], rel=1e-10)
+
+
+@pytest.mark.parametrize("names", [("#2 branch", "c, left", 'say "hi"'), ("a", "#", "#x,#y")])
+def test_names_with_a_hash_a_comma_or_a_quote_read_back(tmp_path, names):
+    """A vessel named "#2 branch" was written unquoted and read as a comment line (the vessel and
+    its terminal dropped). Such names are quoted now and read back as themselves."""
+    net = _openbf_y(names=names)
+    net.set_resistance(3, 1e9).set_resistance(4, 1e9)
+    again = tubefsi.read_network_table(network_io.write_network_table(net, tmp_path / "n.csv"), rheology=NEWTONIAN)
+    assert again.tube_names == list(names) and again._resistance == net._resistance
+    _same_solve(net, again, 1, 1)
+
+
+def test_default_and_numpy_names_read_back_as_the_same_keys(tmp_path):
+    """Tuple names (the default (u, v)) were written as the text "('in', 'j')", so that
+    flow_rate[("in", "j")] raised KeyError after a round trip, and NumPy nodes as
+    "(np.int64(1), np.int64(2))". A default name is written as an empty cell (the reader gives
+    (sn, tn) back), a NumPy integer as a plain one."""
+    wall, tube = network_io.openbf_wall(2e5), tubefsi.Tube(radius=1e-3, thickness=2e-4, length=0.05)
+    net = tubefsi.Network(rheology=NEWTONIAN)
+    for u, v in np.array([[1, 2], [2, 3], [2, 4]]):
+        net.add_tube(u, v, wall, tube)
+    net.set_resistance(np.int64(3), 1e9).set_resistance(np.int64(4), 1e9)
+    path = network_io.write_network_table(net, tmp_path / "d.csv")
+    assert network_io.network_table(net)["Name"] == [None] * 3
+    again = tubefsi.read_network_table(path, rheology=NEWTONIAN)
+    assert again.tube_names == [(1, 2), (2, 3), (2, 4)] and all(type(n) is int for n in again.nodes)
+    ra, rb = _same_solve(net, again, 1, 1)
+    assert rb.flow_rate[(2, 3)] == ra.flow_rate[(np.int64(2), np.int64(3))]
+    text = tubefsi.Network(rheology=NEWTONIAN).add_tube("in", "j", wall, tube).add_tube("j", "out", wall, tube)
+    text.set_resistance("out", 1e9)
+    back = tubefsi.read_network_table(network_io.write_network_table(text, tmp_path / "t.csv"), rheology=NEWTONIAN)
+    assert back.tube_names == [("in", "j"), ("j", "out")]
+    _same_solve(text, back, "in", "in")
+
+
+@pytest.mark.parametrize("names, nodes, what", [
+    (("a", "12", "c"), (1, 2, 3, 4), "tube name '12'"),               # would read back as the integer 12
+    (("a", " b", "c"), (1, 2, 3, 4), "tube name ' b'"),               # the reader strips cells
+    (("a", ("x", "y"), "c"), (1, 2, 3, 4), r"tube name \('x', 'y'\)"),  # a tuple other than (u, v)
+    (("a", "b", "c"), (1, 2, "3", 4), "node name '3'"),
+    (("a", "b", "c"), (1, 2, 3.5, 4), "node name 3.5"),
+    (("a", "b", "c"), (1, 2, "3.0", 4), "node name '3.0'"),            # reads back as the node 3
+])
+def test_names_the_table_would_read_back_as_others_are_refused(tmp_path, names, nodes, what):
+    with pytest.raises(InvalidParameterError, match=what):
+        network_io.write_network_table(_openbf_y(names=names, nodes=nodes), tmp_path / "x.csv")
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.lists(st.text(min_size=1, max_size=8), min_size=3, max_size=3, unique=True))
+def test_any_text_name_reads_back_or_is_refused(tmp_path_factory, names):
+    """The contract of the table's names: written and read back as the same name, or refused
+    with an InvalidParameterError naming it; never another name."""
+    net = _openbf_y(names=tuple(names))
+    path = tmp_path_factory.mktemp("names") / "n.csv"
+    try:
+        network_io.write_network_table(net, path)
+    except InvalidParameterError as err:
+        assert "tube name" in str(err)
+        return
+    assert tubefsi.read_network_table(path, rheology=NEWTONIAN).tube_names == names
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.lists(st.one_of(st.text(min_size=1, max_size=6), st.integers(-10**6, 10**6)), min_size=4, max_size=4,
+                unique=True))
+def test_any_node_name_reads_back_or_is_refused(tmp_path_factory, nodes):
+    """The same contract for node names (text or integers; "nan" once read back as an empty
+    cell)."""
+    net = _openbf_y(nodes=tuple(nodes))
+    path = tmp_path_factory.mktemp("nodes") / "n.csv"
+    try:
+        network_io.write_network_table(net, path)
+    except InvalidParameterError as err:
+        assert "node name" in str(err)
+        return
+    assert tubefsi.read_network_table(path, rheology=NEWTONIAN).nodes == nodes
+
+
+def test_a_linear_thickness_along_a_taper_round_trips_through_the_table(tmp_path):
+    """A Tube.tapered with a linear thickness could not be written by default ("a constant wall
+    thickness (got array of shape (2,))"), and thickness=False read it back with the empirical
+    thickness (inlet pressure 1965.9 -> 1983.9 Pa) without a word. Now h(m) and hd(m) hold the two
+    ends, a taper whose thickness is the empirical one of its radius keeps an empty h cell (the
+    reader's rule), and thickness=False warns."""
+    wall = network_io.openbf_wall(4e5)
+    net = tubefsi.Network(rheology=NEWTONIAN)
+    net.add_tube(1, 2, wall, tubefsi.Tube.tapered(length=0.1, radius=4e-3, outlet_radius=2e-3, thickness=6e-4,
+                                                 outlet_thickness=4e-4), name="linear")
+    net.add_tube(2, 3, wall, tubefsi.Tube(length=0.1, radius=sampled_linear(2e-3, 1.5e-3, 0.1),
+                                          thickness=tubefsi.Profile(network_io._ThicknessOf(
+                                              network_io.empirical_thickness, 2e-3, 1.5e-3, 0.1))), name="empirical")
+    net.add_tube(2, 4, wall, tubefsi.Tube(length=0.05, radius=1e-3, thickness=3e-4), name="uniform")
+    net.set_resistance(3, 1e9).set_resistance(4, 2e9)
+    columns = network_io.network_table(net)
+    assert columns["h(m)"] == [6e-4, None, 3e-4] and columns["hd(m)"] == [4e-4, None, None]
+    again = tubefsi.read_network_table(network_io.write_network_table(net, tmp_path / "t.csv"), rheology=NEWTONIAN)
+    _same_solve(net, again, 1, 1)
+    assert network_io.network_table(again) == columns
+    with pytest.warns(UserWarning, match="tube 'linear'"):
+        network_io.network_table(net, thickness=False)
+
+
+def sampled_linear(a0, a1, length):
+    return tubefsi.sampled([0.0, length], [a0, a1], kind="linear")
+
+
+@pytest.mark.parametrize("graded, field", [("thickness", "thickness"), ("modulus", "wall youngs_modulus")])
+def test_a_profile_the_files_cannot_hold_is_refused_or_warned(tmp_path, graded, field):
+    """A thickness neither linear nor empirical along the tube, or a modulus that varies along
+    it: the table refuses it (naming the tube and the field), a .vtp read back warns (it holds
+    the two ends only). A graded modulus once raised a plain TypeError from float()."""
+    net = tubefsi.Network(rheology=NEWTONIAN)
+    if graded == "thickness":
+        wall = network_io.openbf_wall(4e5)
+        tube = tubefsi.Tube(length=0.1, radius=2e-3, thickness=tubefsi.Profile(
+            lambda z: 2e-4 * (1 + 100 * np.asarray(z) ** 2)))
+    else:
+        wall = network_io.openbf_wall(tubefsi.sampled([0.0, 0.1], [4e5, 2e5], kind="linear"))
+        tube = tubefsi.Tube(length=0.1, radius=2e-3, thickness=2e-4)
+    net.add_tube(1, 2, wall, tube, name="bulge")
+    with pytest.raises(InvalidParameterError, match=f"tube 'bulge', {field}"):
+        network_io.network_table(net)
+    path = network_io.write_vtp(net, tmp_path / "b.vtp")
+    with pytest.warns(UserWarning, match="cell 0"):
+        network_io.read_vtp(path, rheology=NEWTONIAN)
+
+
+def test_vtp_keeps_numpy_integer_nodes_z_and_the_empirical_taper(tmp_path):
+    """NumPy integer node names were not counted as integers (no node array: reading renumbered
+    from 0, and set_inflow(1, q) landed on the old node 2); z was dropped; a taper with the
+    empirical thickness came back with a linear one (the inlet pressure off by 1.3e-5)."""
+    txt = "Name,sn,tn,l(m),Rp(m),Rd(m),E(Pa),R1\na,1,2,0.1,0.004,0.002,400000,0\nb,2,3,0.1,0.002,0.002,400000,1e9\n"
+    (tmp_path / "tap.csv").write_text(txt, encoding="utf-8")
+    net = tubefsi.read_network_table(tmp_path / "tap.csv", rheology=NEWTONIAN)
+    back = network_io.read_vtp(network_io.write_vtp(net, tmp_path / "tap.vtp"), rheology=NEWTONIAN)
+    ra = net.set_inflow(1, 2e-6).solve()
+    rb = back.set_inflow(1, 2e-6).solve()
+    assert back.nodes == [1, 2, 3]
+    np.testing.assert_allclose(rb.pressures, ra.pressures, rtol=1e-13, atol=0)
+    wall, tube = network_io.openbf_wall(2e5), tubefsi.Tube(radius=1e-3, thickness=2e-4, length=0.05)
+    npnet = tubefsi.Network(rheology=NEWTONIAN)
+    for u, v in np.array([[1, 2], [2, 3], [2, 4]]):
+        npnet.add_tube(u, v, wall, tube)
+    npnet.set_pressure(np.int64(3), 0.0).set_pressure(np.int64(4), 0.0)
+    for node, xyz in zip(npnet.nodes, [(0, 0, 0), (1, 0, 0), (2, 1, 0.5), (2, -1, -0.5)]):
+        npnet.set_position(node, xyz)
+    again = network_io.read_vtp(network_io.write_vtp(npnet, tmp_path / "np.vtp"), rheology=NEWTONIAN)
+    assert again.nodes == [1, 2, 3, 4] and again._pressure == {3: 0.0, 4: 0.0}
+    assert again.positions[3] == (2.0, 1.0, 0.5)
+    _same_solve(npnet, again, 1, 1)
+
+
+@pytest.mark.parametrize("node, value", [("1.5 1.7 3", "1.5"), ("nan 1 3", "nan"), ("1 1 3", "1")])
+def test_a_bad_node_array_names_the_file_array_and_point(tmp_path, node, value):
+    """A non-integer node array was truncated (1.5 and 1.7 -> 1), NaN became -2**63."""
+    net = _openbf_y().set_pressure(1, 100.0).set_pressure(3, 0.0).set_pressure(4, 0.0)
+    text = (network_io.write_vtp(net, tmp_path / "y.vtp") and (tmp_path / "y.vtp").read_text())
+    root = ET.fromstring(text)
+    array = next(a for a in root.iter("DataArray") if a.get("Name") == "node")
+    array.attrib.update(format="ascii", type="Float64")
+    array.text = node + " 4"
+    (tmp_path / "bad.vtp").write_bytes(ET.tostring(root))
+    with pytest.raises(InvalidParameterError, match=rf"bad.vtp, point \d, point data 'node'.*got {value}"):
+        network_io.read_vtp(tmp_path / "bad.vtp", rheology=NEWTONIAN)
+
+
+def test_bad_boundary_data_in_a_vtp_names_the_file_and_point(tmp_path):
+    net = _openbf_y().set_pressure(1, 100.0).set_pressure(3, 0.0).set_pressure(4, 0.0)
+    root = ET.fromstring((tmp_path / "y.vtp").read_text() if network_io.write_vtp(net, tmp_path / "y.vtp") else "")
+    array = next(a for a in root.iter("DataArray") if a.get("Name") == "fixed_pressure")
+    array.attrib.update(format="ascii", type="Float64")
+    array.text = "100 nan -5 0"
+    (tmp_path / "bad.vtp").write_bytes(ET.tostring(root))
+    with pytest.raises(InvalidParameterError, match=r"bad.vtp, point 2 \(node 3\), point data 'fixed_pressure'"):
+        network_io.read_vtp(tmp_path / "bad.vtp", rheology=NEWTONIAN)
+    with pytest.raises(InvalidParameterError, match="path must be a file that can be written"):
+        network_io.write_vtp(net, tmp_path / "missing" / "y.vtp")
+    with pytest.raises(InvalidParameterError, match="path must be a file that can be written"):
+        network_io.write_network_table(net, tmp_path / "missing" / "y.csv")
+
+
+def test_pandas_read_csv_of_adan56_reads_as_the_file():
+    """pd.read_csv(adan56()) was refused for its empty "Unnamed: 13" column (openBF's rows end
+    with a comma); node ids a DataFrame holds as floats (1.0) became the text '1.0'."""
+    pd = pytest.importorskip("pandas")
+    frame = pd.read_csv(datasets.adan56())
+    assert any(str(c).startswith("Unnamed") for c in frame.columns)
+    from_frame = tubefsi.read_network_table(frame, rheology=NEWTONIAN, taper="mean")
+    from_file = tubefsi.read_network_table(datasets.adan56(), rheology=NEWTONIAN, taper="mean")
+    assert network_io.network_table(from_frame) == network_io.network_table(from_file)
+    floats = frame.astype({c: float for c in frame.columns if c.strip() in ("sn", "tn")})
+    assert tubefsi.read_network_table(floats, rheology=NEWTONIAN, taper="mean").nodes == from_file.nodes
+
+
+def test_to_networkx_and_back_keeps_the_names():
+    pytest.importorskip("networkx")
+    net = _openbf_y(names=("a", None, ("x", 1))).set_inflow(1, 1e-6).set_pressure(3, 0.0)
+    net.set_resistance(4, 1e9, distal_pressure=50.0)
+    again = tubefsi.Network.from_networkx(net.to_networkx(), rheology=NEWTONIAN)
+    assert again.tube_names == ["a", (2, 3), ("x", 1)]
+    np.testing.assert_array_equal(again.solve().pressures, net.solve().pressures)
+
+
+def test_xarray_keeps_numpy_integer_node_names():
+    pytest.importorskip("xarray")
+    net = tubefsi.Network(rheology=NEWTONIAN)
+    for u, v in np.array([[1, 2], [2, 3]]):
+        net.add_tube(u, v, "rigid", tubefsi.Tube(radius=1e-3, thickness=2e-4, length=0.05))
+    data = net.set_pressure(np.int64(1), 10.0).set_pressure(np.int64(3), 0.0).solve().to_xarray()
+    assert data["node"].dtype.kind == "i" and data["node"].values.tolist() == [1, 2, 3]
+    assert data["u"].dtype.kind == "i"
+
+
+def test_a_point_that_is_not_finite_names_the_file_and_point(tmp_path):
+    net = _openbf_y().set_pressure(1, 100.0).set_pressure(3, 0.0).set_pressure(4, 0.0)
+    root = ET.fromstring((tmp_path / "y.vtp").read_text() if network_io.write_vtp(net, tmp_path / "y.vtp") else "")
+    points = root.find("PolyData/Piece/Points/DataArray")
+    points.attrib.update(format="ascii", type="Float64")
+    points.text = "0 0 0  1 0 0  2 nan 0  2 -1 0"
+    (tmp_path / "bad.vtp").write_bytes(ET.tostring(root))
+    with pytest.raises(InvalidParameterError, match=r"bad.vtp, point 2, Points must be finite coordinates"):
+        network_io.read_vtp(tmp_path / "bad.vtp", rheology=NEWTONIAN)
+
+
+def test_a_node_written_as_a_float_is_the_integer_node(tmp_path):
+    """A file that writes node 2 as "2.0" in one row (a spreadsheet's habit) had the nodes 2 and
+    '2.0', two nodes where the table means one: the tree came apart silently."""
+    text = "Name,sn,tn,l(m),Rp(m),E(Pa),R1\na,1,2,0.1,0.001,4e5,0\nb,2.0,3,0.1,0.001,4e5,1e9\n"
+    net = tubefsi.read_network_table(_write(tmp_path / "f.csv", text), rheology=NEWTONIAN)
+    assert net.nodes == [1, 2, 3]
+
+
+def _write(path, text):
+    path.write_text(text, encoding="utf-8")
+    return path

@@ -19,7 +19,7 @@ license in ``src/tubefsi/data/README.md``). ``tubefsi.read_network_table`` makes
 
 39 of the vessels taper (:math:`R_p \\ne R_d`); here each is the uniform tube of its mean
 radius (``taper="mean"``). The linear tapers (the default) are graded edges, integrated along
-their length at every Newton step: 13–20 s for this network with Newtonian blood, and the
+their length at every Newton step: about 100 s of CPU for this network with Newtonian blood, and the
 root pressure moves by 0.01 % (``docs/network.md``, "ADAN56").
 
 The mean pressure at the root comes out near 76 mmHg, close to the parallel resistance of the

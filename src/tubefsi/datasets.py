@@ -16,7 +16,8 @@ __all__ = ["adan56"]
 
 def adan56() -> Path:
     r"""The path of the ADAN56 arterial network's table (CSV): 77 vessels between 78 nodes,
-    the aortic root at node 1, 39 terminal vessels with a three-element Windkessel (R1, R2, C);
+    the aortic root at node 1, 31 terminal vessels with a three-element Windkessel (R1, R2, C),
+    39 tapered vessels (``Rp != Rd``);
     ``tubefsi.read_network_table(adan56(), rheology=..., wall=...)`` makes the network.
 
     Blanco PJ, Watanabe SM, Passos MA, Lemos PA, Feijóo RA, "An anatomically detailed arterial

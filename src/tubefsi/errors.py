@@ -157,6 +157,9 @@ class ConvergenceError(TubefsiError, ArithmeticError):
 
 
 def _short(value) -> str:
+    if isinstance(value, (tuple, list)):      # a name such as ("in", "j"), a list of columns: as written
+        text = repr(value)
+        return text if len(text) <= 60 else text[:57] + "..."
     try:
         a = np.asarray(value)
     except Exception:          # noqa: BLE001 (a ragged list: the error must still be raised, with its words)

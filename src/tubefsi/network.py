@@ -7,6 +7,7 @@ evaluation of its tubes by groups in :mod:`tubefsi.network_groups`, its results 
 from __future__ import annotations
 
 import copy
+import itertools
 import operator
 from collections.abc import Hashable
 
@@ -81,6 +82,11 @@ class Network:
         from ``v`` to ``u`` is that of the tube read from ``v`` (``docs/network.md``, "Graded
         tubes").
         """
+        for label, node in (("u", u), ("v", v)):
+            if not _hashable(node):
+                raise InvalidParameterError(label, "a hashable node name (a number, text, a tuple...)", node)
+        if name is not None and not _hashable(name):
+            raise InvalidParameterError("name", "a hashable name (a number, text, a tuple...)", name)
         name = (u, v) if name is None else name
         if u == v:
             raise InvalidParameterError("v", "a node other than u", v, "a tube joins two distinct nodes")
@@ -124,8 +130,10 @@ class Network:
         """
         u, v = _names_of("u", u), _names_of("v", v)
         n = len(u)
-        if n == 0 or len(v) != n:
-            raise InvalidParameterError("v", f"a sequence as long as u ({n} >= 1 node names)", len(v))
+        if n == 0:
+            raise InvalidParameterError("u", "a sequence of at least one node name", u)
+        if len(v) != n:
+            raise InvalidParameterError("v", f"a sequence of {n} node names, as long as u", None, f"it has {len(v)}")
         names = list(zip(u, v)) if names is None else _names_of("names", names)
         if len(names) != n:
             raise InvalidParameterError("names", f"{n} names, one per tube", len(names))
@@ -153,11 +161,12 @@ class Network:
         wall, tube, fluid = models
         p_e = as_array("external_pressure", external_pressure, "the real numbers", np.isfinite)
         if p_e.shape not in ((), (n,)):
-            raise InvalidParameterError("external_pressure", f"a number or an array of length {n}", p_e.shape)
+            raise InvalidParameterError("external_pressure", f"a number or an array of length {n}", p_e)
         p_e = np.broadcast_to(p_e.astype(float), (n,))
         shared = parameter_shape(wall) == parameter_shape(tube) == parameter_shape(fluid) == ()
         nodes = self._nodes
-        fresh = [node for node in dict.fromkeys(u + v) if node not in nodes]
+        # new nodes in order of first appearance, u[0], v[0], u[1], ... as add_tube adds them
+        fresh = [node for node in dict.fromkeys(itertools.chain.from_iterable(zip(u, v))) if node not in nodes]
         nodes.update(zip(fresh, range(len(nodes), len(nodes) + len(fresh))))
         # one batch of columns: no Python object per tube (a tube is made when asked for by name)
         self._tubes.add(names, u, v, wall, tube, fluid, p_e, None if shared else np.arange(n))
@@ -169,7 +178,7 @@ class Network:
         boundary condition and position."""
         t = self._tubes.pop(name, None) if _hashable(name) else None
         if t is None:
-            raise InvalidParameterError("name", "the name of a tube of the network", name)
+            raise InvalidParameterError("name", "a name of one of the network's tubes", name)
         u, v = self._tubes.ends()
         used = set(u).union(v)
         gone = [node for node in (t.u, t.v) if node not in used]
@@ -247,7 +256,7 @@ class Network:
         array = as_array(label, values, admissible, check)
         if array.shape not in ((), (len(nodes),)):
             raise InvalidParameterError(label, f"a number or an array of length {len(nodes)} (one per node)",
-                                        array.shape)
+                                        array)
         return nodes, np.broadcast_to(array.astype(float), (len(nodes),)).tolist()
 
     def _free_of_all(self, nodes, kind):
@@ -265,13 +274,23 @@ class Network:
                              ("resistance", self._resistance)):
             if other != kind and _hashable(node) and node in store:
                 raise InvalidParameterError("node", "a node with one boundary condition: a pressure, an inflow or "
-                                            "a resistance", node, f"it has a {'fixed ' if other == 'pressure' else ''}"
-                                            f"{other} already")
+                                            "a resistance", node, f"it has {'a fixed' if other == 'pressure' else 'an'}"
+                                            f" {other} already")
 
     @checked_keywords
     def set_position(self, node: Hashable, xy: tuple[float, float]) -> Network:
-        """Place ``node`` at ``xy = (x, y)`` for the plot."""
-        self.positions[node] = (float(xy[0]), float(xy[1]))
+        """Place ``node`` at ``xy = (x, y)`` or ``(x, y, z)`` (m, finite) for the plot (which draws
+        x and y) and the ``.vtp`` file. A node may be placed before its tubes are added; the
+        position of a node that is in no tube is not used."""
+        if not _hashable(node):
+            raise InvalidParameterError("node", "a hashable node name", node)
+        try:
+            point = np.asarray(xy, dtype=float)
+        except (TypeError, ValueError):
+            point = None
+        if point is None or point.shape not in ((2,), (3,)) or not np.all(np.isfinite(point)):
+            raise InvalidParameterError("xy", "a point (x, y) or (x, y, z) of finite numbers (m)", xy)
+        self.positions[node] = tuple(point.tolist())
         return self
 
     @property
@@ -293,8 +312,9 @@ class Network:
         resistance outlet, :meth:`set_resistance`). Each keyword names the attribute to read (``fluid``:
         the edge attribute holding a tube's rheology, ``"rheology"`` by default).
 
-        Edges run from the first node to the second as networkx lists them; a multigraph's
-        tubes are named ``(u, v, key)``.
+        Edges run from the first node to the second as networkx lists them; a tube is named by
+        the edge attribute ``name`` where there is one (as :meth:`to_networkx` writes it), else
+        ``(u, v, key)`` in a multigraph and ``(u, v)`` in a graph.
         """
         net = cls(rheology=rheology)
         multi = graph.is_multigraph()
@@ -303,7 +323,8 @@ class Network:
             for attr in (wall, tube):
                 if attr not in data:
                     raise InvalidParameterError(f"edge ({u!r}, {v!r})", f"an edge with a {attr!r} attribute", data)
-            net.add_tube(u, v, data[wall], data[tube], name=(u, v, key) if multi else None,
+            name = data["name"] if "name" in data else (u, v, key) if multi else None
+            net.add_tube(u, v, data[wall], data[tube], name=name,
                          rheology=data.get(fluid), external_pressure=data.get("external_pressure", 0.0))
         for node, data in graph.nodes(data=True):
             if pressure in data:
@@ -317,8 +338,8 @@ class Network:
         return net
 
     def to_networkx(self):
-        """A ``networkx.MultiDiGraph`` (keys: the tube names) with the same attributes that
-        :meth:`from_networkx` reads."""
+        """A ``networkx.MultiDiGraph`` (keys and the edge attribute ``name``: the tube names) with
+        the same attributes that :meth:`from_networkx` reads (which gives the same names back)."""
         import networkx as nx
 
         graph = nx.MultiDiGraph()
@@ -335,7 +356,7 @@ class Network:
             graph.add_node(node, **data)
         for t in self._tubes.values():
             wall, tube, fluid = t.models()
-            graph.add_edge(t.u, t.v, key=t.name, wall=wall, tube=tube, rheology=fluid,
+            graph.add_edge(t.u, t.v, key=t.name, name=t.name, wall=wall, tube=tube, rheology=fluid,
                            external_pressure=t.external_pressure)
         return graph
 
@@ -371,8 +392,10 @@ class Network:
             ``rtol`` times the throughput; the warning gives the balance reached.
         """
         rtol = as_scalar("rtol", rtol, "[1e-15, 1)", lambda a: (a >= 1e-15) & (a < 1))
-        if isinstance(max_iterations, bool) or not isinstance(max_iterations, int) or max_iterations < 1:
-            raise InvalidParameterError("max_iterations", "the integers >= 1", max_iterations)
+        if isinstance(max_iterations, (bool, np.bool_)) or not isinstance(max_iterations, (int, np.integer)) \
+                or max_iterations < 1:
+            raise InvalidParameterError("max_iterations", "an integer >= 1", max_iterations)
+        max_iterations = int(max_iterations)
         start = _initial_pressures(initial)
         solver = _Solver(self._snapshot())
         shown = bar(max_iterations, progress, "tubefsi.Network.solve", unit="Newton step")
@@ -455,7 +478,7 @@ def _names_of(label, values) -> list:
     """Node or tube names given as a sequence or an array, as a list of plain Python objects."""
     if isinstance(values, np.ndarray):
         if values.ndim != 1:
-            raise InvalidParameterError(label, "a 1-D sequence of names", values.shape)
+            raise InvalidParameterError(label, "a 1-D sequence of names", values)
         return values.tolist()
     if isinstance(values, (str, bytes)) or not hasattr(values, "__len__"):
         raise InvalidParameterError(label, "a sequence of names (a list or a 1-D array)", values)

@@ -31,7 +31,7 @@ from scipy.sparse import csgraph
 
 from ._keywords import checked_keywords
 from ._validation import as_array
-from .errors import InvalidParameterError
+from .errors import InvalidParameterError, warn_user
 from .geometry import Tube
 from .network import Network
 from .network_solution import NetworkSolution
@@ -53,11 +53,12 @@ _COLUMNS = {
     "wkn": (None, False, None), "m": (None, False, None), "c": ("m^3/pa", False, None),
     "l": ("m", True, None), "rp": ("m", True, None), "rd": ("m", False, None), "e": ("pa", False, None),
     "h": ("m", False, None), "pext": ("pa", False, 0.0), "r1": ("pas/m^3", False, 0.0),
-    "r2": ("pas/m^3", False, 0.0),
+    "r2": ("pas/m^3", False, 0.0), "hd": ("m", False, None), "pd": ("pa", False, None),
 }
 #: the spellings of a unit that are read as the SI unit above
 _UNIT_SPELLINGS = {"pas/m3": "pas/m^3", "pa.s/m^3": "pas/m^3", "pa*s/m^3": "pas/m^3", "m3/pa": "m^3/pa"}
-#: the header the writer writes (openBF's, with an optional thickness column h(m) after E(Pa))
+#: the header the writer writes (openBF's, with the optional thickness columns h(m), hd(m) after E(Pa)
+#: and the optional distal pressure Pd(Pa) of a resistance outlet at the end)
 _HEADER = ("Name", "sn", "tn", "wkn", "l(m)", "M", "Rp(m)", "Rd(m)", "E(Pa)", "Pext", "R1", "R2", "C")
 
 
@@ -98,6 +99,12 @@ def _check_openbf_walls(network):
                 f"tube {tubes.names[int(index[0])]!r}", "openBF's wall, walls['thin-linear'] with poisson_ratio=0.5 (the table "
                 "keeps only E and h, and reading it makes that wall: another wall would come back as a "
                 "different tube law; write_vtp writes any network, for viewing)", wall)
+        if np.any(np.asarray(wall.end_condition) == "open"):
+            # closed and clamped ends agree at poisson_ratio 1/2 (K = 3/4); open ends (K = 1) do not
+            raise InvalidParameterError(
+                f"tube {tubes.names[int(index[0])]!r}, wall end_condition", "'closed' or 'clamped' (the same tube law "
+                "at poisson_ratio=0.5, the one the table's reader makes; open ends are another tube law the table "
+                "cannot hold)", str(wall.end_condition))
 
 
 def _wall_maker(wall):
@@ -127,7 +134,7 @@ class _Table:
             raw = str(raw).strip()
             if key not in _COLUMNS:
                 raise InvalidParameterError(f"{source}, column {raw!r}", f"one of the table's columns "
-                                            f"({', '.join(_HEADER)}, h(m))", raw)
+                                            f"({', '.join(_HEADER)}, h(m), hd(m), Pd(Pa))", raw)
             expected = _COLUMNS[key][0]
             if unit is not None and _UNIT_SPELLINGS.get(unit, unit) != expected:
                 raise InvalidParameterError(f"{source}, column {raw!r}", f"SI units ({expected or 'none'})", raw)
@@ -143,9 +150,10 @@ class _Table:
         return InvalidParameterError(f"{self.source}, {self.where[k]}, column {self.spelled[key]!r}", admissible,
                                      value)
 
-    def numbers(self, key, admissible, predicate, default=None):
-        """Column ``key`` as floats (a missing or empty cell takes ``default``); the first cell
-        that is no number or fails ``predicate`` is an error naming its row and column."""
+    def numbers(self, key, admissible, predicate, default=None, empty=False):
+        """Column ``key`` as floats (a missing or empty cell takes ``default``; with ``empty``
+        an empty cell is NaN); the first cell that is no number or fails ``predicate`` is an
+        error naming its row and column."""
         cells = self.columns.get(key)
         n = len(self.where)
         if cells is None:
@@ -158,10 +166,15 @@ class _Table:
             values = None
         if values is not None and values.shape == (n,) and not np.any(np.isnan(values)):
             return self._checked(key, cells, values, admissible, predicate)
+        if values is not None and values.shape == (n,) and empty:     # (a DataFrame's empty cells: NaN)
+            return self._checked(key, cells, values, admissible, predicate, empty=True)
         values = np.empty(n)
         for k, cell in enumerate(cells):            # a cell is text (a file) or a number (a DataFrame)
             text = cell.strip() if isinstance(cell, str) else cell
             if text == "" or text is None or (isinstance(text, float) and math.isnan(text)):
+                if empty:
+                    values[k] = math.nan
+                    continue
                 if default is None:
                     raise self.error(key, k, admissible, "an empty cell")
                 values[k] = default
@@ -170,19 +183,24 @@ class _Table:
                 values[k] = float(text)
             except (TypeError, ValueError):
                 raise self.error(key, k, admissible, text) from None
-        return self._checked(key, cells, values, admissible, predicate)
+        return self._checked(key, cells, values, admissible, predicate, empty)
 
-    def _checked(self, key, cells, values, admissible, predicate):
-        """``values``, or the error naming the first cell that is not finite or fails ``predicate``."""
+    def _checked(self, key, cells, values, admissible, predicate, empty=False):
+        """``values``, or the error naming the first cell that is not finite or fails ``predicate``
+        (with ``empty``, NaN is an empty cell: allowed)."""
         with np.errstate(invalid="ignore"):
             bad = ~(np.isfinite(values) & predicate(values))
+        if empty:
+            bad &= ~np.isnan(values)
         if np.any(bad):
             k = int(np.flatnonzero(bad)[0])
             raise self.error(key, k, admissible, cells[k].strip() if isinstance(cells[k], str) else cells[k])
         return values
 
-    def names(self, key):
-        """Column ``key`` as node or vessel names: integers where a cell is one, else its text."""
+    def names(self, key, empty=False):
+        """Column ``key`` as node or vessel names: integers where a cell is one (an integral
+        float of a DataFrame, or the text "1.0" of a file, included: 1.0 -> 1), else its text; with ``empty``, an empty cell
+        is None."""
         cells = self.columns[key]
         if all(isinstance(c, str) for c in cells):     # a file's column: integers at once where all are
             text = np.char.strip(np.array(cells, dtype=str))
@@ -195,11 +213,23 @@ class _Table:
             if isinstance(cell, (int, np.integer)) and not isinstance(cell, bool):
                 out.append(int(cell))
                 continue
+            if isinstance(cell, (float, np.floating)) and math.isfinite(cell) and float(cell).is_integer():
+                out.append(int(cell))
+                continue
             text = str(cell).strip() if cell is not None else ""
-            if text == "" or text == "nan":
+            if text == "" or (isinstance(cell, (float, np.floating)) and math.isnan(cell)):   # (a DataFrame's NaN)
+                if empty:
+                    out.append(None)
+                    continue
                 raise self.error(key, k, "a name (not empty)", "an empty cell")
-            out.append(int(text) if re.fullmatch(r"[+-]?\d+", text) else text)
+            integer = _INTEGER.fullmatch(text)        # "2" and "2.0" are the node 2
+            out.append(int(integer.group(1)) if integer else text)
         return out
+
+
+#: a cell that names an integer node or vessel: digits, and a point with zeros only ("2.0", as a
+#: spreadsheet writes an integer)
+_INTEGER = re.compile(r"([+-]?\d+)(?:\.0*)?")
 
 
 def _column_key(raw):
@@ -241,11 +271,25 @@ def _read_csv(path):
 
 
 def _read_frame(frame):
+    """A DataFrame's table; the empty ``Unnamed: N`` columns pandas makes of a trailing
+    delimiter (``pandas.read_csv`` of openBF's rows, which end with a comma) are dropped."""
     header = [str(c) for c in frame.columns]
     rows = [list(r) for r in frame.itertuples(index=False, name=None)]
+    keep = [j for j, name in enumerate(header)
+            if not (re.fullmatch(r"Unnamed: \d+", name) and all(_blank(row[j]) for row in rows))]
+    header, rows = [header[j] for j in keep], [[row[j] for j in keep] for row in rows]
     if not rows:
         raise InvalidParameterError("DataFrame", "a table with at least one row", "no rows")
     return _Table("DataFrame", header, rows, [f"row {k}" for k in range(len(rows))])
+
+
+def _blank(cell) -> bool:
+    """Whether a DataFrame cell is empty (None, NaN or blank text)."""
+    if cell is None:
+        return True
+    if isinstance(cell, str):
+        return cell.strip() == ""
+    return isinstance(cell, (float, np.floating)) and math.isnan(cell)
 
 
 @checked_keywords
@@ -260,16 +304,21 @@ def read_network_table(source, *, rheology=None, wall=None, thickness=None, dist
         must be the SI one given here):
 
         ============  ==============================================================
-        ``Name``      the vessel's (tube's) name
+        ``Name``      the vessel's (tube's) name (an empty cell: the default ``(sn, tn)``)
         ``sn, tn``    source and target node (integers stay integers)
         ``l(m)``      length
         ``Rp(m)``     proximal (inlet) radius
         ``Rd(m)``     distal radius (optional: ``Rp``)
         ``E(Pa)``     elastic modulus (needed by the default wall)
-        ``h(m)``      wall thickness (optional: :func:`empirical_thickness`, or ``thickness``)
+        ``h(m)``      wall thickness (optional: :func:`empirical_thickness`, or ``thickness``;
+                      an empty cell: that rule for this vessel)
+        ``hd(m)``     distal wall thickness (optional, with ``h(m)``: a thickness running
+                      linearly from ``h`` to ``hd``; an empty cell: ``h``)
         ``Pext``      external pressure (Pa, optional: 0)
         ``R1, R2``    terminal resistances (Pa s/m^3, optional: 0); ``R1 + R2 > 0`` makes
                       ``tn`` a resistance outlet, :meth:`~tubefsi.Network.set_resistance`
+        ``Pd(Pa)``    the distal pressure of the vessel's resistance outlet (optional: the
+                      keyword ``distal_pressure``; an empty cell too)
         ``C``         terminal compliance (m^3/Pa): ignored, it carries no flow at steady state
         ``wkn, M``    openBF's Windkessel label and mesh points: ignored
         ============  ==============================================================
@@ -319,8 +368,9 @@ def read_network_table(source, *, rheology=None, wall=None, thickness=None, dist
         raise InvalidParameterError("distal_pressure", "a finite number (Pa), one for every outlet", distal_pressure)
     p_d = float(p_d)
 
-    names = table.names("name")
     sn, tn = table.names("sn"), table.names("tn")
+    # an empty Name is the default name (sn, tn), as add_tube gives it
+    names = [(a, b) if name is None else name for name, a, b in zip(table.names("name", empty=True), sn, tn)]
     length = table.numbers("l", "(0, inf) m", lambda a: a > 0)
     rp = table.numbers("rp", "(0, inf) m", lambda a: a > 0)
     rd = table.numbers("rd", "(0, inf) m", lambda a: a > 0) if "rd" in table.columns else rp.copy()
@@ -329,10 +379,17 @@ def read_network_table(source, *, rheology=None, wall=None, thickness=None, dist
                                     "or give wall=)", list(table.spelled.values()))
     modulus = table.numbers("e", "(0, inf) Pa", lambda a: a > 0) if "e" in table.columns else \
         np.full(len(names), math.nan)
-    h = table.numbers("h", "(0, inf) m", lambda a: a > 0) if "h" in table.columns else None
+    # h(m): the (proximal) thickness, an empty cell the rule's; hd(m): the distal one, an empty
+    # cell h's (or the rule's where h is empty)
+    h = table.numbers("h", "(0, inf) m", lambda a: a > 0, empty=True) if "h" in table.columns else None
+    hd = table.numbers("hd", "(0, inf) m", lambda a: a > 0, empty=True) if "hd" in table.columns else None
+    if hd is not None and h is None:
+        raise InvalidParameterError(table.source, "a column h(m) with the column hd(m) (hd is the distal thickness)",
+                                    list(table.spelled.values()))
     p_ext = table.numbers("pext", "finite numbers (Pa)", lambda a: a == a, default=0.0)
     r1 = table.numbers("r1", "[0, inf) Pa s/m^3", lambda a: a >= 0, default=0.0)
     r2 = table.numbers("r2", "[0, inf) Pa s/m^3", lambda a: a >= 0, default=0.0)
+    pd = table.numbers("pd", "finite numbers (Pa)", lambda a: a == a, empty=True) if "pd" in table.columns else None
     seen = {}
     for k, (name, a, b) in enumerate(zip(names, sn, tn)):
         if a == b:
@@ -343,11 +400,18 @@ def read_network_table(source, *, rheology=None, wall=None, thickness=None, dist
     rule = empirical_thickness if thickness is None else thickness
     if taper == "mean":
         rp = rd = 0.5 * (rp + rd)
-    tapered = rp != rd
-    h0 = np.asarray(rule(rp), dtype=float) if h is None else h
-    if h is None and not np.all(np.isfinite(h0) & (h0 > 0)):
+    by_rule = np.ones(len(names), dtype=bool) if h is None else np.isnan(h)
+    if hd is None:
+        hd = np.full(len(names), math.nan)
+    h0 = np.asarray(rule(rp), dtype=float) if h is None else np.where(by_rule, np.asarray(rule(rp), dtype=float), h)
+    if np.any(by_rule) and not np.all(np.isfinite(h0) & (h0 > 0)):
         k = int(np.flatnonzero(~(np.isfinite(h0) & (h0 > 0)))[0])
         raise table.error("rp", k, "a radius whose thickness(radius) is a positive number", rp[k])
+    if np.any(by_rule & ~np.isnan(hd)):
+        k = int(np.flatnonzero(by_rule & ~np.isnan(hd))[0])
+        raise table.error("hd", k, "an empty cell where h(m) is empty (the thickness rule's vessel)", hd[k])
+    h1 = np.where(np.isnan(hd), h0, hd)            # the distal thickness of a vessel whose h is given
+    tapered = (rp != rd) | (~by_rule & (h1 != h0))
 
     net = Network(rheology=rheology)
     # runs of consecutive rows, uniform or tapered: the uniform ones in one add_tubes each (the
@@ -360,19 +424,29 @@ def read_network_table(source, *, rheology=None, wall=None, thickness=None, dist
                           names=[names[k] for k in run], external_pressure=p_ext[run])
             continue
         for k in run:
-            radius = sampled([0.0, length[k]], [rp[k], rd[k]], kind="linear")
-            wall_thickness = float(h[k]) if h is not None else Profile(_ThicknessOf(rule, rp[k], rd[k], length[k]))
+            ends = [0.0, length[k]]
+            radius = sampled(ends, [rp[k], rd[k]], kind="linear") if rp[k] != rd[k] else float(rp[k])
+            if by_rule[k]:
+                wall_thickness = Profile(_ThicknessOf(rule, rp[k], rd[k], length[k]))
+            elif h1[k] != h0[k]:
+                wall_thickness = sampled(ends, [h0[k], h1[k]], kind="linear")
+            else:
+                wall_thickness = float(h0[k])
             net.add_tube(sn[k], tn[k], make_wall(float(modulus[k]), float(h0[k]), float(rp[k])),
                          Tube(radius=radius, thickness=wall_thickness, length=float(length[k])), name=names[k],
                          external_pressure=float(p_ext[k]))
     terminal = np.flatnonzero(r1 + r2 > 0)
+    if pd is not None and np.any(~np.isnan(pd) & (pd != 0) & (r1 + r2 == 0)):
+        k = int(np.flatnonzero(~np.isnan(pd) & (pd != 0) & (r1 + r2 == 0))[0])
+        raise table.error("pd", k, "0 or empty on a vessel without a terminal resistance (R1 + R2 = 0)", pd[k])
     outlets = {}
     for k in terminal:
         if tn[k] in outlets:
             raise table.error("r1", k, f"one terminal resistance per node ({table.where[outlets[tn[k]]]} gives "
                               f"node {tn[k]!r} one)", r1[k])
         outlets[tn[k]] = k
-        net.set_resistance(tn[k], float(r1[k] + r2[k]), distal_pressure=p_d)
+        distal = p_d if pd is None or math.isnan(pd[k]) else float(pd[k])
+        net.set_resistance(tn[k], float(r1[k] + r2[k]), distal_pressure=distal)
     return net
 
 
@@ -390,12 +464,44 @@ class _ThicknessOf:
 
 
 # ---------------------------------------------------------------------------- writing the table
+#: the fractions of a graded tube's length where its laws are probed (irregular: no symmetric
+#: profile passes for linear by chance)
+_PROBES = np.array([0.0, 0.137, 0.29, 0.5, 0.71, 0.863, 1.0])
+#: how a file rebuilds a graded tube's radius and thickness from their end values
+LINEAR, EMPIRICAL, OTHER = 0, 1, 2
+
+
 def _ends(tube):
-    """``(a(0), a(L), t(0), t(L), L)`` of a tube (uniform or graded)."""
+    """``(a(0), a(L), t(0), t(L), L, radius law, thickness law)`` of a tube (uniform or
+    graded). The laws are what the files can rebuild from the end values: :data:`LINEAR` (a
+    uniform value included), :data:`EMPIRICAL` (the thickness :func:`empirical_thickness` of
+    the radius) or :data:`OTHER`, found by comparing the tube at seven positions (to 1e-12)."""
     length = float(tube.length)
-    a, t = tube.at(np.array([0.0, length]))
-    a, t = np.broadcast_to(np.asarray(a, dtype=float), (2,)), np.broadcast_to(np.asarray(t, dtype=float), (2,))
-    return float(a[0]), float(a[1]), float(t[0]), float(t[1]), length
+    a, t = tube.at(_PROBES * length)
+    a = np.broadcast_to(np.asarray(a, dtype=float), _PROBES.shape)
+    t = np.broadcast_to(np.asarray(t, dtype=float), _PROBES.shape)
+
+    def linear(f):
+        return bool(np.allclose(f, f[0] + (f[-1] - f[0]) * _PROBES, rtol=1e-12, atol=0))
+
+    radius_law = LINEAR if linear(a) else OTHER
+    if linear(t):
+        thickness_law = LINEAR
+    elif np.allclose(t, empirical_thickness(a), rtol=1e-12, atol=0):
+        thickness_law = EMPIRICAL
+    else:
+        thickness_law = OTHER
+    return float(a[0]), float(a[-1]), float(t[0]), float(t[-1]), length, radius_law, thickness_law
+
+
+def _modulus(wall, length):
+    """``(E at the inlet, law)`` of a wall's ``youngs_modulus`` (NaN without one): the law
+    :data:`OTHER` where it varies along the tube (the files hold one number per tube)."""
+    modulus = getattr(wall, "youngs_modulus", math.nan)
+    if not isinstance(modulus, Profile):
+        return float(modulus), LINEAR
+    values = np.broadcast_to(np.asarray(modulus(_PROBES * length), dtype=float), _PROBES.shape)
+    return float(values[0]), LINEAR if np.all(values == values[0]) else OTHER
 
 
 def _geometry(network) -> dict:
@@ -413,13 +519,14 @@ def _geometry(network) -> dict:
            "v": list(map(nodes.__getitem__, tubes.V.tolist())), "p_ext": np.array(tubes.external, dtype=float)}
     for key in ("a0", "a1", "t0", "t1", "length", "E"):
         out[key] = np.empty(n)
+    out["radius_law"], out["thickness_law"], out["modulus_law"] = (np.full(n, LINEAR) for _ in range(3))
     for batch, index in tubes.by_batch():
         if batch.graded:
             for k in index.tolist():
                 wall, tube, _ = tubes[k].models()
-                a0, a1, t0, t1, length = _ends(tube)
-                out["a0"][k], out["a1"][k], out["t0"][k], out["t1"][k], out["length"][k] = a0, a1, t0, t1, length
-                out["E"][k] = float(getattr(wall, "youngs_modulus", math.nan))
+                (out["a0"][k], out["a1"][k], out["t0"][k], out["t1"][k], out["length"][k], out["radius_law"][k],
+                 out["thickness_law"][k]) = _ends(tube)
+                out["E"][k], out["modulus_law"][k] = _modulus(wall, out["length"][k])
             continue
         first = batch                   # (its tubes share its models: one indexing each)
         rows = np.zeros(index.size, dtype=int) if batch.rows is None else batch.rows[tubes.place[index]]
@@ -437,16 +544,25 @@ def _geometry(network) -> dict:
 
 @checked_keywords
 def network_table(network, *, thickness="auto") -> dict:
-    """The table form of ``network`` as columns (header -> list), the columns of
+    r"""The table form of ``network`` as columns (header -> list), the columns of
     :func:`write_network_table` (``pandas.DataFrame(network_table(net))`` takes them).
 
-    ``E(Pa)`` is each wall's ``youngs_modulus`` (a wall without one is an error: the table form
-    holds linear elastic walls); ``R1`` the terminal resistance of a resistance outlet at the
-    vessel's target node, ``R2 = C = 0`` (the table keeps only the steady state); ``M`` one mesh
-    point per millimetre (openBF's usual, at least 5). ``thickness``: ``"auto"`` writes an
-    ``h(m)`` column unless every thickness is :func:`empirical_thickness` of its radius, which
-    the reader recomputes; ``True`` always writes it (tapered vessels then need a constant
-    thickness), ``False`` never.
+    ``E(Pa)`` is each wall's ``youngs_modulus`` (the table holds openBF's wall only,
+    :func:`openbf_wall`: another wall, or open ends, is an error naming the tube); ``R1`` the
+    terminal resistance of a resistance outlet at the vessel's target node, ``R2 = C = 0`` (the
+    table keeps only the steady state), and a column ``Pd(Pa)`` with the outlets' distal
+    pressures where one is not 0; ``M`` one mesh point per millimetre (openBF's usual, at least
+    5). A tube named by default, ``(u, v)``, gets an empty ``Name`` (the reader gives it that
+    name back); other names and the nodes must be integers or text that reads back as itself
+    (not integer-like, no surrounding blanks or line breaks), else an error names them.
+
+    ``thickness``: ``"auto"`` writes an ``h(m)`` column unless every thickness is
+    :func:`empirical_thickness` of its radius, which the reader recomputes; ``True`` always
+    writes it, ``False`` never (a thickness the reader would not recompute then warns). With
+    ``h(m)``, a thickness running linearly along a tapered vessel (:meth:`tubefsi.Tube.tapered`)
+    adds the distal thickness ``hd(m)``, and a tapered vessel whose thickness is the empirical one
+    of its radius gets an empty ``h`` cell (the reader's rule). A radius that is not linear along
+    the vessel, or a thickness neither linear nor empirical, is an error naming the tube.
     """
     if thickness not in ("auto", True, False):
         raise InvalidParameterError("thickness", "'auto', True or False", thickness)
@@ -459,57 +575,100 @@ def network_table(network, *, thickness="auto") -> dict:
         raise InvalidParameterError(f"tube {g['name'][k]!r}", "a wall with a youngs_modulus (the table form holds "
                                     "linear elastic walls)", type(network._tubes[g["name"][k]].wall).__name__)
     _check_openbf_walls(network)
+    if np.any(g["modulus_law"] == OTHER):
+        k = int(np.flatnonzero(g["modulus_law"] == OTHER)[0])
+        raise InvalidParameterError(f"tube {g['name'][k]!r}, wall youngs_modulus", "one number along the tube (the "
+                                    "table's E(Pa) holds one per vessel)", "a modulus that varies along it")
+    for key, what in (("radius_law", "radius"), ("thickness_law", "thickness")):
+        if np.any(g[key] == OTHER):
+            k = int(np.flatnonzero(g[key] == OTHER)[0])
+            raise InvalidParameterError(
+                f"tube {g['name'][k]!r}, {what}", "uniform or linear along the tube" + (
+                    " (or the empirical thickness of the radius)" if what == "thickness" else "") +
+                " (the table holds its two end values, and the reader makes it so)", "another profile")
+    names = [_table_name("tube", name, default=(a, b)) for name, a, b in zip(g["name"], g["u"], g["v"])]
+    u = [_table_name("node", node) for node in g["u"]]
+    v = [_table_name("node", node) for node in g["v"]]
     resistance = network._resistance
     # a resistance outlet on the first vessel that ends at its node
     first_into = {}
-    for k, v in enumerate(g["v"]):
-        first_into.setdefault(v, k)
-    terminal = np.zeros(len(g["name"]))
-    written = set()
-    for node, (r, _) in resistance.items():
-        if node in first_into:
-            terminal[first_into[node]] = r
-            written.add(node)
-    columns = {"Name": g["name"], "sn": g["u"], "tn": g["v"], "wkn": [0] * len(g["name"]),
-               "l(m)": g["length"].tolist(), "M": np.maximum(5, np.round(g["length"] * 1e3)).astype(int).tolist(),
-               "Rp(m)": g["a0"].tolist(), "Rd(m)": g["a1"].tolist(), "E(Pa)": g["E"].tolist(),
-               "Pext": g["p_ext"].tolist(), "R1": terminal.tolist(), "R2": [0.0] * len(g["name"]),
-               "C": [0.0] * len(g["name"])}
-    h_p, h_d, r_p, r_d = g["t0"], g["t1"], g["a0"], g["a1"]
-    rows = [(name,) for name in g["name"]]
-    lost = [node for node in resistance if node not in written]
+    for k, b in enumerate(g["v"]):
+        first_into.setdefault(b, k)
+    n = len(g["name"])
+    terminal, distal = np.zeros(n), np.zeros(n)
+    lost = [node for node in resistance if node not in first_into]
     if lost:
         raise InvalidParameterError("network", "resistance outlets at the target node of a tube (the table puts "
                                     "R1 on the vessel that ends there)", lost[0])
-    distal = {p_d for _, p_d in resistance.values()}
-    if len(distal) > 1:
-        raise InvalidParameterError("network", "one distal pressure for every resistance outlet (the table has "
-                                    "none; read_network_table(distal_pressure=...) sets it)", sorted(distal))
-    rule = bool(np.allclose(h_p, empirical_thickness(r_p), rtol=1e-12, atol=0)
-                and np.allclose(h_d, empirical_thickness(r_d), rtol=1e-12, atol=0))
-    if thickness is True or (thickness == "auto" and not rule):
-        if not np.array_equal(h_p, h_d):
-            k = int(np.flatnonzero(h_p != h_d)[0])
-            raise InvalidParameterError(f"tube {rows[k][0]!r}", "a constant wall thickness (the table's h(m) column "
-                                        "holds one number per vessel)", (float(h_p[k]), float(h_d[k])))
-        columns = {**{k: columns[k] for k in _HEADER[:9]}, "h(m)": h_p.tolist(),
-                   **{k: columns[k] for k in _HEADER[9:]}}
+    for node, (r, p_d) in resistance.items():
+        terminal[first_into[node]], distal[first_into[node]] = r, p_d
+    columns = {"Name": names, "sn": u, "tn": v, "wkn": [0] * n,
+               "l(m)": g["length"].tolist(), "M": np.maximum(5, np.round(g["length"] * 1e3)).astype(int).tolist(),
+               "Rp(m)": g["a0"].tolist(), "Rd(m)": g["a1"].tolist(), "E(Pa)": g["E"].tolist(),
+               "Pext": g["p_ext"].tolist(), "R1": terminal.tolist(), "R2": [0.0] * n, "C": [0.0] * n}
+    if np.any(distal != 0):
+        columns["Pd(Pa)"] = distal.tolist()
+    h_p, h_d, r_p, r_d = g["t0"], g["t1"], g["a0"], g["a1"]
+    by_rule = g["thickness_law"] == EMPIRICAL
+    # what the reader makes without an h(m) column: the empirical thickness (a law along a tapered vessel)
+    rule = by_rule | ((r_p == r_d) & (h_p == h_d) & np.isclose(h_p, empirical_thickness(r_p), rtol=1e-12, atol=0))
+    if thickness is False and not np.all(rule):
+        k = int(np.flatnonzero(~rule)[0])
+        warn_user(f"write_network_table(thickness=False): tube {g['name'][k]!r} (and {int(np.sum(~rule)) - 1} more) "
+                  "has a wall thickness other than empirical_thickness of its radius, which read_network_table "
+                  "makes without an h(m) column: the table reads back as another network", UserWarning)
+    if thickness is True or (thickness == "auto" and not np.all(rule)):
+        graded_rule = by_rule & (r_p != r_d)
+        h = [None if graded_rule[k] else float(h_p[k]) for k in range(n)]
+        extra = {"h(m)": h}
+        if np.any(~by_rule & (h_p != h_d)):
+            extra["hd(m)"] = [float(h_d[k]) if not by_rule[k] and h_d[k] != h_p[k] else None for k in range(n)]
+        columns = {**{k: columns[k] for k in _HEADER[:9]}, **extra, **{k: columns[k] for k in columns
+                                                                         if k not in _HEADER[:9]}}
     return columns
+
+
+def _table_name(kind, name, default=None):
+    """A tube or node name as the table's cell: an integer (NumPy's too) as a plain one, text as
+    itself, a tube's default name ``(u, v)`` as an empty cell; anything the reader would read
+    back as another name is an error naming it."""
+    if default is not None and isinstance(name, tuple) and name == default:
+        return None
+    if isinstance(name, (int, np.integer)) and not isinstance(name, (bool, np.bool_)):
+        return int(name)
+    if isinstance(name, str) and name and name == name.strip() and not _INTEGER.fullmatch(name) \
+            and "\n" not in name and "\r" not in name:
+        return name
+    raise InvalidParameterError(
+        f"{kind} name {name!r}", "an integer or text that reads back as itself (not an integer's digits, such "
+        "as '12' or '12.0', no "
+        "surrounding blanks or line breaks)" + (", or the default name (u, v)" if kind == "tube" else "") +
+        ": the table writes names as text", name)
 
 
 @checked_keywords
 def write_network_table(network, path, *, thickness="auto", comment=None):
     """Write ``network`` as a table of vessels (CSV, the columns of :func:`network_table`;
     numbers with all their digits, so that :func:`read_network_table` gives the same network
-    back). ``comment`` (text) goes first, each line after ``#``. Returns the path."""
+    back; an empty cell where :func:`network_table` has None). ``comment`` (text) goes first,
+    each line after ``#``; a name starting with ``#`` is quoted (the reader would take its line
+    for a comment), as one with a comma or a quote is. Returns the path."""
     columns = network_table(network, thickness=thickness)
-    with open(path, "w", newline="", encoding="utf-8") as fh:
+    try:
+        fh = open(path, "w", newline="", encoding="utf-8")
+    except OSError as err:
+        raise InvalidParameterError("path", "a file that can be written", str(path), str(err)) from None
+    with fh:
         for line in ([] if comment is None else str(comment).splitlines()):
             fh.write(f"# {line}\n")
         writer = csv.writer(fh, lineterminator="\n")
         writer.writerow(list(columns))
         for row in zip(*columns.values()):
-            writer.writerow([repr(x) if isinstance(x, float) else str(x) for x in row])
+            cells = ["" if x is None else repr(x) if isinstance(x, float) else str(x) for x in row]
+            if cells[0].startswith("#"):          # (csv quotes only a delimiter, a quote or a line break)
+                fh.write('"' + cells[0].replace('"', '""') + '",')
+                cells = cells[1:]
+            writer.writerow(cells)
     return path
 
 
@@ -584,7 +743,7 @@ def tree_layout(network, *, root=None) -> dict:
 # ---------------------------------------------------------------------------- VTK polylines
 #: cell arrays of the geometry (per tube) and of a solution (NetworkSolution attribute names)
 _GEOMETRY = ("radius", "radius_proximal", "radius_distal", "thickness_proximal", "thickness_distal", "length",
-             "youngs_modulus", "external_pressure")
+             "youngs_modulus", "external_pressure", "radius_law", "thickness_law", "modulus_law")
 _RESULTS = {"flow_rate": "flow_rates", "pressure_drop": "pressure_drops", "radius_u": "radius_u",
             "radius_v": "radius_v", "strain_u": "strain_u", "strain_v": "strain_v",
             "wall_shear_stress_u": "wall_shear_stress_u", "wall_shear_stress_v": "wall_shear_stress_v"}
@@ -634,12 +793,15 @@ def write_vtp(network_or_solution, path, *, positions=None):
     cell from its ``u`` to its ``v``. Cell data: ``radius`` (the mean of the two ends, for
     ParaView's Tube filter), ``radius_proximal``, ``radius_distal``, ``thickness_proximal``,
     ``thickness_distal``, ``length`` (m), ``youngs_modulus`` (Pa, NaN for a wall without one),
-    ``external_pressure`` (Pa); given a solution also ``flow_rate`` (m^3/s), ``pressure_drop``
-    (Pa), ``radius_u``, ``radius_v`` (deformed, m), ``strain_u``, ``strain_v``,
+    ``external_pressure`` (Pa), ``radius_law`` and ``thickness_law`` (how the profile runs
+    between the two ends: 0 linear, 1 the :func:`empirical_thickness` of the radius, 2 another
+    law, which :func:`read_vtp` makes linear with a warning), ``modulus_law`` (2 where the
+    ``youngs_modulus``, its inlet value here, varies along the tube); given a solution also
+    ``flow_rate`` (m^3/s), ``pressure_drop`` (Pa), ``radius_u``, ``radius_v`` (deformed, m), ``strain_u``, ``strain_v``,
     ``wall_shear_stress_u``, ``wall_shear_stress_v`` (Pa). Point data: the boundary conditions
     ``fixed_pressure``, ``inflow``, ``resistance``, ``distal_pressure`` (NaN where a node has
-    none), ``node`` (the node names, where they are all integers) and, given a solution,
-    ``pressure`` (Pa). Returns the path."""
+    none), ``node`` (the node names, where they are all integers, NumPy's too) and, given a
+    solution, ``pressure`` (Pa). Returns the path."""
     if isinstance(network_or_solution, NetworkSolution):
         solution, network = network_or_solution, network_or_solution.net
     elif isinstance(network_or_solution, Network):
@@ -654,7 +816,7 @@ def write_vtp(network_or_solution, path, *, positions=None):
         raise InvalidParameterError("network_or_solution", "a network with at least one tube", network_or_solution)
     xyz = _positions(network, positions)
     cells = dict(zip(_GEOMETRY, (0.5 * (g["a0"] + g["a1"]), g["a0"], g["a1"], g["t0"], g["t1"], g["length"], g["E"],
-                                 g["p_ext"])))
+                                 g["p_ext"], g["radius_law"], g["thickness_law"], g["modulus_law"])))
     connectivity = np.array([[index[a] for a in g["u"]], [index[b] for b in g["v"]]], dtype=np.int64).T
     if solution is not None:
         for key, attribute in _RESULTS.items():
@@ -663,8 +825,8 @@ def write_vtp(network_or_solution, path, *, positions=None):
               "inflow": [network._inflow.get(n, math.nan) for n in nodes],
               "resistance": [network._resistance.get(n, (math.nan, math.nan))[0] for n in nodes],
               "distal_pressure": [network._resistance.get(n, (math.nan, math.nan))[1] for n in nodes]}
-    if all(isinstance(n, int) and not isinstance(n, bool) for n in nodes):
-        points["node"] = np.array(nodes, dtype=np.int64)
+    if all(isinstance(n, (int, np.integer)) and not isinstance(n, (bool, np.bool_)) for n in nodes):
+        points["node"] = np.array([int(n) for n in nodes], dtype=np.int64)
     if solution is not None:
         points["pressure"] = solution.pressures
     root = ET.Element("VTKFile", type="PolyData", version="1.0", byte_order="LittleEndian", header_type="UInt64")
@@ -681,7 +843,10 @@ def write_vtp(network_or_solution, path, *, positions=None):
     for key, values in cells.items():
         _data_array(cell_data, key, np.asarray(values, dtype=float))
     ET.indent(root)
-    ET.ElementTree(root).write(path, encoding="utf-8", xml_declaration=True)
+    try:
+        ET.ElementTree(root).write(path, encoding="utf-8", xml_declaration=True)
+    except OSError as err:
+        raise InvalidParameterError("path", "a file that can be written", str(path), str(err)) from None
     return path
 
 
@@ -753,17 +918,36 @@ def read_vtp(path, *, rheology=None, wall=None):
     ``radius``; its thickness ``thickness_proximal``/``thickness_distal``, else ``thickness``,
     else :func:`empirical_thickness` of the radius; its length ``length``, else the distance
     between its points. ``wall`` is a model or a factory ``wall(E, h, R)`` as in
-    :func:`read_network_table` (the cell data ``youngs_modulus`` gives ``E``). Nodes are named by
-    the point data ``node`` if present, else by their index; they take the positions of the
-    points and the boundary conditions of the point data ``fixed_pressure``, ``inflow``,
-    ``resistance`` with ``distal_pressure`` (NaN: none). Results in the file are not read.
+    :func:`read_network_table` (the cell data ``youngs_modulus`` gives ``E``); ``thickness_law``
+    1 makes the thickness :func:`empirical_thickness` of the radius along the tube, and a law
+    2 (one the file does not hold) is read as linear with a warning. Nodes are named by the
+    point data ``node`` if present (integers, distinct), else by their index; they take the
+    positions of the points ((x, y), or (x, y, z) when a point has a z other than 0) and the
+    boundary conditions of the point data ``fixed_pressure``, ``inflow``, ``resistance`` with
+    ``distal_pressure`` (NaN: none; an error names the file and the point). Results in the file
+    are not read.
     """
     label = Path(path).name
     xyz, lines, point_data, cell_data = _vtp_arrays(path)
     n_tubes = len(lines)
     if n_tubes == 0:
         raise InvalidParameterError(label, "at least one line cell", 0)
-    names = point_data["node"].astype(np.int64).tolist() if "node" in point_data else list(range(len(xyz)))
+    if "node" in point_data:
+        node = point_data["node"]
+        with np.errstate(invalid="ignore"):
+            bad = ~(np.isfinite(node) & (node == np.round(node)) & (np.abs(node) < 2.0**53))
+        if np.any(bad):
+            i = int(np.flatnonzero(bad)[0])
+            raise InvalidParameterError(f"{label}, point {i}, point data 'node'", "integers (the node names)",
+                                        float(node[i]))
+        names = node.astype(np.int64).tolist()
+        if len(set(names)) != len(names):
+            seen = set()
+            i = next(i for i, name in enumerate(names) if name in seen or seen.add(name))
+            raise InvalidParameterError(f"{label}, point {i}, point data 'node'", "distinct integers (a name per "
+                                        "point)", names[i])
+    else:
+        names = list(range(len(xyz)))
 
     def cell(key, fallback=None):
         return cell_data.get(key, fallback)
@@ -799,7 +983,17 @@ def read_vtp(path, *, rheology=None, wall=None):
     _, first, counts = np.unique(pairs, return_index=True, return_counts=True)
     shared = np.isin(pairs, pairs[first[counts > 1]])
     names_of = [(u[k], v[k], k) if shared[k] else (u[k], v[k]) for k in range(n_tubes)]
-    graded = (rp != rd) | (hp != hd)
+    thickness_law = cell("thickness_law", np.zeros(n_tubes))
+    approximated = ((cell("radius_law", np.zeros(n_tubes)) == OTHER) | (thickness_law == OTHER)
+                    | (cell("modulus_law", np.zeros(n_tubes)) == OTHER))
+    if np.any(approximated):
+        k = int(np.flatnonzero(approximated)[0])
+        warn_user(f"read_vtp: {label}, cell {k} (and {int(np.sum(approximated)) - 1} more): its radius, thickness or "
+                  "modulus ran along the tube by a law the file does not hold (radius_law or thickness_law 2, or a "
+                  "youngs_modulus that varies along it, modulus_law 2); it is read as linear between the two "
+                  "ends (the modulus as its inlet value), another tube than the one written", UserWarning)
+    by_rule = thickness_law == EMPIRICAL
+    graded = (rp != rd) | (hp != hd) | by_rule
     net = Network(rheology=rheology)
     cuts = np.flatnonzero(np.diff(graded.astype(np.int8))) + 1
     for run in np.split(np.arange(n_tubes), cuts):
@@ -809,20 +1003,40 @@ def read_vtp(path, *, rheology=None, wall=None):
                           names=[names_of[k] for k in run])
             continue
         for k in run:
-            net.add_tube(u[k], v[k], make_wall(float(modulus[k]), float(hp[k]), float(rp[k])),
-                         Tube.tapered(length=float(length[k]), radius=float(rp[k]), outlet_radius=float(rd[k]),
-                                      thickness=float(hp[k]), outlet_thickness=float(hd[k])),
+            if by_rule[k]:
+                tube = Tube(length=float(length[k]), thickness=Profile(_ThicknessOf(empirical_thickness, rp[k], rd[k],
+                                                                                    length[k])),
+                            radius=float(rp[k]) if rp[k] == rd[k] else sampled([0.0, float(length[k])],
+                                                                                  [rp[k], rd[k]], kind="linear"))
+            else:
+                tube = Tube.tapered(length=float(length[k]), radius=float(rp[k]), outlet_radius=float(rd[k]),
+                                    thickness=float(hp[k]), outlet_thickness=float(hd[k]))
+            net.add_tube(u[k], v[k], make_wall(float(modulus[k]), float(hp[k]), float(rp[k])), tube,
                          name=names_of[k], external_pressure=float(p_ext[k]))
-    for i, node in enumerate(names):
-        if node not in net._nodes:
-            continue
-        net.set_position(node, (float(xyz[i, 0]), float(xyz[i, 1])))
+    used = np.array([node in net._nodes for node in names], dtype=bool)
+    if not np.all(np.isfinite(xyz[used])):
+        i = int(np.flatnonzero(used & ~np.all(np.isfinite(xyz), axis=1))[0])
+        raise InvalidParameterError(f"{label}, point {i}, Points", "finite coordinates (m)", xyz[i].tolist())
+    flat = xyz.shape[1] < 3 or not np.any(xyz[used, 2])       # (x, y) unless a point has a z
+    points = xyz[:, :2] if flat else xyz[:, :3]
+    # the positions in one pass (checked above, as set_position checks one)
+    net.positions.update((node, tuple(p)) for node, p, keep in zip(names, points.tolist(), used) if keep)
+    with_bc = np.zeros(len(names), dtype=bool)
+    for key in ("fixed_pressure", "inflow", "resistance"):
+        if key in point_data:
+            with_bc |= np.isfinite(point_data[key])
+    for i in np.flatnonzero(used & with_bc).tolist():
+        node = names[i]
         bc = {key: float(point_data[key][i]) for key in _NODE_DATA if key in point_data}
-        if math.isfinite(bc.get("fixed_pressure", math.nan)):
-            net.set_pressure(node, bc["fixed_pressure"])
-        if math.isfinite(bc.get("inflow", math.nan)):
-            net.set_inflow(node, bc["inflow"])
-        if math.isfinite(bc.get("resistance", math.nan)):
-            p_d = bc.get("distal_pressure", 0.0)
-            net.set_resistance(node, bc["resistance"], distal_pressure=p_d if math.isfinite(p_d) else 0.0)
+        for key, setter in (("fixed_pressure", net.set_pressure), ("inflow", net.set_inflow),
+                            ("resistance", net.set_resistance)):
+            if not math.isfinite(bc.get(key, math.nan)):
+                continue
+            p_d = bc.get("distal_pressure", math.nan)
+            try:
+                setter(node, bc[key], *([p_d if math.isfinite(p_d) else 0.0] if key == "resistance" else []))
+            except InvalidParameterError as err:       # the file, the point and its array, then what was wrong
+                raise InvalidParameterError(f"{label}, point {i} (node {node!r}), point data {key!r}",
+                                            err.admissible, bc[key] if err.parameter != "node" else err.value,
+                                            err.args[0].split("; ", 1)[1] if "; " in err.args[0] else "") from None
     return net

@@ -330,17 +330,22 @@ def _hashable(x) -> bool:
 
 
 def _labels(names) -> np.ndarray:
-    """Names as a 1-D array of coordinate labels: as they are if all are text or all integers,
-    else as text."""
-    if all(isinstance(x, str) for x in names) or all(isinstance(x, int) and not isinstance(x, bool) for x in names):
+    """Names as a 1-D array of coordinate labels: as they are if all are text or all integers
+    (NumPy's too), else as text."""
+    if all(isinstance(x, str) for x in names):
         return np.array(names)
+    if all(isinstance(x, (int, np.integer)) and not isinstance(x, (bool, np.bool_)) for x in names):
+        return np.array([int(x) for x in names], dtype=np.int64)
     return np.array([str(x) for x in names])
 
 
 def _text(x):
+    if isinstance(x, np.integer):
+        return int(x)
     return x if isinstance(x, (str, int, bool)) else str(x)
 
 
 def _records(table):
-    return [{k: (v if isinstance(v, (float, int, bool, str)) else str(v)) for k, v in zip(table, row)}
+    return [{k: (v if isinstance(v, (float, int, bool, str)) else int(v) if isinstance(v, np.integer) else str(v))
+             for k, v in zip(table, row)}
             for row in zip(*table.values())]

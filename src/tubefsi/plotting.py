@@ -43,6 +43,7 @@ import attrs
 import numpy as np
 
 from . import registry
+from ._keywords import checked_keywords
 from .errors import InvalidParameterError, NoSteadyStateError, StretchRangeError, TubefsiError
 from .network_io import tree_layout
 from .solve import max_flow_rate, solve, solve_unchecked
@@ -795,6 +796,7 @@ _NETWORK_COLOURS = {
 }
 
 
+@checked_keywords
 def plot_network(result, *, color="pressure", positions=None, layout="tree", ax=None, cmap="viridis",
                  max_width=8.0, layout_seed=0):
     r"""Draw a solved network: each tube a segment coloured by ``color`` and as wide as its mean
@@ -810,7 +812,7 @@ def plot_network(result, *, color="pressure", positions=None, layout="tree", ax=
         shear stress of their two ends. The colour bar shows it in a display unit (kPa, mL/min,
         ...).
     positions : mapping node -> (x, y), optional
-        Node coordinates; by default those of :meth:`~tubefsi.Network.set_position` (or the
+        Node coordinates (m; a point (x, y, z) is drawn at (x, y)); by default those of :meth:`~tubefsi.Network.set_position` (or the
         ``pos`` node attribute of a networkx graph), else the ``layout``.
     layout : {"tree", "spring"}
         Where nodes have no position: ``"tree"``, :func:`tubefsi.network_io.tree_layout`
@@ -818,8 +820,9 @@ def plot_network(result, *, color="pressure", positions=None, layout="tree", ax=
         seeded by ``layout_seed`` (needs networkx).
     ax : matplotlib Axes, optional
     cmap : str or Colormap
+        A matplotlib colormap or its registered name.
     max_width : float
-        Line width (points) of the widest tube; the others in proportion to their radius.
+        Line width (points, > 0) of the widest tube; the others in proportion to their radius.
 
     Returns
     -------
@@ -832,6 +835,17 @@ def plot_network(result, *, color="pressure", positions=None, layout="tree", ax=
         raise InvalidParameterError("color", f"one of {sorted(_NETWORK_COLOURS)}", color)
     if layout not in ("tree", "spring"):
         raise InvalidParameterError("layout", "'tree' or 'spring'", layout)
+    import matplotlib
+    from matplotlib.colors import Colormap
+
+    if not isinstance(cmap, Colormap) and not (isinstance(cmap, str) and cmap in matplotlib.colormaps):
+        raise InvalidParameterError("cmap", "a matplotlib Colormap or a registered colormap name such as 'viridis'",
+                                    cmap)
+    width = np.asarray(max_width, dtype=float) if isinstance(max_width, (int, float, np.number)) else None
+    if width is None or isinstance(max_width, bool) or not (np.isfinite(width) and width > 0):
+        raise InvalidParameterError("max_width", "(0, inf) points", max_width)
+    if positions is not None and not hasattr(positions, "keys"):
+        raise InvalidParameterError("positions", "a mapping node -> (x, y) or (x, y, z) (m)", positions)
     nodes = result.nodes
     pos = dict(result.net.positions if positions is None else positions)
     if any(node not in pos for node in nodes):
@@ -844,7 +858,16 @@ def plot_network(result, *, color="pressure", positions=None, layout="tree", ax=
                 raise InvalidParameterError("layout", "'tree', or 'spring' with networkx installed", layout,
                                             "give positions= or set_position(), or install networkx") from None
             pos = {**nx.spring_layout(result.net.to_networkx().to_undirected(as_view=True), seed=layout_seed), **pos}
-    pts = np.array([pos[n] for n in nodes], dtype=float)
+    pts = np.empty((len(nodes), 2))
+    for i, node in enumerate(nodes):
+        try:
+            point = np.asarray(pos[node], dtype=float)
+        except (TypeError, ValueError):
+            point = np.array([np.nan])
+        if point.shape not in ((2,), (3,)) or not np.all(np.isfinite(point)):
+            raise InvalidParameterError(f"positions[{node!r}]", "a point (x, y) or (x, y, z) of finite numbers (m)",
+                                        pos[node])
+        pts[i] = point[:2]                       # (drawn in the x-y plane)
     xy = np.stack([pts[result.U], pts[result.V]], axis=1)
     radius = 0.5 * (result.radius_u + result.radius_v)
     widths = max_width * radius / radius.max()
