@@ -216,27 +216,6 @@ def test_vectorized_solve_equals_one_at_a_time():
     np.testing.assert_allclose(x[solved], (np.log1p(k * target) / k)[solved], rtol=4e-15)
 
 
-@pytest.mark.parametrize("degree", [16, 24, 32])
-def test_barycentric_is_the_chebyshev_interpolant(degree):
-    """The barycentric formula against the same interpolant summed as a Chebyshev series by NumPy
-    (:func:`numpy.polynomial.chebyshev.chebval` on the coefficients of numpy's own
-    :func:`~numpy.polynomial.chebyshev.chebfit` through the nodes), on and off the nodes, and a
-    point's value the same bits alone and in a batch."""
-    from numpy.polynomial import chebyshev as C
-
-    from tubefsi.numerics.spectral import barycentric, lobatto_rule
-    rule = lobatto_rule(degree)
-    rng = np.random.default_rng(degree)
-    values = np.exp(np.sin(3.0 * rule.t + rng.uniform(0, 1, (5, 1))))            # 5 functions, one per row
-    t = np.concatenate([rng.uniform(-1, 1, 2), rule.t[[0, 3, -1]]])              # off and on the nodes
-    (p,) = barycentric(rule, t, values)
-    for i in range(5):
-        series = C.chebfit(rule.t, values[i], degree)
-        assert abs(p[i] - C.chebval(t[i], series)) <= 64 * np.finfo(float).eps * np.max(np.abs(values[i]))
-        (alone,) = barycentric(rule, t[i:i + 1], values[i:i + 1])
-        assert alone[0] == p[i]
-
-
 def test_hermite_root_of_a_cubic():
     """A cubic is its own Hermite interpolant: the root of s^3 + s (rise 2, slopes 1 and 4) = goal
     against numpy's polynomial roots."""

@@ -16,8 +16,7 @@ import numpy as np
 
 from .kernels import blocked_matmul
 
-__all__ = ["solve_integral", "CHEBYSHEV_DEGREE", "LOBATTO_NODES", "lobatto_rule", "clenshaw", "barycentric",
-           "hermite_root"]
+__all__ = ["solve_integral", "CHEBYSHEV_DEGREE", "LOBATTO_NODES", "lobatto_rule", "clenshaw", "hermite_root"]
 
 #: Degree of the Chebyshev interpolant of :func:`solve_integral` (17 Chebyshev–Lobatto nodes).
 CHEBYSHEV_DEGREE = 16
@@ -39,7 +38,6 @@ class _LobattoRule:
     coef: slice
     anti: slice
     cumulative: slice
-    weights: np.ndarray
 
 
 @functools.lru_cache(maxsize=8)
@@ -56,13 +54,9 @@ def lobatto_rule(n):
     to_antiderivative = np.polynomial.chebyshev.chebint(to_coef, lbnd=-1.0, axis=0)
     cumulative = np.polynomial.chebyshev.chebvander(t, n + 1) @ to_antiderivative
     matrix = np.vstack([to_coef, to_antiderivative, cumulative])
-    # the barycentric weights of Chebyshev-Lobatto nodes: alternating signs, the end nodes halved
-    weights = (-1.0) ** k
-    weights[[0, -1]] *= 0.5
-    for constant in (t, nodes, matrix, weights):     # (shared by every call: a write into one would change later answers)
+    for constant in (t, nodes, matrix):     # (shared by every call: a write into one would change later answers)
         constant.setflags(write=False)
-    return _LobattoRule(n, t, nodes, matrix, slice(0, n + 1), slice(n + 1, 2 * n + 3), slice(2 * n + 3, 3 * n + 4),
-                       weights)
+    return _LobattoRule(n, t, nodes, matrix, slice(0, n + 1), slice(n + 1, 2 * n + 3), slice(2 * n + 3, 3 * n + 4))
 
 
 #: The Chebyshev–Lobatto nodes of :func:`solve_integral` on [0, 1] (an end node is exactly 0, the other 1).
@@ -116,36 +110,9 @@ def hermite_root(rise, goal, d0, d1, iterations=3):
     return s
 
 
-def barycentric(rule, t, *values):
-    r"""The interpolants through each of ``values`` (their values at ``rule``'s Chebyshev–Lobatto
-    nodes, along the last axis) at ``t`` (one point per row: ``t`` has the shape of
-    ``values[k][..., 0]``).
-
-    The barycentric formula of the second kind (J.-P. Berrut and L. N. Trefethen, *SIAM Review*
-    46, 2004, section 5),
-
-    .. math:: p(t) = \frac{\sum_j r_j f_j}{\sum_j r_j}, \qquad r_j = \frac{w_j}{t - t_j},
-              \qquad w_j = (-1)^j \text{ (halved at the end nodes)},
-
-    is forward stable on these nodes (N. J. Higham, *IMA J. Numer. Anal.* 24, 2004) and costs a
-    fixed handful of array operations whatever the degree, where Clenshaw's recurrence takes three
-    per coefficient: the Newton iterations on an interpolant of one or a few points are bound by
-    the count of operations, not by arithmetic. The terms :math:`r_j` serve every interpolant on
-    the same nodes. A ``t`` on a node exactly is moved off it by one unit in the last place (the
-    formula divides by :math:`t - t_j`; the interpolant moves by that ulp times its slope).
-
-    The nodes run along the last axis, contiguous, because NumPy sums a contiguous row in the
-    same order whatever the number of rows: a point's bits do not depend on its batch (summed
-    along the first axis, a lone column is summed in another order than the columns of a batch)."""
-    t = np.asarray(t, dtype=float)
-    d = t[..., None] - rule.t
-    on_node = d == 0
-    if on_node.any():
-        t = np.where(on_node.any(axis=-1), np.nextafter(t, np.where(t < 0.5, 2.0, -2.0)), t)
-        d = t[..., None] - rule.t
-    r = rule.weights / d
-    sum_r = r.sum(axis=-1)
-    return tuple((r * f).sum(axis=-1) / sum_r for f in values)
+#: Batches of at most this many points evaluate an interpolant and its derivative in one pass
+#: (the same bits either way; only the time differs).
+_PAIRED_BELOW = 2048
 
 
 def solve_integral(f, target, upper, *, rtol=1e-14, values=None, degree=CHEBYSHEV_DEGREE):
@@ -216,23 +183,28 @@ def solve_integral(f, target, upper, *, rtol=1e-14, values=None, degree=CHEBYSHE
     d1 = flat_y.take(lower + live.size)
     d1 *= scale                                              # dJ/ds at the ends, s in [0, 1]
     rise, goal = c1 - c0, t_goal - c0
-    del flat_y, flat_cumulative, c0, c1, scale, j, lower
+    # the integrand values (nodes x points) and the bracket's ends are no longer needed: freed
+    # before the Newton iterations allocate theirs, the call's peak memory is lower, and with it
+    # the heap that glibc trims after the call and the next call faults back in
+    del values, y, flat_y, flat_cumulative, c0, c1, scale, j, lower
     s = hermite_root(rise, goal, d0, d1)
     t = t0 + (t1 - t0) * s
-    # Newton on the interpolant A of the integral (degree n + 1), its slope the integrand's (degree
-    # n): both by the barycentric formula through their values at the nodes. That formula gives
-    # the degree-n interpolant of A's values; on Chebyshev-Lobatto nodes T_{n+1} takes the values
-    # of T_{n-1} (cos((n + 1) theta_j) = cos((n - 1) theta_j) at theta_j = j pi / n), so
-    # A = that interpolant + a_{n+1} (T_{n+1} - T_{n-1}), and T_{n+1} - T_{n-1} = -2 sin(n theta)
-    # sin(theta) at t = cos(theta). Quadratic: a step below 1e-9 leaves an error of order
-    # (f'/f) 1e-18 after it, and is the last one.
-    top = anti[-1]
-    n = rule.degree
-    cumulative_rows, y_rows = np.ascontiguousarray(cumulative.T), np.ascontiguousarray(y.T)
+    # Newton on the interpolant: quadratic, so a step below 1e-9 leaves an error of order
+    # (f'/f) 1e-18 after it, and is the last one
     moving = np.ones(live.size, dtype=bool)
+    # a small batch pays per array operation: the integral and the integrand in one Clenshaw pass
+    # halve them (the integrand's top coefficient is zero, so its values are the same bits); a
+    # large batch is faster in two passes over contiguous rows
+    paired = live.size <= _PAIRED_BELOW
+    if paired:
+        pair = np.zeros((anti.shape[0], 2, live.size))
+        pair[:, 0] = anti
+        pair[:-1, 1] = coef
     for _ in range(8):
-        integral, integrand = barycentric(rule, t, cumulative_rows, y_rows)
-        integral += top * (-2.0 * np.sin(n * np.arccos(t)) * np.sqrt((1.0 - t) * (1.0 + t)))
+        if paired:
+            integral, integrand = clenshaw(pair, np.broadcast_to(t, (2, live.size)))
+        else:
+            integral, integrand = clenshaw(anti, t), clenshaw(coef, t)
         step = (integral - t_goal) / (integrand * h)
         step[~moving] = 0.0                  # a point's iterations do not depend on its neighbours'
         t = np.minimum(np.maximum(t - step, t0), t1)
