@@ -114,15 +114,18 @@ class _Solver:
         self.feeds = feeds
         self.groups = _Groups(self.tubes, ~self.feeder)
         self.feed_groups = _Groups(self.tubes, self.feeder)
-        self.limit = np.where(self.feeder, self.feed_groups.limit, self.groups.limit)
+        # per tube, the limit pressures at its ends u and v (a graded tube's differ: ``_Groups``)
+        self.limit_u = np.where(self.feeder, self.feed_groups.limit_u, self.groups.limit_u)
+        self.limit_v = np.where(self.feeder, self.feed_groups.limit_v, self.groups.limit_v)
         self.radius = np.where(self.feeder, self.feed_groups.radius, self.groups.radius)
         self.radius0_u = np.where(self.feeder, self.feed_groups.radius_u, self.groups.radius_u)
         self.radius0_v = np.where(self.feeder, self.feed_groups.radius_v, self.groups.radius_v)
         self.length = np.where(self.feeder, self.feed_groups.length, self.groups.length)
-        # a node's bound: the smallest limit pressure of its tubes (an inlet must stay below it)
+        # a node's bound: the smallest limit pressure of its tubes at their ends there (an inlet
+        # must stay below it; a graded tube's interior is checked by its own solve)
         self.p_limit = np.full(n_nodes, np.inf)
-        np.minimum.at(self.p_limit, self.U, self.limit)
-        np.minimum.at(self.p_limit, self.V, self.limit)
+        np.minimum.at(self.p_limit, self.U, self.limit_u)
+        np.minimum.at(self.p_limit, self.V, self.limit_v)
         over = self.fixed & (self.p_fixed >= self.p_limit)
         if np.any(over):
             i = int(np.flatnonzero(over)[0])
@@ -180,8 +183,10 @@ class _Solver:
         self._pattern = None                 # built by the next _jacobian
 
     def _limiting_tube(self, i):
+        """The name of the tube whose limit pressure at node ``i`` is the node's bound."""
         at = np.flatnonzero((self.U == i) | (self.V == i))
-        return self.tubes[int(at[np.argmin(self.limit[at])])].name
+        limit = np.where(self.U[at] == i, self.limit_u[at], self.limit_v[at])
+        return self.tubes[int(at[np.argmin(limit)])].name
 
     # ------------------------------------------------------------------ linear algebra
     def _jacobian(self, gu, gv):
@@ -248,13 +253,16 @@ class _Solver:
             return np.ones(self.n_tubes)
 
     # ------------------------------------------------------------------ Newton
-    def _edges(self, p):
+    def _edges(self, p, named=False):
+        """Per tube at the node pressures ``p``: its flow (u to v), its derivatives by p_u and p_v
+        (the Jacobian's, see the module's docstring) and its deformed radii at u and v. A tube
+        without a steady state raises NoSteadyStateError (naming it where ``named``)."""
         du = p[self.U] - p[self.V]
         forward = du >= 0
         drop = np.abs(du)
         drop[drop <= _TINY * float(np.max(p))] = 0.0      # flow ~ (1e-30)^(1/n) of the network's
         outlet = np.where(forward, p[self.V], p[self.U])
-        q, d_in, d_out, r_in, r_out = self.groups.evaluate(drop, outlet, forward)
+        q, d_in, d_out, r_in, r_out = self.groups.evaluate(drop, outlet, forward, named)
         bad = ~np.isfinite(q)
         if np.any(bad):
             q, d_in, d_out = self._tiny_drops(bad, drop, outlet, forward, q, d_in, d_out, float(np.max(p)))
@@ -336,14 +344,19 @@ class _Solver:
                     p[i] = value
         room = np.where(np.isfinite(self.p_limit), self.p_limit, np.inf)
         p[free] = np.clip(p[free], 0.0, np.where(np.isfinite(room[free]), _TO_BOUND * room[free], np.inf))
-        for _ in range(60):            # a start beyond what a wall law reaches: halve it
+        # a start beyond what a wall law (or a graded tube) reaches: halve it, then try the free
+        # nodes at zero (the lowest pressures there: the fixed nodes' tubes then carry the most
+        # flow and feel the least pressure downstream); failing that the fixed pressures alone
+        # have no steady state
+        for attempt in range(6):
             try:
                 q, gu, gv, r_u, r_v = self._edges(p)
                 break
             except NoSteadyStateError:
-                p[free] *= 0.5
-        else:
-            q, gu, gv, r_u, r_v = self._edges(p)
+                if not np.any(p[free] > 0):
+                    self._edges(p, named=True)
+                    raise
+                p[free] = 0.5 * p[free] if attempt < 4 else 0.0
         balance = self._balance(q, p)
         # nodes held at their bound (an active set): where Newton pushes a node into its limit
         # pressure and the line search must cut the step, the node is held there and the rest
@@ -380,8 +393,9 @@ class _Solver:
                 try:
                     t_q, t_gu, t_gv, t_ru, t_rv = self._edges(trial)
                 except NoSteadyStateError:    # beyond what a wall law reaches (a peak): shorter
-                    t_balance = None
+                    t_balance = beyond = None
                 else:
+                    beyond = alpha
                     t_balance = self._balance(t_q, trial)
                 if t_balance is not None and np.linalg.norm(t_balance[free]) <= (1 - 1e-4 * alpha) * norm:
                     break
@@ -403,6 +417,10 @@ class _Solver:
                               f"{rtol:g}: pressures close to a limit pressure amplify the rounding of the "
                               f"pressures into the flows beyond that", AccuracyWarning)
                     return self._result(p, q, r_u, r_v, iteration, _share(worst, through))
+                if alpha < 1e-10 and beyond is None:
+                    # every step, however short, leaves what a tube reaches (a graded tube whose
+                    # profile would pass a section's limit pressure): Newton pushes beyond it
+                    self._edges(trial, named=True)
                 if alpha < 1e-10:
                     raise ConvergenceError(f"network: the line search stalled after {iteration} Newton iterations; "
                                            f"largest mass imbalance {worst:.3e} m^3/s = {_share(worst, through):.3e} of "
