@@ -440,6 +440,15 @@ class _Groups:
             radius_out[index] = np.broadcast_to(_radius_at(tube, tube.length) * sol.scene.outlet_stretch, index.shape)
         return p_in, radius_in, radius_out
 
+    def max_flow(self, outlet, forward):
+        """Per tube, :func:`tubefsi.max_flow_rate` at the ``outlet`` pressure with its flow entering
+        at u where ``forward``, else at v (0 for the tubes of no group; ``inf`` where it has none)."""
+        out = np.zeros(outlet.size)
+        for part, index, wall, tube, p_e in self._pieces(forward):
+            out[index] = np.broadcast_to(tubefsi_max_flow(part.fluid, wall, tube, outlet_pressure=outlet[index],
+                                                          external_pressure=p_e), index.shape)
+        return out
+
     def apparent_viscosity(self, q, mu, stretch):
         """Per tube, the Newtonian viscosity with the fluid's pressure gradient at ``|q|`` in the tube
         of its radius times ``stretch`` (one per tube; ``mu`` where q = 0; a graded tube: the

@@ -149,10 +149,11 @@ class _Solver:
         if inflow > capacity:
             i = int(outlets[np.argmin(self.p_limit[outlets])])
             raise NoSteadyStateError("flow_rate", capacity, inflow,
-                                     f"the net inflow exceeds what the resistance outlets take with every outlet "
-                                     f"node below its limit pressure, sum (p_lim - p_d)/R (e.g. node "
+                                     f"the network's capacity is at most this, what the resistance outlets take "
+                                     f"with every outlet node at its limit pressure, sum (p_lim - p_d)/R (e.g. node "
                                      f"{self.nodes[i]!r} at the limit pressure {self.p_limit[i]:.6g} Pa of tube "
-                                     f"{self._limiting_tube(i)!r})")
+                                     f"{self._limiting_tube(i)!r}); the tubes upstream may carry less",
+                                     name="the net inflow")
 
     def _check_connected(self, n):
         graph = sp.coo_matrix((np.ones(self.U.size), (self.U, self.V)), shape=(n, n))
@@ -505,11 +506,42 @@ class _Solver:
         nodes = np.flatnonzero(pinned)
         i = int(nodes[np.argmax(excess)])
         tube = self._limiting_tube(i)
-        raise NoSteadyStateError("pressure", float(self.p_limit[i]), float(p[i]),
-                                 f"tube {tube!r} reaches its limit pressure at node {self.nodes[i]!r} (to "
-                                 f"{_AT_BOUND:g} relative): held there, the network still leaves "
-                                 f"{float(np.sum(excess)):.6g} m^3/s it cannot carry, so no steady state "
-                                 f"below it carries these inflows")
+        raise self._capacity_error(pinned, float(np.sum(excess)), p, i, tube)
+
+    def _capacity_error(self, pinned, excess, p, i, tube):
+        r"""The NoSteadyStateError of inflows beyond the network's capacity, found with the nodes
+        ``pinned`` held (to :data:`_AT_BOUND`) at their limit pressures and ``excess`` left over
+        there: its ``limit`` is the flow the network carries so, the injected flow less the excess
+        (a lower bound on the capacity, the supremum over the pressures below the limits); the
+        message adds an upper bound, the same with the tubes that leave the pinned nodes at their
+        maximum flow rates (:func:`tubefsi.max_flow_rate` at their held outlet pressures: at the
+        limit itself the other pressures can only be higher, and those flows lower)."""
+        injected = float(np.sum(np.maximum(self.source, 0.0)))
+        carried = injected - excess
+        q, _, _, _, _ = self._edges(p)
+        leaving = (pinned[self.U] & (q > 0)) | (pinned[self.V] & (q < 0))
+        leaving &= ~(pinned[self.U] & pinned[self.V])
+        room = float(np.sum(self._max_flow(p, leaving) - np.abs(q[leaving])))
+        upper = (f"at most {carried + max(room, 0.0):.6g} m^3/s (the tubes leaving it at their maximum flow "
+                 f"rates)" if np.isfinite(room) else "the fluid has no maximum flow rate in its tubes, so more "
+                 "only in the limit, with tubes inflated beyond the model's range")
+        return NoSteadyStateError("flow_rate", carried, injected,
+                                  f"the network's capacity: with node {self.nodes[i]!r} held at the limit pressure "
+                                  f"{self.p_limit[i]:.10g} Pa of tube {tube!r} (to {_AT_BOUND:g} relative) it "
+                                  f"carries {carried:.6g} m^3/s of the {injected:.6g} m^3/s injected; {upper}",
+                                  name="the injected flow rate")
+
+    def _max_flow(self, p, mask):
+        """Per tube of ``mask``, :func:`tubefsi.max_flow_rate` with its flow entering at its
+        higher-pressure end and the other end's pressure as the outlet pressure."""
+        forward = p[self.U] >= p[self.V]
+        outlet = np.where(forward, p[self.V], p[self.U])
+        out = np.zeros(int(np.sum(mask)))
+        groups = _Groups(self.tubes, mask & ~self.feeder)
+        feed = _Groups(self.tubes, mask & self.feeder)
+        values = groups.max_flow(outlet, forward) + feed.max_flow(outlet, forward)
+        out[:] = values[mask]
+        return out
 
     def _to_bound(self, p, step):
         """The largest step fraction (<= 1) that goes at most 90 % of the way to a bound, and the
