@@ -392,7 +392,18 @@ class _Solver:
             ju = np.maximum(np.nan_to_num(gu, nan=c, posinf=c / _CLIP), _CLIP * c)
             jv = -np.maximum(np.nan_to_num(-gv, nan=c, posinf=c / _CLIP), _CLIP * c)
             step = self._linear_solve(self._jacobian(ju, jv), -F)
-            alpha, bounded = self._to_bound(p, step)
+            alpha, bounded = self._to_bound(p, step, released)
+            if alpha == 0.0:
+                # Newton's full steps brought the node to its limit pressure and push on: hold it
+                # there (as a cut step into it would)
+                pinned[bounded] = True
+                held_from[bounded] = p[bounded]
+                p = p.copy()
+                p[bounded] = (1.0 - _AT_BOUND) * self.p_limit[bounded]
+                self._unknowns(self.unknown & ~pinned)
+                q, gu, gv, r_u, r_v = self._edges(p)
+                balance = self._balance(q, p)
+                continue
             first = alpha
             # the node a cut step would hold at its bound: within _NEAR_BOUND of it, never released
             pin = bounded if (bounded is not None and not released[bounded]
@@ -557,10 +568,11 @@ class _Solver:
         out[:] = values[mask]
         return out
 
-    def _to_bound(self, p, step):
+    def _to_bound(self, p, step, released):
         """The largest step fraction (<= 1) that goes at most 90 % of the way to a bound, and the
-        node whose limit pressure sets it (None where none does); raises when a node sits at a
-        bound and the step still pushes outward."""
+        node whose limit pressure sets it (None where none does); where a node sits at its limit
+        pressure (to _AT_BOUND) and the step still pushes outward, ``(0.0, node)`` (the caller holds
+        it there) or, for a node held and ``released`` before, raises."""
         pf, lim = p[self.free], self.p_limit[self.free]
         up = step > 0
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -573,6 +585,8 @@ class _Solver:
             return 1.0, None
         node = int(self.free[i])
         if up[i] and gap_up[i] <= _AT_BOUND * lim[i]:
+            if not released[node]:
+                return 0.0, node
             tube = self._limiting_tube(node)
             raise NoSteadyStateError("pressure", float(lim[i]), float(pf[i]),
                                      f"tube {tube!r} reaches its limit pressure at node {self.nodes[node]!r} "
