@@ -261,3 +261,21 @@ def test_graded_edge_reviewer_cases_are_the_single_tube(case):
     net.add_tube("u", "v", wall, tube)
     net.set_inflow("s", single.flow_rate).set_pressure("v", 100.0)
     assert rel_err(net.solve().pressure["u"], p_in) < 1e-12
+
+
+def test_graded_edge_softer_inside_is_refused_naming_it():
+    """A wall four times softer in the middle than at its ends: node pressures below both ends'
+    limit pressures (21.9 kPa) but a profile that would pass the middle's (5.47 kPa) has no steady
+    state. The single graded tube (:func:`tubefsi.solve`) refuses it with its largest inlet
+    pressure; the network raises the same limit at once, naming the tube."""
+    fluid = fluids["newtonian"](viscosity=3.5e-3)
+    tube = tubefsi.Tube(radius=8e-4, thickness=1.6e-4, length=L)
+    wall = walls["thick-neo-hookean"](shear_modulus=lambda z: MU * (1 + 3 * (2 * z / L - 1) ** 2))
+    with pytest.raises(tubefsi.NoSteadyStateError) as single:
+        tubefsi.solve(fluid, wall, tube, pressure_drop=10000.0, outlet_pressure=5000.0)
+    net = tubefsi.Network(rheology=fluid)
+    net.add_tube("u", "v", wall, tube, name="soft middle")
+    net.set_pressure("u", 15000.0).set_pressure("v", 5000.0)
+    with pytest.raises(tubefsi.NoSteadyStateError, match="tube 'soft middle'") as info:
+        net.solve()
+    assert info.value.limit == single.value.limit
