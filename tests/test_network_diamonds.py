@@ -95,3 +95,62 @@ def test_many_random_diamonds():
     outlet takes below its limit pressure)."""
     for seed in [*range(400), 1108]:
         test_random_diamonds_balance.hypothesis.inner_test(seed=seed)
+
+
+CROSS = [("s", "a"), ("s", "b"), ("a", "b"), ("a", "t"), ("b", "t"), ("t", "o")]
+
+
+def _review_diamond(fluid, q=None, p_s=None):
+    """The new-user review's diamond with a cross edge s -> {a, b}, a -> b, {a, b} -> t -> o, every
+    tube 0.1 mm x 1 cm with a thick neo-Hookean wall (4 kPa, t/a = 0.3), o a resistance outlet of
+    1e11 Pa s/m^3; fed at s by the inflow ``q`` or held at the pressure ``p_s``."""
+    net = Network(rheology=fluid)
+    wall = walls["thick-neo-hookean"](shear_modulus=4e3)
+    for u, v in CROSS:
+        net.add_tube(u, v, wall, Tube(radius=1e-4, thickness=3e-5, length=1e-2))
+    net.set_resistance("o", 1e11)
+    return net.set_inflow("s", q) if p_s is None else net.set_pressure("s", p_s)
+
+
+def test_power_law_capacity_is_named_as_a_flow_rate():
+    """Above the capacity (7.64e-9 m^3/s, well below the resistance outlet's bound 1.05e-8) the
+    inflow raises NoSteadyStateError whose ``limit`` is the capacity as a flow rate. Reference:
+    the network held at the pressure (1 - 1e-12) p_lim at s (p_lim = mu ln 1.3 in closed form), a
+    pressure-driven solve (no inflow, no active set): the flow it takes in is the capacity, 1e-9.
+    Just below it (0.995 of it) the inflow has a steady state at s below p_lim; the message gives
+    an upper bound (the tubes leaving s at their maximum flow rates) within 2 % of it."""
+    fluid = rheologies["power-law"](consistency=0.017, index=0.7)
+    limit = 4e3 * np.log1p(0.3)
+    held = _review_diamond(fluid, p_s=(1 - 1e-12) * limit).solve()
+    capacity = held.flow_rate[("s", "a")] + held.flow_rate[("s", "b")]
+    assert capacity < 0.75 * limit / 1e11
+    with pytest.raises(NoSteadyStateError, match="capacity") as info:
+        _review_diamond(fluid, q=1.01 * capacity).solve()
+    assert info.value.quantity == "flow_rate"
+    assert info.value.limit == pytest.approx(capacity, rel=1e-9)
+    upper = float(str(info.value).split("at most ")[1].split(" ")[0])
+    assert capacity < upper < 1.02 * capacity
+    below = _review_diamond(fluid, q=0.995 * capacity).solve()
+    assert below.pressure["s"] < limit
+    assert below.pressure["o"] == pytest.approx(0.995 * capacity * 1e11, rel=1e-12)
+
+
+@pytest.mark.slow
+def test_carreau_yasuda_capacity_is_named_as_a_flow_rate():
+    """The Carreau–Yasuda fluid (Newtonian at high shear) has no maximum flow rate in a tube: the
+    flow the review's diamond takes grows without bound (logarithmically in the gap) as s nears
+    its limit pressure, so its capacity is the one resolved with s held 1e-12 below it. Reference:
+    that pressure-driven solve (no inflow, no active set), 1e-4 to the error's ``limit`` (the
+    rounding of pressures 1e-12 below the limit, amplified by the tubes inflated there, leaves
+    both balances at ~1e-6 of the flow); the message says there is more only in the limit. 0.97
+    of it has a steady state."""
+    fluid = rheologies["carreau-yasuda"](zero_shear_viscosity=0.056, infinite_shear_viscosity=0.0035,
+                                          relaxation_time=3.313, index=0.3568, transition=2.0)
+    limit = 4e3 * np.log1p(0.3)
+    held = _review_diamond(fluid, p_s=(1 - 1e-12) * limit).solve()
+    capacity = held.flow_rate[("s", "a")] + held.flow_rate[("s", "b")]
+    with pytest.raises(NoSteadyStateError, match="no maximum flow rate") as info:
+        _review_diamond(fluid, q=1.01 * capacity).solve()
+    assert info.value.limit == pytest.approx(capacity, rel=1e-4)
+    below = _review_diamond(fluid, q=0.97 * capacity).solve()
+    assert below.pressure["s"] < limit

@@ -205,3 +205,77 @@ def test_add_tubes_refuses_graded_tubes():
     with pytest.raises(tubefsi.InvalidParameterError, match="by add_tube"):
         net.add_tubes(["a"], ["b"], wall, tube)
 
+
+
+def test_graded_edge_node_bounded_by_its_own_end_limit():
+    """A wall softening along the tube (modulus 2 mu -> mu, limit pressures mu ln 1.2 x 2 -> 1):
+    an inlet pressure above the smallest limit along the tube (5.47 kPa at the outlet) but below
+    the inlet's own (10.9 kPa), with the pressure below the local limit everywhere, has a steady
+    state; the one-edge network carries the single graded tube's flow (:func:`tubefsi.solve`,
+    1e-12), where it used to refuse it by the smallest limit. The node pressure beyond the inlet's
+    own limit is refused, naming it."""
+    fluid = fluids["newtonian"](viscosity=3.5e-3)
+    tube = tubefsi.Tube(radius=8e-4, thickness=1.6e-4, length=L)
+    wall = walls["thick-neo-hookean"](shear_modulus=lambda z: MU * (2 - z / L))
+    single = tubefsi.solve(fluid, wall, tube, pressure_drop=5000.0, outlet_pressure=1000.0)
+    assert float(single.pressure(0.0)) > MU * np.log(1.2)
+    net = tubefsi.Network(rheology=fluid)
+    net.add_tube("u", "v", wall, tube)
+    net.set_pressure("u", 6000.0).set_pressure("v", 1000.0)
+    assert rel_err(net.solve().flow_rates[0], single.flow_rate) < 1e-12
+    net.set_pressure("u", 11000.0)
+    with pytest.raises(tubefsi.NoSteadyStateError, match="limit pressure 10939.29") as info:
+        net.solve()
+    assert info.value.limit == pytest.approx(2 * MU * np.log(1.2), rel=1e-9)
+
+
+_REVIEW = {   # the reviewer's reproducers: a modulus 8 -> 4 kPa along the tube, a taper entered narrow
+    "graded-modulus": (lambda L: (walls["thick-neo-hookean"](shear_modulus=tubefsi.sampled([0, L], [8e3, 4e3],
+                                                                                           kind="linear")),
+                                  tubefsi.Tube(radius=1e-4, thickness=3e-5, length=L)), 1500.0),
+    "taper": (lambda L: (walls["thick-neo-hookean"](shear_modulus=4e3),
+                         tubefsi.Tube.tapered(length=L, radius=0.6e-4, outlet_radius=1.2e-4, thickness=3e-5,
+                                              outlet_thickness=3e-5)), 1000.0),
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case", sorted(_REVIEW))
+def test_graded_edge_reviewer_cases_are_the_single_tube(case):
+    """The two cases of the new-user review (inlet pressure above the smallest limit along the
+    tube, below the inlet's own): the one-edge network and the same edge fed by a short uniform
+    tube from a fixed pressure equal the single graded tube (:func:`tubefsi.solve`; the feeder's
+    outlet pressure, the network's free node, is the single tube's inlet pressure), 1e-12."""
+    length = 1e-2
+    fluid = fluids["newtonian"](viscosity=3.5e-3)
+    make, p_in = _REVIEW[case]
+    wall, tube = make(length)
+    single = tubefsi.solve(fluid, wall, tube, pressure_drop=p_in - 100.0, outlet_pressure=100.0)
+    net = tubefsi.Network(rheology=fluid)
+    net.add_tube("u", "v", wall, tube)
+    net.set_pressure("u", p_in).set_pressure("v", 100.0)
+    assert rel_err(net.solve().flow_rates[0], single.flow_rate) < 1e-12
+    net = tubefsi.Network(rheology=fluid)
+    net.add_tube("s", "u", walls["thick-neo-hookean"](shear_modulus=4e3),
+                 tubefsi.Tube(radius=1e-4, thickness=5e-5, length=1e-3))
+    net.add_tube("u", "v", wall, tube)
+    net.set_inflow("s", single.flow_rate).set_pressure("v", 100.0)
+    assert rel_err(net.solve().pressure["u"], p_in) < 1e-12
+
+
+def test_graded_edge_softer_inside_is_refused_naming_it():
+    """A wall four times softer in the middle than at its ends: node pressures below both ends'
+    limit pressures (21.9 kPa) but a profile that would pass the middle's (5.47 kPa) has no steady
+    state. The single graded tube (:func:`tubefsi.solve`) refuses it with its largest inlet
+    pressure; the network raises the same limit at once, naming the tube."""
+    fluid = fluids["newtonian"](viscosity=3.5e-3)
+    tube = tubefsi.Tube(radius=8e-4, thickness=1.6e-4, length=L)
+    wall = walls["thick-neo-hookean"](shear_modulus=lambda z: MU * (1 + 3 * (2 * z / L - 1) ** 2))
+    with pytest.raises(tubefsi.NoSteadyStateError) as single:
+        tubefsi.solve(fluid, wall, tube, pressure_drop=10000.0, outlet_pressure=5000.0)
+    net = tubefsi.Network(rheology=fluid)
+    net.add_tube("u", "v", wall, tube, name="soft middle")
+    net.set_pressure("u", 15000.0).set_pressure("v", 5000.0)
+    with pytest.raises(tubefsi.NoSteadyStateError, match="tube 'soft middle'") as info:
+        net.solve()
+    assert info.value.limit == single.value.limit

@@ -293,7 +293,13 @@ class _Groups:
             self.parts.append(_Part(index, t.rheology, t.wall, t.tube, _column(tubes.external[index]),
                                     _reversed(t.wall, t.tube)))
         n = len(tubes)
+        self.names = tubes.names               # (to name a tube in an error)
+        # the node (gauge) pressures at which the transmural one reaches the limit pressure: the
+        # smallest along each tube (``limit``) and at its ends u (z = 0) and v (z = L), which bound
+        # the pressures of its nodes (a uniform tube: all three the same)
         self.limit = np.zeros(n)
+        self.limit_u = np.zeros(n)
+        self.limit_v = np.zeros(n)
         self.radius = np.zeros(n)            # a uniform tube's radius; a graded tube's Poiseuille mean
         self.radius_u = np.zeros(n)          # the undeformed radii at the two ends
         self.radius_v = np.zeros(n)
@@ -301,30 +307,60 @@ class _Groups:
         for part in self.parts:
             index, wall, tube = part.index, part.wall, part.tube
             if part.reverse is None:
-                # the node (gauge) pressure at which the transmural one reaches the limit pressure
-                limit = wall.limit_pressure(tube.reduced_thickness)
+                limit = limit_u = limit_v = wall.limit_pressure(tube.reduced_thickness)
                 self.radius[index] = np.broadcast_to(tube.radius, index.shape)
             else:
-                limit, self.radius[index] = _along(part)
-            self.limit[index] = np.broadcast_to(limit + np.asarray(part.external), index.shape)
+                limit, limit_u, limit_v, self.radius[index] = _along(part)
+            for out, value in ((self.limit, limit), (self.limit_u, limit_u), (self.limit_v, limit_v)):
+                out[index] = np.broadcast_to(value + np.asarray(part.external), index.shape)
             self.radius_u[index], self.radius_v[index] = (np.broadcast_to(a, index.shape) for a in part.ends())
             self.length[index] = np.broadcast_to(tube.length, index.shape)
 
-    def evaluate(self, drop, outlet, forward):
+    def evaluate(self, drop, outlet, forward, named=False):
         """Flow rates and the derivatives by the inlet and outlet pressures of the tubes (pressure-
         controlled, the flow entering at u where ``forward``, else at v; zeros for the tubes of no
-        group)."""
+        group). A tube without a steady state raises NoSteadyStateError: with ``named``, one that
+        names it (found by solving the tubes of its group one by one: for the error shown only)."""
         q, d_in, d_out, radius_in, radius_out = (np.zeros(drop.size) for _ in range(5))
         for part, index, wall, tube, p_e in self._pieces(forward):
             # Newton's trial pressures: unchecked (the result is checked once; no process-wide
             # warning filter, which would silence other threads too)
-            sol = solve_unchecked(part.fluid, wall, tube, pressure_drop=drop[index], outlet_pressure=outlet[index],
-                                  external_pressure=p_e)
+            try:
+                sol = solve_unchecked(part.fluid, wall, tube, pressure_drop=drop[index],
+                                      outlet_pressure=outlet[index], external_pressure=p_e)
+            except NoSteadyStateError as exc:
+                if not named:
+                    raise
+                raise self._named(exc, part.fluid, wall, tube, p_e, index, drop, outlet) from None
             q[index] = sol.flow_rate
             _, d_in[index], d_out[index] = sol._sensitivities()
             radius_in[index] = sol.inlet_radius
             radius_out[index] = np.broadcast_to(_radius_at(tube, tube.length) * sol.scene.outlet_stretch, index.shape)
         return q, d_in, d_out, radius_in, radius_out
+
+    def _named(self, exc, fluid, wall, tube, p_e, index, drop, outlet):
+        """``exc`` (a pressure-controlled solve of the tubes ``index`` without a steady state) as a
+        NoSteadyStateError naming the first of them that has none (each solved alone: the error
+        path only), with its inlet and outlet pressures."""
+        j = 0
+        if index.size > 1:
+            p_e = np.broadcast_to(np.asarray(p_e, dtype=float), index.shape)
+            for j in range(index.size):
+                k = index[j]
+                try:
+                    solve_unchecked(_entry_of(fluid, index.size, j), _entry_of(wall, index.size, j),
+                                    _entry_of(tube, index.size, j),
+                                    pressure_drop=drop[k], outlet_pressure=outlet[k], external_pressure=p_e[j])
+                except NoSteadyStateError as found:
+                    exc = found
+                    break
+        k = int(index[j])
+        inlet = float(drop[k] + outlet[k])
+        where = f"tube {self.names[k]!r} at the outlet pressure {float(outlet[k]):.10g} Pa"
+        if exc.quantity == "pressure":
+            return NoSteadyStateError("pressure", exc.limit, inlet, name="the inlet pressure of " + where)
+        return NoSteadyStateError(exc.quantity, exc.limit, None, f"{where} and the inlet pressure {inlet:.10g} Pa "
+                                  f"({exc})")
 
     def _pieces(self, forward):
         """``(part, index, wall, tube, external)``: the tubes of each part, split by the direction
@@ -404,6 +440,15 @@ class _Groups:
             radius_out[index] = np.broadcast_to(_radius_at(tube, tube.length) * sol.scene.outlet_stretch, index.shape)
         return p_in, radius_in, radius_out
 
+    def max_flow(self, outlet, forward):
+        """Per tube, :func:`tubefsi.max_flow_rate` at the ``outlet`` pressure with its flow entering
+        at u where ``forward``, else at v (0 for the tubes of no group; ``inf`` where it has none)."""
+        out = np.zeros(outlet.size)
+        for part, index, wall, tube, p_e in self._pieces(forward):
+            out[index] = np.broadcast_to(tubefsi_max_flow(part.fluid, wall, tube, outlet_pressure=outlet[index],
+                                                          external_pressure=p_e), index.shape)
+        return out
+
     def apparent_viscosity(self, q, mu, stretch):
         """Per tube, the Newtonian viscosity with the fluid's pressure gradient at ``|q|`` in the tube
         of its radius times ``stretch`` (one per tube; ``mu`` where q = 0; a graded tube: the
@@ -446,6 +491,13 @@ class _Groups:
         return tuple((part.index, part.fluid) for part in self.parts)
 
 
+def _entry_of(model, n, j):
+    """``model`` (whose array parameters have length ``n`` or are scalars) at entry ``j``."""
+    arrays = {f: np.asarray(v)[j] for f in _array_fields(type(model))
+              if isinstance(v := getattr(model, f), np.ndarray) and v.shape == (n,)}
+    return attrs.evolve(model, **arrays) if arrays else model
+
+
 def _radius_at(tube, z):
     """The undeformed radius at the position ``z`` (m): a(z) of a graded tube, else its radius."""
     if isinstance(tube.radius, Profile):
@@ -458,18 +510,20 @@ _SAMPLES = 65
 
 
 def _along(part):
-    r"""A graded tube's bound for its nodes' pressures and its radius for the rigid start: the
-    smallest local limit pressure of its sections (sampled at 65 positions and its breakpoints: a
-    node pressure below it keeps every section below its own, since the pressure falls along the
-    flow), and the Poiseuille mean :math:`(\frac1L\int_0^L a^{-4}\,dz)^{-1/4}` (trapezoidal rule)."""
+    r"""A graded tube's limit pressures and its radius for the rigid start: the smallest local limit
+    pressure of its sections (sampled at 65 positions and its breakpoints), the local ones at its
+    ends ``z = 0`` and ``z = L`` (the bounds of its nodes' pressures: the pressure at an end is its
+    node's; the interior is checked by the graded-tube solve itself, which raises where the
+    profile would pass a section's own limit), and the Poiseuille mean
+    :math:`(\frac1L\int_0^L a^{-4}\,dz)^{-1/4}` (trapezoidal rule)."""
     scene = make_scene(part.fluid, part.wall, part.tube)
     L = float(part.tube.length)
     z = np.union1d(np.linspace(0.0, L, _SAMPLES), [b for b in _breakpoints(scene) if 0.0 < b < L])
     wall, a, tb = scene.at_position(z)
-    limit = float(np.min(np.broadcast_to(wall._limit_pressure(tb), z.shape)))
+    limit = np.broadcast_to(np.asarray(wall._limit_pressure(tb), dtype=float), z.shape)
     a = np.broadcast_to(a, z.shape)
     mean = float((np.trapezoid(a**-4.0, z) / L) ** -0.25)
-    return limit, mean
+    return float(np.min(limit)), float(limit[0]), float(limit[-1]), mean
 
 
 def _flipped(profile, length):

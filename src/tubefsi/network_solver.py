@@ -23,8 +23,8 @@ Globalization: the start is a Newtonian network (each tube a Hagen–Poiseuille 
 each with the tube inflated to :math:`R = a(1+\varepsilon)` by its wall's hoop strain at the mean
 of its end pressures and the fluid's apparent viscosity in it: the secant :math:`|q|/(L\,G(|q|, R))`);
 every Newton step is cut to stay inside
-:math:`0 \le p_i < p_{lim}` (a step goes at most 90 % of the way to a tube's limit pressure or
-to zero) and then halved until the residual norm :math:`\|F\|_2` decreases (Armijo). The derivative of a tube without flow is
+:math:`0 \le p_i < p_{lim}` (a step goes at most 90 % of the way to a tube's limit pressure at
+that node, or to zero; a graded tube's interior is checked by its own solve) and then halved until the residual norm :math:`\|F\|_2` decreases (Armijo). The derivative of a tube without flow is
 degenerate — :math:`\partial q/\partial p \to 0` for a shear-thinning fluid, :math:`\infty` for a
 shear-thickening one, as :math:`\Delta p \to 0` — so a tube whose pressure drop is below
 :math:`10^{-8}` of the largest pressure enters the Jacobian with its secant conductance
@@ -38,6 +38,10 @@ A trial pressure beyond what a wall's tube law reaches halves the step; a flow r
 single-tube solve cannot give at a drop far below the pressures (NaN, the generic rheology path)
 is the secant of a probe drop (``docs/network.md``). A node with an inflow and a single
 tube is no unknown: that tube is solved flow-controlled at the end.
+
+Inflows beyond the network's capacity: a node pushed into its limit pressure is held there (an
+active set, ``_Solver._pinned_done``); an excess left there raises ``NoSteadyStateError`` whose
+``limit`` is the flow the network carries so (``_Solver._capacity_error``).
 
 Converged means that the mass balance of every free node is below ``rtol`` times the
 throughput (the total flow that enters the network); otherwise :class:`ConvergenceError`.
@@ -114,15 +118,18 @@ class _Solver:
         self.feeds = feeds
         self.groups = _Groups(self.tubes, ~self.feeder)
         self.feed_groups = _Groups(self.tubes, self.feeder)
-        self.limit = np.where(self.feeder, self.feed_groups.limit, self.groups.limit)
+        # per tube, the limit pressures at its ends u and v (a graded tube's differ: ``_Groups``)
+        self.limit_u = np.where(self.feeder, self.feed_groups.limit_u, self.groups.limit_u)
+        self.limit_v = np.where(self.feeder, self.feed_groups.limit_v, self.groups.limit_v)
         self.radius = np.where(self.feeder, self.feed_groups.radius, self.groups.radius)
         self.radius0_u = np.where(self.feeder, self.feed_groups.radius_u, self.groups.radius_u)
         self.radius0_v = np.where(self.feeder, self.feed_groups.radius_v, self.groups.radius_v)
         self.length = np.where(self.feeder, self.feed_groups.length, self.groups.length)
-        # a node's bound: the smallest limit pressure of its tubes (an inlet must stay below it)
+        # a node's bound: the smallest limit pressure of its tubes at their ends there (an inlet
+        # must stay below it; a graded tube's interior is checked by its own solve)
         self.p_limit = np.full(n_nodes, np.inf)
-        np.minimum.at(self.p_limit, self.U, self.limit)
-        np.minimum.at(self.p_limit, self.V, self.limit)
+        np.minimum.at(self.p_limit, self.U, self.limit_u)
+        np.minimum.at(self.p_limit, self.V, self.limit_v)
         over = self.fixed & (self.p_fixed >= self.p_limit)
         if np.any(over):
             i = int(np.flatnonzero(over)[0])
@@ -146,10 +153,11 @@ class _Solver:
         if inflow > capacity:
             i = int(outlets[np.argmin(self.p_limit[outlets])])
             raise NoSteadyStateError("flow_rate", capacity, inflow,
-                                     f"the net inflow exceeds what the resistance outlets take with every outlet "
-                                     f"node below its limit pressure, sum (p_lim - p_d)/R (e.g. node "
+                                     f"the network's capacity is at most this, what the resistance outlets take "
+                                     f"with every outlet node at its limit pressure, sum (p_lim - p_d)/R (e.g. node "
                                      f"{self.nodes[i]!r} at the limit pressure {self.p_limit[i]:.6g} Pa of tube "
-                                     f"{self._limiting_tube(i)!r})")
+                                     f"{self._limiting_tube(i)!r}); the tubes upstream may carry less",
+                                     name="the net inflow")
 
     def _check_connected(self, n):
         graph = sp.coo_matrix((np.ones(self.U.size), (self.U, self.V)), shape=(n, n))
@@ -180,8 +188,10 @@ class _Solver:
         self._pattern = None                 # built by the next _jacobian
 
     def _limiting_tube(self, i):
+        """The name of the tube whose limit pressure at node ``i`` is the node's bound."""
         at = np.flatnonzero((self.U == i) | (self.V == i))
-        return self.tubes[int(at[np.argmin(self.limit[at])])].name
+        limit = np.where(self.U[at] == i, self.limit_u[at], self.limit_v[at])
+        return self.tubes[int(at[np.argmin(limit)])].name
 
     # ------------------------------------------------------------------ linear algebra
     def _jacobian(self, gu, gv):
@@ -248,13 +258,16 @@ class _Solver:
             return np.ones(self.n_tubes)
 
     # ------------------------------------------------------------------ Newton
-    def _edges(self, p):
+    def _edges(self, p, named=False):
+        """Per tube at the node pressures ``p``: its flow (u to v), its derivatives by p_u and p_v
+        (the Jacobian's, see the module's docstring) and its deformed radii at u and v. A tube
+        without a steady state raises NoSteadyStateError (naming it where ``named``)."""
         du = p[self.U] - p[self.V]
         forward = du >= 0
         drop = np.abs(du)
         drop[drop <= _TINY * float(np.max(p))] = 0.0      # flow ~ (1e-30)^(1/n) of the network's
         outlet = np.where(forward, p[self.V], p[self.U])
-        q, d_in, d_out, r_in, r_out = self.groups.evaluate(drop, outlet, forward)
+        q, d_in, d_out, r_in, r_out = self.groups.evaluate(drop, outlet, forward, named)
         bad = ~np.isfinite(q)
         if np.any(bad):
             q, d_in, d_out = self._tiny_drops(bad, drop, outlet, forward, q, d_in, d_out, float(np.max(p)))
@@ -336,14 +349,19 @@ class _Solver:
                     p[i] = value
         room = np.where(np.isfinite(self.p_limit), self.p_limit, np.inf)
         p[free] = np.clip(p[free], 0.0, np.where(np.isfinite(room[free]), _TO_BOUND * room[free], np.inf))
-        for _ in range(60):            # a start beyond what a wall law reaches: halve it
+        # a start beyond what a wall law (or a graded tube) reaches: halve it, then try the free
+        # nodes at zero (the lowest pressures there: the fixed nodes' tubes then carry the most
+        # flow and feel the least pressure downstream); failing that the fixed pressures alone
+        # have no steady state
+        for attempt in range(6):
             try:
                 q, gu, gv, r_u, r_v = self._edges(p)
                 break
             except NoSteadyStateError:
-                p[free] *= 0.5
-        else:
-            q, gu, gv, r_u, r_v = self._edges(p)
+                if not np.any(p[free] > 0):
+                    self._edges(p, named=True)
+                    raise
+                p[free] = 0.5 * p[free] if attempt < 4 else 0.0
         balance = self._balance(q, p)
         # nodes held at their bound (an active set): where Newton pushes a node into its limit
         # pressure and the line search must cut the step, the node is held there and the rest
@@ -362,12 +380,30 @@ class _Solver:
                 # a pinned node takes flow out: its pressure goes down
                 p, q, gu, gv, r_u, r_v, balance = self._release(p, pinned, released, held_from)
                 continue
+            if np.any(pinned) and np.linalg.norm(F) <= 10 * np.linalg.norm(self._noise(p, q, gu, gv)):
+                # the rest balanced to what rounding allows (the held nodes' steep tubes amplify
+                # it): the held nodes' excess decides now, where it dwarfs the rest's imbalance
+                # (line searches stalled on rounding took tens of seconds to say the same)
+                if not self._pinned_done(pinned, balance, p, max(rtol * through, 10 * float(np.sum(np.abs(F))))):
+                    p, q, gu, gv, r_u, r_v, balance = self._release(p, pinned, released, held_from)
+                    continue
             if iteration == max_iterations:
                 break
             ju = np.maximum(np.nan_to_num(gu, nan=c, posinf=c / _CLIP), _CLIP * c)
             jv = -np.maximum(np.nan_to_num(-gv, nan=c, posinf=c / _CLIP), _CLIP * c)
             step = self._linear_solve(self._jacobian(ju, jv), -F)
-            alpha, bounded = self._to_bound(p, step)
+            alpha, bounded = self._to_bound(p, step, released)
+            if alpha == 0.0:
+                # Newton's full steps brought the node to its limit pressure and push on: hold it
+                # there (as a cut step into it would)
+                pinned[bounded] = True
+                held_from[bounded] = p[bounded]
+                p = p.copy()
+                p[bounded] = (1.0 - _AT_BOUND) * self.p_limit[bounded]
+                self._unknowns(self.unknown & ~pinned)
+                q, gu, gv, r_u, r_v = self._edges(p)
+                balance = self._balance(q, p)
+                continue
             first = alpha
             # the node a cut step would hold at its bound: within _NEAR_BOUND of it, never released
             pin = bounded if (bounded is not None and not released[bounded]
@@ -380,8 +416,9 @@ class _Solver:
                 try:
                     t_q, t_gu, t_gv, t_ru, t_rv = self._edges(trial)
                 except NoSteadyStateError:    # beyond what a wall law reaches (a peak): shorter
-                    t_balance = None
+                    t_balance = beyond = None
                 else:
+                    beyond = alpha
                     t_balance = self._balance(t_q, trial)
                 if t_balance is not None and np.linalg.norm(t_balance[free]) <= (1 - 1e-4 * alpha) * norm:
                     break
@@ -403,6 +440,10 @@ class _Solver:
                               f"{rtol:g}: pressures close to a limit pressure amplify the rounding of the "
                               f"pressures into the flows beyond that", AccuracyWarning)
                     return self._result(p, q, r_u, r_v, iteration, _share(worst, through))
+                if alpha < 1e-10 and beyond is None:
+                    # every step, however short, leaves what a tube reaches (a graded tube whose
+                    # profile would pass a section's limit pressure): Newton pushes beyond it
+                    self._edges(trial, named=True)
                 if alpha < 1e-10:
                     raise ConvergenceError(f"network: the line search stalled after {iteration} Newton iterations; "
                                            f"largest mass imbalance {worst:.3e} m^3/s = {_share(worst, through):.3e} of "
@@ -487,16 +528,51 @@ class _Solver:
         nodes = np.flatnonzero(pinned)
         i = int(nodes[np.argmax(excess)])
         tube = self._limiting_tube(i)
-        raise NoSteadyStateError("pressure", float(self.p_limit[i]), float(p[i]),
-                                 f"tube {tube!r} reaches its limit pressure at node {self.nodes[i]!r} (to "
-                                 f"{_AT_BOUND:g} relative): held there, the network still leaves "
-                                 f"{float(np.sum(excess)):.6g} m^3/s it cannot carry, so no steady state "
-                                 f"below it carries these inflows")
+        # what the network did not carry out: the held nodes' excess and what the rest still
+        # keeps (at rounding level where the rest is balanced to it)
+        raise self._capacity_error(pinned, float(np.sum(excess) + np.sum(balance[self.free])), p, i, tube)
 
-    def _to_bound(self, p, step):
+    def _capacity_error(self, pinned, excess, p, i, tube):
+        r"""The NoSteadyStateError of inflows beyond the network's capacity, found with the nodes
+        ``pinned`` held (to :data:`_AT_BOUND`) at their limit pressures and ``excess`` not carried
+        out (left there and, at rounding level, at the other free nodes): its ``limit`` is the flow
+        the network carries so, the injected flow less the excess
+        (a lower bound on the capacity, the supremum over the pressures below the limits); the
+        message adds an upper bound, the same with the tubes that leave the pinned nodes at their
+        maximum flow rates (:func:`tubefsi.max_flow_rate` at their held outlet pressures: at the
+        limit itself the other pressures can only be higher, and those flows lower)."""
+        injected = float(np.sum(np.maximum(self.source, 0.0)))
+        carried = injected - excess
+        q, _, _, _, _ = self._edges(p)
+        leaving = (pinned[self.U] & (q > 0)) | (pinned[self.V] & (q < 0))
+        leaving &= ~(pinned[self.U] & pinned[self.V])
+        room = float(np.sum(self._max_flow(p, leaving) - np.abs(q[leaving])))
+        upper = (f"at most {carried + max(room, 0.0):.6g} m^3/s (the tubes leaving it at their maximum flow "
+                 f"rates)" if np.isfinite(room) else "the fluid has no maximum flow rate in its tubes, so more "
+                 "only in the limit, with tubes inflated beyond the model's range")
+        return NoSteadyStateError("flow_rate", carried, injected,
+                                  f"the network's capacity: with node {self.nodes[i]!r} held at the limit pressure "
+                                  f"{self.p_limit[i]:.10g} Pa of tube {tube!r} (to {_AT_BOUND:g} relative) it "
+                                  f"carries {carried:.6g} m^3/s of the {injected:.6g} m^3/s injected; {upper}",
+                                  name="the injected flow rate")
+
+    def _max_flow(self, p, mask):
+        """Per tube of ``mask``, :func:`tubefsi.max_flow_rate` with its flow entering at its
+        higher-pressure end and the other end's pressure as the outlet pressure."""
+        forward = p[self.U] >= p[self.V]
+        outlet = np.where(forward, p[self.V], p[self.U])
+        out = np.zeros(int(np.sum(mask)))
+        groups = _Groups(self.tubes, mask & ~self.feeder)
+        feed = _Groups(self.tubes, mask & self.feeder)
+        values = groups.max_flow(outlet, forward) + feed.max_flow(outlet, forward)
+        out[:] = values[mask]
+        return out
+
+    def _to_bound(self, p, step, released):
         """The largest step fraction (<= 1) that goes at most 90 % of the way to a bound, and the
-        node whose limit pressure sets it (None where none does); raises when a node sits at a
-        bound and the step still pushes outward."""
+        node whose limit pressure sets it (None where none does); where a node sits at its limit
+        pressure (to _AT_BOUND) and the step still pushes outward, ``(0.0, node)`` (the caller holds
+        it there) or, for a node held and ``released`` before, raises."""
         pf, lim = p[self.free], self.p_limit[self.free]
         up = step > 0
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -509,6 +585,8 @@ class _Solver:
             return 1.0, None
         node = int(self.free[i])
         if up[i] and gap_up[i] <= _AT_BOUND * lim[i]:
+            if not released[node]:
+                return 0.0, node
             tube = self._limiting_tube(node)
             raise NoSteadyStateError("pressure", float(lim[i]), float(pf[i]),
                                      f"tube {tube!r} reaches its limit pressure at node {self.nodes[node]!r} "
@@ -564,7 +642,7 @@ _UNRESOLVED = ("; no flow is resolved at all: tubes in series whose conductances
 
 #: The largest mass imbalance (a share of the throughput) accepted, with an AccuracyWarning, where
 #: the rounding of the pressures allows no better; beyond it the line search's stall is an error.
-_WORST_ROUNDED = 1e-6
+_WORST_ROUNDED = 1e-4
 
 
 def _at(index, by_node):
