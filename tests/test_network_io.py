@@ -487,14 +487,19 @@ def test_names_the_table_would_read_back_as_others_are_refused(tmp_path, names, 
 def test_any_text_name_reads_back_or_is_refused(tmp_path_factory, names):
     """The contract of the table's names: written and read back as the same name, or refused
     with an InvalidParameterError naming it; never another name."""
-    net = _openbf_y(names=tuple(names))
-    path = tmp_path_factory.mktemp("names") / "n.csv"
+    _reads_back_or_is_refused(_openbf_y(names=tuple(names)), tmp_path_factory.mktemp("names") / "n.csv",
+                              "tube name", "tube_names", names)
+
+
+def _reads_back_or_is_refused(net, path, what, attribute, expected):
+    """Write ``net``'s table to ``path``: refused naming ``what``, or read back with ``attribute``
+    equal to ``expected``."""
     try:
         network_io.write_network_table(net, path)
     except InvalidParameterError as err:
-        assert "tube name" in str(err)
+        assert what in str(err)
         return
-    assert tubefsi.read_network_table(path, rheology=NEWTONIAN).tube_names == names
+    assert getattr(tubefsi.read_network_table(path, rheology=NEWTONIAN), attribute) == expected
 
 
 @settings(max_examples=25, deadline=None)
@@ -503,14 +508,8 @@ def test_any_text_name_reads_back_or_is_refused(tmp_path_factory, names):
 def test_any_node_name_reads_back_or_is_refused(tmp_path_factory, nodes):
     """The same contract for node names (text or integers; "nan" once read back as an empty
     cell)."""
-    net = _openbf_y(nodes=tuple(nodes))
-    path = tmp_path_factory.mktemp("nodes") / "n.csv"
-    try:
-        network_io.write_network_table(net, path)
-    except InvalidParameterError as err:
-        assert "node name" in str(err)
-        return
-    assert tubefsi.read_network_table(path, rheology=NEWTONIAN).nodes == nodes
+    _reads_back_or_is_refused(_openbf_y(nodes=tuple(nodes)), tmp_path_factory.mktemp("nodes") / "n.csv",
+                              "node name", "nodes", nodes)
 
 
 def test_a_linear_thickness_along_a_taper_round_trips_through_the_table(tmp_path):
