@@ -188,3 +188,53 @@ def test_a_band_below_the_runs_accuracy_warns():
     r = tubefsi.evolve(FLUID, WALL, TUBE, np.linspace(0.0, 0.05, 11), inlet_pressure=2.02e4, initial=steady, rtol=1e-3)
     with pytest.warns(tubefsi.AccuracyWarning, match="narrower than the run's accuracy"):
         assert math.isfinite(r.settling_time(1.0 - 1e-7))
+
+
+def test_a_shear_thinning_run_survives_a_lowered_inlet_pressure():
+    """Lowering the inlet pressure of a shear-thinning run mid-way once stopped it with an
+    InvalidParameterError from inside the integrator (a Newton iterate beyond the wall's range).
+    The run completes, and its long-time limit is ``solve``'s at the lowered pressure."""
+    fluid = tubefsi.registry.rheologies["power-law"](consistency=0.017, index=0.7)
+    r = tubefsi.evolve(fluid, WALL, TUBE, np.linspace(0.0, 3.0, 7), inlet_pressure=lambda t: 2e4 if t < 0.1 else 1e4,
+                       rtol=1e-4)
+    steady = tubefsi.solve(fluid, WALL, TUBE, pressure_drop=1e4).flow_rate
+    assert r.inlet_flow_rate[-1] == pytest.approx(steady, rel=1e-5)
+
+
+@pytest.mark.slow
+def test_a_plain_class_wall_given_by_its_stretch_evolves():
+    """A WallModel subclass with the one method ``_stretch`` (its domain: stretches >= 1): the
+    resting cells' trial states undershoot to strains of -1e-25, which stopped the run; its
+    long-time limit is ``solve``'s."""
+    from tubefsi.walls.base import WallModel
+
+    class LinearWall(WallModel):
+        def _stretch(self, pressure, tb):
+            return 1.0 + np.asarray(pressure) / (2e5 * tb)
+
+    r = tubefsi.evolve(FLUID, LinearWall(), TUBE, np.linspace(0.0, 0.5, 3), inlet_pressure=1e3, rtol=1e-3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", tubefsi.AccuracyWarning)
+        steady = tubefsi.solve(FLUID, LinearWall(), TUBE, pressure_drop=1e3).flow_rate
+    assert r.inlet_flow_rate[-1] == pytest.approx(steady, rel=1e-5)
+
+
+@pytest.mark.parametrize("kwargs, name", [
+    (dict(inlet_pressure=np.array([])), "inlet_pressure"),
+    (dict(inlet_pressure=np.zeros((2, 0))), "inlet_pressure"),
+    (dict(inlet_pressure=1e3, external_pressure=np.zeros(0)), "external_pressure"),
+])
+def test_an_empty_array_of_scenes_is_refused(kwargs, name):
+    with pytest.raises(tubefsi.InvalidParameterError, match=name):
+        tubefsi.evolve(FLUID, WALL, TUBE, TIMES, rtol=1e-3, **kwargs)
+
+
+def test_a_change_below_the_runs_accuracy_warns():
+    """A 0.5 % step run at a loose tolerance without error control: its change lies below what the
+    run resolves, so its settling time is 0 as far as the run can tell, and it says so (it once
+    returned 0 silently where the stored history gives 1.8 s)."""
+    fluid = tubefsi.registry.rheologies["power-law"](consistency=0.017, index=0.7)
+    r = tubefsi.evolve(fluid, WALL, TUBE, np.linspace(0.0, 5.0, 51), inlet_pressure=2e4 + 100, initial=2e4,
+                       outlet=tubefsi.Chamber.linear(1e-7, 1e-11), error_control=False, cells=32, rtol=1e-2)
+    with pytest.warns(tubefsi.AccuracyWarning, match="narrower than the run's accuracy"):
+        r.settling_time(0.9)
