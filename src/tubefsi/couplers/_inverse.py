@@ -156,18 +156,35 @@ def newton(engine, scene, target, index, q=None, upper=None):
     return v, ok, Integral(value=value, error=error, converged=converged, panels=np.zeros(n, dtype=int))
 
 
+class _Remembered:
+    """``F(x, i)`` of an integral (``integral(x, i)`` returns an :class:`Integral` at the points
+    ``i``), keeping each point's last evaluation: for Newton's method, where the evaluation its last,
+    quadratically small step came from stands for the answer's (``solve_increasing``'s
+    ``evaluated``), so the answer's error estimate needs no evaluation of its own."""
+
+    def __init__(self, integral, start):
+        self.integral = integral
+        self.value = np.array(start, dtype=float)
+        self.error = np.zeros(self.value.size)
+        self.converged = np.ones(self.value.size, dtype=bool)   # whether the last evaluation met its tolerance
+
+    def __call__(self, x, i):
+        result = self.integral(x, i)
+        self.converged[i], self.error[i] = result.converged, result.error
+        self.value[i] = result.value
+        return np.asarray(result.value, dtype=float)
+
+    def last(self, converged=None) -> Integral:
+        """The last evaluations as an :class:`Integral` (``converged``: instead of their own flags)."""
+        return Integral(value=self.value, error=self.error,
+                        converged=self.converged if converged is None else converged,
+                        panels=np.zeros(self.value.size, dtype=int))
+
+
 def _iterate(engine, scene, target, index, qflat, upper):
     """:func:`newton`'s iteration proper, on points with a positive target."""
     n = target.size
-    last_ok = np.ones(n, dtype=bool)      # whether each point's last evaluation met its tolerance
-    last_error = np.zeros(n)
-    last_value = np.array(target)
-
-    def F(v, i):
-        result = engine._J(scene, v, index[i], None if qflat is None else qflat[i])
-        last_ok[i], last_error[i] = result.converged, result.error
-        last_value[i] = result.value
-        return np.asarray(result.value, dtype=float)
+    F = _Remembered(lambda v, i: engine._J(scene, v, index[i], None if qflat is None else qflat[i]), target)
 
     def dF(v, i):
         return engine.integrand(scene.at(index[i]), v, None if qflat is None else qflat[i])
@@ -198,7 +215,7 @@ def _iterate(engine, scene, target, index, qflat, upper):
                 short = F(v[at_cap], at_cap) < target[at_cap] * (1 - 1e-9)
             ok = ok.copy()
             ok[at_cap[short]] = False
-    return v, ok, Integral(value=last_value, error=last_error, converged=last_ok | ~ok, panels=np.zeros(n, dtype=int))
+    return v, ok, F.last(F.converged | ~ok)
 
 
 def one_batch(engine, scene, target, index, bound):
@@ -501,15 +518,7 @@ def inlet_log_stretch(engine, scene, dp, index):
     if polish.size == 0:
         return v
     sub = index[polish]
-    # each point's last evaluation, whose error estimate stands for the answer's where Newton's
-    # last step from it was quadratically small (else the answer is evaluated once more)
-    last_value, last_error = np.zeros(sub.size), np.zeros(sub.size)
-    last_ok = np.ones(sub.size, dtype=bool)
-
-    def F(x, i):
-        rise = engine.rise_from_outlet(scene, x, sub[i])
-        last_value[i], last_error[i], last_ok[i] = rise.value, rise.error, rise.converged
-        return rise.value
+    F = _Remembered(lambda x, i: engine.rise_from_outlet(scene, x, sub[i]), np.zeros(sub.size))
 
     def dF(x, i):
         return engine._slope(scene.at(sub[i]), x)
@@ -527,8 +536,7 @@ def inlet_log_stretch(engine, scene, dp, index):
     again = np.flatnonzero(~evaluated)
     if again.size:                               # the answer's own error estimate where Newton ended elsewhere
         F(w[again], again)
-    warn_unconverged("the pressure rise from the outlet",
-                     Integral(value=last_value, error=last_error, converged=last_ok, panels=np.zeros(sub.size, dtype=int)))
+    warn_unconverged("the pressure rise from the outlet", F.last())
     v = v.copy()
     v[polish] = w
     return v
