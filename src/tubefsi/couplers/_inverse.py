@@ -79,8 +79,9 @@ def _pick(value, index):
 
 def log_stretch_cap(scene, index):
     """The largest log-stretch a solve may reach: below a maximum stretch, and ln(1e15)."""
-    v_max = np.asarray(_pick(scene.log_stretch_max, index), dtype=float) + np.zeros(np.shape(index))
-    return np.where(np.isfinite(v_max), np.minimum(MAX_LOG_STRETCH, v_max * (1 - 8 * EPS)), MAX_LOG_STRETCH)
+    v_max = np.asarray(_pick(scene.log_stretch_max, index), dtype=float)
+    # (fmin drops a NaN, and an infinite maximum is above the cap)
+    return np.fmin(MAX_LOG_STRETCH, v_max * (1 - 8 * EPS)) + np.zeros(np.shape(index))
 
 
 def _linear_guess(engine, scene, target, index, q):
@@ -618,26 +619,35 @@ def one_batch_mapped(engine, scene, target, index, q, bound):
     for every node and the interpolant's tail for the integral (else left to :func:`newton`)."""
     target = np.asarray(target, dtype=float).ravel()
     index = np.asarray(index).ravel()
-    q = np.broadcast_to(np.asarray(q, dtype=float), target.shape)
+    q = np.asarray(q, dtype=float)
+    if q.shape != target.shape:
+        q = np.broadcast_to(q, target.shape)
     v = np.zeros(target.size)
     solved = np.zeros(target.size, dtype=bool)
-    bound = np.broadcast_to(bound, target.shape)
-    live = np.flatnonzero((target > 0) & (q > 0))
+    bound = np.asarray(bound, dtype=float)
+    if bound.shape != target.shape:
+        bound = np.broadcast_to(bound, target.shape)
+    live = np.nonzero((target > 0) & (q > 0))[0]
     which = flow_map.kind(scene.rheology)
     if live.size == 0 or which is None:
         return v, solved
-    pts = scene.at(index)
     with np.errstate(all="ignore"):
-        y_out = (np.log(4.0 / math.pi * q) - 3.0 * np.log(pts.radius * pts.outlet_stretch)) + np.zeros(target.size)
-        # the linear guess from the law at the outlet's apparent rate (a start: within a factor ~2)
-        if which == "closed":      # (exact there, and cheap)
-            rough, _, _ = flow_map.flow_map(pts.rheology, y_out, y_out, which=which).wall_stress(y_out[None])
-            rough = rough[0]
-        else:
-            rough = np.asarray(pts.rheology._stress(np.exp(y_out)), dtype=float) + np.zeros(target.size)
-        slope0 = np.asarray(engine._slope(pts, np.zeros(target.size)), dtype=float) + np.zeros(target.size)
-        radius_out = (pts.radius * pts.outlet_stretch) + np.zeros(target.size)
-        top = np.minimum(1.5 * target * 2.0 * rough / (radius_out * slope0), bound)
+        return _one_batch_mapped(engine, scene, target, index, q, bound, v, solved, live, which)
+
+
+def _one_batch_mapped(engine, scene, target, index, q, bound, v, solved, live, which):
+    """:func:`one_batch_mapped` once its arguments are arrays and some point is live."""
+    pts = scene.at(index)
+    zeros = np.zeros(target.size)
+    y_out = (np.log(4.0 / math.pi * q) - 3.0 * np.log(pts.radius * pts.outlet_stretch)) + zeros
+    # the linear guess from the law at the outlet's apparent rate (a start: within a factor ~2)
+    if which == "closed":      # (exact there, and cheap)
+        rough, _, _ = flow_map.flow_map(pts.rheology, y_out, y_out, which=which).wall_stress(y_out[None])
+        rough = rough[0]
+    else:
+        rough = np.asarray(pts.rheology._stress(np.exp(y_out)), dtype=float) + zeros
+    slope0 = np.asarray(pts.wall._log_slope(pts.outlet_stretch, pts.tb), dtype=float) + zeros
+    top = np.minimum(1.5 * target * 2.0 * rough / ((pts.radius * pts.outlet_stretch) * slope0), bound)
     top = np.where(np.isfinite(top) & (top > 0), top, 0.0)
     live = live[top[live] > 0]
     rtol = max(engine._RTOL, _MAPPED_RTOL)
@@ -645,12 +655,17 @@ def one_batch_mapped(engine, scene, target, index, q, bound):
     for degree in _MAPPED_DEGREES:
         if live.size == 0:
             break
-        f, vouched = _mapped_integrand(engine, scene, index[live], y_out[live], top[live], which)
-        with np.errstate(all="ignore"):
-            x, good, short = solve_integral(f, target[live], top[live], rtol=rtol, degree=degree)
+        every = live.size == target.size           # (no gathers)
+        f, vouched = _mapped_integrand(engine, scene, index if every else index[live], y_out if every else y_out[live],
+                                       top if every else top[live], which)
+        x, good, short = solve_integral(f, target if every else target[live], top if every else top[live],
+                                        rtol=rtol, degree=degree, method="barycentric")
         good &= vouched
         v[live[good]] = x[good]
         solved[live[good]] = True
+        if good.all():
+            live = live[:0]
+            break
         # short: three times the interval; a tail that missed: the next degree on the same one, or
         # (at the top degree already) the interval in pieces
         again = short & vouched
@@ -666,8 +681,7 @@ def one_batch_mapped(engine, scene, target, index, q, bound):
         if split.size == 0:
             break
         f, vouched = _mapped_integrand(engine, scene, index[split], y_out[split], top[split], which)
-        with np.errstate(all="ignore"):
-            x, good = _solve_in_pieces(f, target[split], top[split], pieces, _MAPPED_DEGREES[-1], rtol)
+        x, good = _solve_in_pieces(f, target[split], top[split], pieces, _MAPPED_DEGREES[-1], rtol)
         good &= vouched
         v[split[good]] = x[good]
         solved[split[good]] = True
@@ -688,12 +702,12 @@ def _mapped_integrand(engine, scene, ids, y_out, top, which):
     sub = scene.at(ids)
     fmap = flow_map.flow_map(sub.rheology, y_out - 3.0 * top - 1e-9, y_out + 1e-9, which=which)
     vouched = np.ones(ids.size, dtype=bool)
-    a = sub.radius * sub.outlet_stretch
 
     def f(u, i):
         tau, ok, _ = fmap.wall_stress(y_out - 3.0 * u)
         vouched[:] &= ok.all(axis=0)
-        return engine._slope(sub, u) * (a * np.exp(u)) / (2.0 * tau)
+        stretch = engine.stretch_at(sub, u)
+        return sub.wall._log_slope(stretch, sub.tb) * (sub.radius * stretch) / (2.0 * tau)
 
     return f, vouched
 
@@ -832,7 +846,7 @@ def solve_flow_rate_mapped(engine, scene, v, dp, index):
         s_lo, s_hi, shift, log_l = lo[live], hi[live], log_shift[live], np.log(length[live])
         if stress_law:
             fmap = flow_map.flow_map(sub.rheology, None, s_hi + shift, x_lo=x_out[live] - 3.0 * vv - 1.0)
-            s_lo = fmap.y_nodes[0, 0] + 3.0 * vv - shift + 1e-12 * (1.0 + np.abs(s_hi))
+            s_lo = fmap.bottom + 3.0 * vv - shift + 1e-12 * (1.0 + np.abs(s_hi))
         else:
             fmap = flow_map.flow_map(sub.rheology, s_lo + shift - 3.0 * vv - 1e-9, s_hi + shift + 1e-9)
         s = 0.5 * (s_lo + s_hi)

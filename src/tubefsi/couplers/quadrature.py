@@ -126,7 +126,7 @@ class Quadrature(SeparatedVariables):
         v, solved = _inverse.one_batch_mapped(self, scene, target, index, q, bound)
         ok = np.ones(target.size, dtype=bool)
         final = Integral.exact(target)
-        rest = np.flatnonzero(~solved & (target > 0))
+        rest = np.nonzero(~solved & (target > 0))[0]
         if rest.size:
             up = None if upper is None else np.broadcast_to(np.asarray(upper, dtype=float), target.shape)[rest]
             qq = np.broadcast_to(np.asarray(q, dtype=float), target.shape)[rest]

@@ -212,7 +212,7 @@ class SeparatedVariables(Coupler):
         rounding of :math:`\lambda` alone moves the pressure by :math:`|\lambda P'/\Delta p|\,\epsilon`
         relative (the problem itself may be well conditioned in the flow rate; the stretch is not)."""
         pts = scene.at(index)
-        if not np.any(np.isfinite(np.asarray(pts.log_stretch_max, dtype=float))):
+        if not np.isfinite(np.asarray(pts.log_stretch_max, dtype=float)).any():
             return
         with np.errstate(all="ignore"):       # (lambda P' = dP / d ln lambda)
             estimate = 2.0 * EPS * np.abs(pts.wall._log_slope(self.stretch_at(pts, v), pts.tb) / rise)
@@ -380,10 +380,13 @@ class SeparatedVariables(Coupler):
             else:
                 v[served], rise[served] = v_t[served], rise_t[served]
             todo &= ~served
-        target = np.where(todo, self.target(pts, np.where(todo, q, 1.0)), 0.0) if np.any(todo) else todo * 0.0
+        if todo.all():
+            target = self.target(pts, q) + 0.0 * q
+        else:
+            target = np.where(todo, self.target(pts, np.where(todo, q, 1.0)), 0.0) if todo.any() else todo * 0.0
         solved = self._flow_direct(scene, q, target, todo, v)
         feasible = None
-        if not np.all(solved.ok):
+        if not solved.ok.all():
             beyond = _inverse.classify_runaway(self, scene, q, np.flatnonzero(~solved.ok), v, raise_=raise_)
             feasible = np.ones(q.shape, dtype=bool)
             feasible[beyond] = False
@@ -411,12 +414,12 @@ class SeparatedVariables(Coupler):
                 todo = todo.copy()
                 todo[sub] = False
                 answered[sub] = True
-        if np.any(todo):
-            sub = np.flatnonzero(todo)
+        if todo.any():
+            sub = np.nonzero(todo)[0]
             v[sub], ok[sub], final = self._solve_J(scene, target[sub], sub, None if scene.rheology.separable else q[sub])
             warn_unconverged("the separated-variables integral", final, where=ok[sub])
             answered[sub] = ok[sub]
-        return _Direct(points=np.flatnonzero(answered), ok=ok)
+        return _Direct(points=np.nonzero(answered)[0], ok=ok)
 
     def _curve(self, scene: Scene, q):
         r"""The inlet log-stretches of a long curve through one scene without a table (a non-separable

@@ -88,8 +88,11 @@ def blocked_matmul(a, b):
     AVX-512 machine); one problem shape for every column makes a point's result independent of its
     batch. Small blocks also stay below OpenBLAS's threading threshold."""
     rows, size = a.shape[0], b.shape[1]
-    out = np.empty((rows, size))
     block = np.zeros((b.shape[0], _BLOCK))
+    if size <= _BLOCK:                        # (one block: its product's first columns)
+        block[:, :size] = b
+        return (a @ block)[:, :size]
+    out = np.empty((rows, size))
     for start in range(0, size, _BLOCK):
         count = min(_BLOCK, size - start)
         block[:, :count] = b[:, start:start + count]

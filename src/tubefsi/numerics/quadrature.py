@@ -394,7 +394,7 @@ def warn_unconverged(what: str, result: Integral, where=None) -> None:
     bad = ~np.asarray(result.converged, dtype=bool)
     if where is not None:
         bad &= np.asarray(where, dtype=bool)
-    if not np.any(bad):
+    if not bad.any():
         return
     with np.errstate(divide="ignore", invalid="ignore"):
         rel = np.where(result.value != 0, np.abs(result.error / result.value), np.inf)

@@ -115,7 +115,39 @@ def hermite_root(rise, goal, d0, d1, iterations=3):
 _PAIRED_BELOW = 2048
 
 
-def solve_integral(f, target, upper, *, rtol=1e-14, values=None, degree=CHEBYSHEV_DEGREE):
+@functools.lru_cache(maxsize=4)
+def _barycentric_rule(n):
+    """What :func:`solve_integral`'s ``method="barycentric"`` needs of degree ``n`` (constants,
+    read-only): one matrix from the values at the nodes to the last three Chebyshev coefficients
+    (the tail), the antiderivative at the nodes and at :math:`s_*` (midway between the two middle
+    nodes); the ``n + 2`` nodes of the antiderivative (the Lobatto nodes, then :math:`s_*`) with
+    their barycentric weights; and the Lobatto nodes' own weights :math:`(-1)^i`, halved at the
+    ends."""
+    rule = lobatto_rule(n)
+    star = 0.5 * (rule.t[n // 2] + rule.t[n // 2 + 1])
+    at_star = np.polynomial.chebyshev.chebvander(np.array([star]), n + 1) @ rule.matrix[rule.anti]
+    matrix = np.vstack([rule.matrix[rule.coef][-3:], rule.matrix[rule.cumulative], at_star])
+    nodes = np.append(rule.t, star)
+    gaps = nodes[:, None] - nodes[None, :]
+    np.fill_diagonal(gaps, 1.0)
+    weights = 1.0 / np.prod(gaps, axis=1)
+    weights /= np.abs(weights).max()
+    lobatto = (-1.0) ** np.arange(n + 1)
+    lobatto[[0, -1]] *= 0.5
+    for constant in (matrix, nodes, weights, lobatto):
+        constant.setflags(write=False)
+    return matrix, nodes, weights, lobatto
+
+
+def _barycentric(weights, offsets, values):
+    """The barycentric formula (second form) along the last axis: the interpolant of ``values``
+    at the points whose offsets from the nodes are ``offsets`` (NaN where a point is on a node,
+    an offset exactly 0: the caller takes the node's value there)."""
+    ratio = weights / offsets
+    return (ratio * values).sum(axis=-1) / ratio.sum(axis=-1)
+
+
+def solve_integral(f, target, upper, *, rtol=1e-14, values=None, degree=CHEBYSHEV_DEGREE, method="clenshaw"):
     r"""Solve :math:`\int_0^{x} f(u)\,du = T` for :math:`x \in (0, X]`, per point, from one
     batch of integrand values: a Chebyshev interpolant on ``[0, X]``, integrated exactly.
 
@@ -135,24 +167,48 @@ def solve_integral(f, target, upper, *, rtol=1e-14, values=None, degree=CHEBYSHE
     and finite. The others are left to the caller (an adaptive method): nothing here is
     accepted unchecked.
 
+    ``method`` says how the root is found on the interpolant (the same root, to rounding; the
+    caller picks one, so a point's bits never depend on its batch):
+
+    * ``"clenshaw"``: from the cubic Hermite interpolant between the nodes that bracket it,
+      then Newton's method with the interpolant evaluated by Clenshaw's recurrence: three
+      array operations per coefficient, each over the batch (the fewest operations per point,
+      for large batches);
+    * ``"barycentric"``: from the interpolant of the inverse, :math:`t(J)` through the nodes'
+      :math:`(J_i, t_i)`, then Newton's method with the antiderivative (degree :math:`n + 1`,
+      through the nodes and one point more) and the integrand evaluated by the barycentric
+      formula (Berrut & Trefethen, *SIAM Review* 46, 2004): a handful of array operations
+      over ``(points, nodes)`` and ``(points, nodes, nodes)`` (the fewest operations, for
+      one point or a few).
+
     Returns ``(x, solved, short)``, flat arrays of the targets' size: ``x`` is meaningful only
     where ``solved``; ``short`` marks the points whose integral over ``[0, X]`` falls short of
     the target (the caller may try a longer interval).
     """
     rule = lobatto_rule(degree)
+    barycentric = method == "barycentric"
+    matrix = _barycentric_rule(degree)[0] if barycentric else rule.matrix
     target = np.asarray(target, dtype=float).ravel()
-    upper = np.broadcast_to(np.asarray(upper, dtype=float), target.shape)
+    upper = np.asarray(upper, dtype=float)
+    if upper.shape != target.shape:
+        upper = np.broadcast_to(upper, target.shape)
     if values is None:
         nodes = rule.nodes[:, None] * upper
         values = f(nodes, np.arange(target.size))
     y = np.asarray(values, dtype=float)
     half = 0.5 * upper
     with np.errstate(invalid="ignore", over="ignore"):
-        maps = blocked_matmul(rule.matrix, y)            # (3n + 4, P): rows contiguous, for the recurrences
-        coef, anti, cumulative = maps[rule.coef], maps[rule.anti], maps[rule.cumulative]
-        anti *= half                                     # dx = (X/2) dt
-        cumulative *= half
-        tail = np.abs(coef[-3:]).sum(axis=0) * upper
+        maps = blocked_matmul(matrix, y)                 # rows contiguous, for the recurrences
+        if barycentric:          # (the tail, then the antiderivative at the nodes and at s_*)
+            tail_rows, known = maps[:3], maps[3:]
+            known *= half                                # dx = (X/2) dt
+            cumulative = known[:-1]
+        else:
+            coef, anti, cumulative = maps[rule.coef], maps[rule.anti], maps[rule.cumulative]
+            tail_rows = coef[-3:]
+            anti *= half
+            cumulative *= half
+        tail = np.abs(tail_rows).sum(axis=0) * upper
         # every value positive: one reduction over the whole batch (NaN fails it), the per-point
         # minimum (a strided reduction, ten times dearer) only where that fails
         positive = True if y.min() > 0 else np.min(y, axis=0) > 0
@@ -160,13 +216,21 @@ def solve_integral(f, target, upper, *, rtol=1e-14, values=None, degree=CHEBYSHE
         short = usable & (cumulative[-1] < target)
         good = usable & ~short & (tail <= rtol * target)
     x = np.zeros(target.size)
-    live = np.flatnonzero(good)
+    live = np.nonzero(good)[0]
     if live.size == 0:
         return x, good, short
     h, t_goal = half, target
     if live.size < target.size:
-        coef, anti, cumulative, y = coef[:, live], anti[:, live], cumulative[:, live], y[:, live]
-        h, t_goal = half[live], target[live]
+        h, t_goal, y = half[live], target[live], y[:, live]
+        if barycentric:
+            known = known[:, live]
+        else:
+            coef, anti, cumulative = coef[:, live], anti[:, live], cumulative[:, live]
+    if barycentric:
+        t, moving = _root_barycentric(degree, known, y, h, t_goal)
+        good[live[moving]] = False
+        x[live] = h * (1.0 + t)
+        return x, good, short
     # the bracketing nodes, and the cubic Hermite interpolant of the integral between them (its
     # slopes are the integrand values themselves) as Newton's start: within ~1e-5 of the root
     j = np.maximum(np.minimum(np.count_nonzero(cumulative < t_goal, axis=0), rule.degree), 1)
@@ -215,3 +279,42 @@ def solve_integral(f, target, upper, *, rtol=1e-14, values=None, degree=CHEBYSHE
         good[live[moving]] = False
     x[live] = h * (1.0 + t)
     return x, good, short
+
+
+def _root_barycentric(degree, known, y, h, goal):
+    """``(t, unconverged)``: the root :math:`t \in [-1, 1]` of :math:`J(t) =` ``goal``, where
+    :math:`J` is the antiderivative of the interpolant of ``y`` (``(nodes, P)``), ``known`` at the
+    nodes and at :math:`s_*` (``(nodes + 1, P)``), with :math:`J' = h\,p`
+    (:func:`solve_integral`, ``method="barycentric"``). The points along the first axis and
+    the nodes along the last, contiguous one: a sum over the nodes is taken in the same order
+    whatever the number of points."""
+    _, nodes, weights, lobatto = _barycentric_rule(degree)
+    rule = lobatto_rule(degree)
+    values_j = np.ascontiguousarray(known.T)                                        # (P, n + 2)
+    values_f = np.ascontiguousarray(y.T)                                            # (P, n + 1)
+    j_nodes = values_j[:, :-1]
+    # the start: t(J) through (J_i, t_i), by the linear rational interpolant with the Lobatto
+    # nodes' weights at the J_i, their image under a smooth increasing map (f > 0); its error
+    # falls exponentially with the degree (Baltensperger, Berrut & Noël, Math. Comp. 68, 1999):
+    # a start, which Newton's method checks
+    with np.errstate(all="ignore"):
+        t = np.fmin(np.fmax(_barycentric(lobatto, goal[:, None] - j_nodes, rule.t), -1.0), 1.0)   # (a NaN: -1)
+        # Newton on the interpolant: quadratic, so a step below 1e-9 leaves an error of order
+        # (f'/f) 1e-18 after it, and is the last one
+        moving = np.ones(goal.size, dtype=bool)
+        for _ in range(8):
+            offsets = t[:, None] - nodes
+            integral = _barycentric(weights, offsets, values_j)
+            integrand = _barycentric(lobatto, offsets[:, :-1], values_f)
+            on_node = offsets[:, :-1] == 0.0
+            if on_node.any():               # (the formula's 0/0: the node's own values)
+                hit, first = on_node.any(axis=1), on_node.argmax(axis=1)
+                rows = np.arange(goal.size)
+                integral = np.where(hit, j_nodes[rows, first], integral)
+                integrand = np.where(hit, values_f[rows, first], integrand)
+            step = np.where(moving, (integral - goal) / (integrand * h), 0.0)
+            t = np.fmin(np.fmax(t - step, -1.0), 1.0)
+            moving &= ~(np.abs(step) <= 1e-9)
+            if not moving.any():
+                break
+    return t, moving

@@ -35,13 +35,15 @@ import math
 import numpy as np
 
 from ..fields import _array_fields, _replace
+from ..numerics.cache import keep_on_class
 from ..numerics.kernels import blocked_matmul
 from ..numerics.quadrature import unit_integral
-from ..numerics.spectral import clenshaw, hermite_root, lobatto_rule
+from ..numerics.spectral import lobatto_rule
 
 __all__ = ["kind", "ClosedMap", "PanelMap", "flow_map", "wall_stress", "log_rate_bracket"]
 
 _EPS = float(np.finfo(float).eps)
+_TINY = float(np.finfo(float).tiny)
 #: Degree and width (in ln of the wall shear rate) of a panel of :class:`PanelMap`.
 DEGREE, WIDTH = 24, 1.0
 #: At most this many panels per fluid (a range of e^24 in the wall shear rate).
@@ -58,29 +60,96 @@ _NEWTON = 60
 
 @functools.lru_cache(maxsize=2)
 def _y_maps(degree):
-    """Values at the Chebyshev-Lobatto nodes -> the Chebyshev coefficients of their interpolant (rows
-    ``0..degree``), of its derivative (the next ``degree``) and that derivative at the nodes (the
-    last ``degree + 1``), in one matrix: one product per panel gives all (constants of the degree,
-    read-only)."""
+    """Values at the Chebyshev-Lobatto nodes -> the last three Chebyshev coefficients of their
+    interpolant (its tail: rows 0..2) and the interpolant's derivative at the nodes (the next
+    ``degree + 1``), in one matrix (constants of the degree, read-only)."""
     rule = lobatto_rule(degree)
     to_coef = rule.matrix[rule.coef]
     to_derivative = np.polynomial.chebyshev.chebder(to_coef, axis=0)
     at_nodes = np.polynomial.chebyshev.chebvander(rule.t, degree - 1) @ to_derivative
-    maps = np.vstack([to_coef, to_derivative, at_nodes])
+    maps = np.vstack([to_coef[-3:], at_nodes])
     maps.setflags(write=False)
     return maps
 
 
 @functools.lru_cache(maxsize=2)
+def _lobatto_weights(degree):
+    """The barycentric weights of the Chebyshev-Lobatto nodes: :math:`(-1)^i`, halved at the ends
+    (Berrut & Trefethen, *SIAM Review* 46, 2004; a common factor cancels)."""
+    w = (-1.0) ** np.arange(degree + 1)
+    w[[0, -1]] *= 0.5
+    w.setflags(write=False)
+    return w
+
+
+@functools.lru_cache(maxsize=2)
 def _k_maps(degree):
-    """The maps of :func:`~tubefsi.numerics.spectral.lobatto_rule` (values -> coefficients,
-    antiderivative, cumulative integrals at the nodes), then the cumulative rows' absolute values:
-    applied to positive values, those give the sums of the terms each cumulative integral adds up,
-    the scale of its rounding (constants of the degree, read-only)."""
+    """Values at the Chebyshev-Lobatto nodes -> the last three Chebyshev coefficients of their
+    interpolant (its tail: rows 0..2), the cumulative integrals at the nodes (the next
+    ``degree + 1``) and those rows' absolute values (the last ``degree + 1``): applied to
+    positive values, those give the sums of the terms each cumulative integral adds up, the
+    scale of its rounding (constants of the degree, read-only)."""
     rule = lobatto_rule(degree)
-    maps = np.vstack([rule.matrix, np.abs(rule.matrix[rule.cumulative])])
+    cumulative = rule.matrix[rule.cumulative]
+    maps = np.vstack([rule.matrix[rule.coef][-3:], cumulative, np.abs(cumulative)])
     maps.setflags(write=False)
     return maps
+
+
+#: Unit panels below a map's start on which :func:`_k_below` takes :math:`K` there, in one batch.
+_BELOW = 16
+#: The relative tolerance of that :math:`K` (the map's values need it to a few eps).
+_K_RTOL = 1e-15
+
+
+@functools.lru_cache(maxsize=2)
+def _sum_maps(degree):
+    """Values at the Chebyshev-Lobatto nodes -> their Clenshaw-Curtis integral over [-1, 1] (row 0)
+    and the last three Chebyshev coefficients of their interpolant (its tail; constants)."""
+    rule = lobatto_rule(degree)
+    maps = np.vstack([rule.matrix[rule.cumulative][-1:], rule.matrix[rule.coef][-3:]])
+    maps.setflags(write=False)
+    return maps
+
+
+def _k_below(rheology, x0, above):
+    r"""``(K, error, g, tau)``: :math:`K = \int_0^{\dot\gamma_0}\tau^3\,d\dot\gamma =
+    \int_{-\infty}^{x_0}\tau(e^x)^3 e^x\,dx` at each point's ``x0`` (its array parameters one
+    per point), an estimate of its error, and the shear rates and stresses at the nodes of the
+    ``above`` panels above :math:`x_0` (``(nodes, above, P)``: the map's first ones, whose law
+    values are taken in the same batch).
+
+    On ``_BELOW`` unit panels below :math:`x_0`, all in one batch (Clenshaw–Curtis on each, its
+    Chebyshev tail its error); below them the rest lies in :math:`[0, \tau_b^3\dot\gamma_b]`
+    for an increasing law (:math:`\tau \le \tau_b` there), taken as half of it, with half of it
+    as its error. Where that misses ``_K_RTOL`` (a law still thinning steeply far below
+    :math:`x_0`: :math:`\tau^3\dot\gamma` falls by less than 1e-16 over the panels) the
+    adaptive quadrature from zero (:func:`~tubefsi.numerics.quadrature.unit_integral`) answers."""
+    rule = lobatto_rule(DEGREE)
+    p = x0.size
+    # panel j (-_BELOW .. above - 1) spans [x0 + j W, x0 + (j + 1) W], as the map's panel j does
+    x = x0 + WIDTH * (np.arange(-_BELOW, above)[:, None] + rule.nodes[:, None, None])    # (nodes, panels, P)
+    g_all = np.exp(x)
+    tau_all = PanelMap._tau(rheology, g_all)
+    g, tau = g_all[:, :_BELOW], tau_all[:, :_BELOW]
+    values = tau * tau * tau * g
+    sums = blocked_matmul(_sum_maps(DEGREE), values.reshape(DEGREE + 1, _BELOW * p)).reshape(4, _BELOW, p)
+    tails = np.abs(sums[1:]).sum(axis=0)
+    tails = np.where(tails <= 32.0 * _EPS * values.max(axis=0), 0.0, tails)      # (the values' rounding)
+    rest = 0.5 * values[0, 0]                                  # the bottom node: x0 - _BELOW W
+    # the sums over the panels along a contiguous last axis (the same order whatever the number
+    # of points)
+    K = rest + (0.5 * WIDTH) * np.ascontiguousarray(sums[0].T).sum(axis=1)
+    error = rest + (0.5 * WIDTH) * np.ascontiguousarray(tails.T).sum(axis=1) + 4.0 * _EPS * K
+    fine = (error <= _K_RTOL * K) & (values[0, 0] >= 0.0)
+    if not fine.all():
+        missed = np.flatnonzero(~fine)
+        g0 = np.exp(x0[missed])
+        base = unit_integral(lambda t, idx: PanelMap._tau(_at(rheology, missed[idx], column=True), g0[idx, None] * t) ** 3,
+                             missed.size, rtol=_K_RTOL)
+        K[missed] = g0 * base.value
+        error[missed] = g0 * base.error + 4.0 * _EPS * np.abs(K[missed])
+    return K, error, g_all[:, _BELOW:], tau_all[:, _BELOW:]
 
 
 def _overridden(cls, name) -> bool:
@@ -88,17 +157,33 @@ def _overridden(cls, name) -> bool:
     return len(owners) > 1 and owners[0] is not owners[-1]
 
 
+def _class_kind(cls):
+    """What :func:`kind` finds from the class alone: ``"closed"``, ``"stress"`` (before the yield
+    stress is looked at) or ``""``, kept on the class."""
+    found = cls.__dict__.get("_tubefsi_map_kind")
+    if found is None:
+        if _overridden(cls, "_apparent_shear_rate"):
+            found = "closed"
+        elif _overridden(cls, "_stress") and not _overridden(cls, "_shear_rate"):
+            found = "stress"
+        else:
+            found = ""
+        found = keep_on_class(cls, "_tubefsi_map_kind", found)
+    return found
+
+
 def kind(rheology):
     """``"closed"`` (a closed form of the apparent wall shear rate), ``"stress"`` (a law given by its
     stress, without a yield stress), or None (a law the maps do not serve)."""
-    cls = type(rheology)
     if rheology.separable:
         return None
-    if _overridden(cls, "_apparent_shear_rate"):
-        return "closed"
-    if _overridden(cls, "_stress") and not _overridden(cls, "_shear_rate") and \
-            not np.any(np.asarray(rheology.yield_stress) != 0):
-        return "stress"
+    found = _class_kind(type(rheology))
+    if found == "closed":
+        return found
+    if found == "stress":
+        tau_y = rheology.yield_stress
+        if (tau_y == 0.0) if type(tau_y) is float else not np.any(np.asarray(tau_y) != 0):
+            return found
     return None
 
 
@@ -192,89 +277,104 @@ class PanelMap:
         self.x0 = y_lo + math.log(0.75) - 0.01 if x_lo is None else np.asarray(x_lo, dtype=float) + np.zeros(n)
         if x_lo is not None:
             y_lo = np.full(n, -np.inf)
-        # Chebyshev coefficients of y per panel ([:, 0]) and of its derivative ([:, 1], the top one zero),
-        # stacked for one Clenshaw pass of both
-        self.pair = np.full((DEGREE + 1, 2, MAX_PANELS, n), np.nan)
-        self.pair[-1, 1] = 0.0
-        # each panel's y at its middle node apart: the interpolant holds y's variation over the panel
-        self.offset = np.full((MAX_PANELS, n), np.nan)
-        self.y_nodes = np.full((DEGREE + 1, MAX_PANELS, n), np.nan)
-        self.node_slopes = np.full((DEGREE + 1, MAX_PANELS, n), np.nan)     # dy/dt at the nodes
+        # per panel: y at its middle node (``offset``) and at its top node, and at its nodes (the
+        # last, contiguous axis: a sum over them is taken in the same order whatever the number of
+        # points) y's variation from the middle node, z = y - offset, which the interpolant holds,
+        # and the interpolant's slope dz/dt (``nodes[..., 0, :]`` and ``nodes[..., 1, :]``)
+        self.offset = np.empty((MAX_PANELS, n))
+        self.tops = np.empty((MAX_PANELS, n))
+        self.nodes = np.empty((MAX_PANELS, n, 2, DEGREE + 1))
+        for unset in (self.offset, self.tops, self.nodes):    # (a panel never built: NaN)
+            unset.fill(np.nan)
+        #: :math:`y` at the bottom of each point's map (its first panel's first node).
+        self.bottom = np.full(n, np.nan)
         self.ok = np.isfinite(self.x0) & np.isfinite(y_hi)
         self.panels = np.zeros(n, dtype=int)
+        live = np.nonzero(self.ok)[0]
+        if live.size == 0:
+            return
         with np.errstate(all="ignore"):
-            g0 = np.exp(self.x0)
-            base = unit_integral(lambda t, idx: self._tau(_at(rheology, idx, column=True), g0[idx, None] * t) ** 3, n, rtol=1e-15)
-            K = g0 * base.value
-            err_k = g0 * base.error + 4.0 * _EPS * np.abs(K)
+            batch = self._batch(live, 0, y_hi)
+            K, err_k, g, tau = _k_below(rheology, self.x0, batch)
             self.ok &= np.isfinite(K) & (K > 0)
-            live = np.flatnonzero(self.ok)
+            live = np.nonzero(self.ok)[0]
+            laws = (g, tau) if live.size == n else (g[..., live], tau[..., live])   # (the first batch's law values)
             j = 0
             while live.size and j < MAX_PANELS:
-                # the panels of this step, built in one batch: at least those that y <= x + ln(4/3)
-                # (Gamma <= 4 gamma_w / 3) says most live points need to reach y_hi
-                need = np.ceil((y_hi[live] - math.log(4.0 / 3.0) - self.x0[live]) / WIDTH - j + 1e-9)
-                batch = int(min(MAX_PANELS - j, max(1.0, float(np.sort(need)[(9 * (need.size - 1)) // 10]))))
-                live = self._panels(rheology, live, j, batch, K, err_k, y_lo, y_hi, x_lo is None)
+                live = self._panels(rheology, live, j, batch, K, err_k, y_lo, y_hi, x_lo is None, laws)
                 j += batch
+                laws = None
+                if live.size and j < MAX_PANELS:
+                    batch = self._batch(live, j, y_hi)
             self.ok[live] = False                                   # (beyond MAX_PANELS)
 
-    def _panels(self, rheology, live, j0, batch, K, err_k, y_lo, y_hi, check_bottom):
+    def _batch(self, live, j, y_hi):
+        """How many panels the next step builds from panel ``j`` on, in one batch: at least those that
+        y <= x + ln(4/3) (Gamma <= 4 gamma_w / 3) says most of the points ``live`` need to reach y_hi."""
+        need = np.ceil((y_hi[live] - math.log(4.0 / 3.0) - self.x0[live]) / WIDTH - j + 1e-9)
+        return int(min(MAX_PANELS - j, max(1.0, float(np.sort(need)[(9 * (need.size - 1)) // 10]))))
+
+    def _panels(self, rheology, live, j0, batch, K, err_k, y_lo, y_hi, check_bottom, laws=None):
         """Panels ``j0 .. j0 + batch - 1`` of the points ``live``, their law values in one batch (a
-        point's bits are those of building them one by one); ``K`` and ``err_k`` carried up panel
+        point's bits are those of building them one by one), or ``laws`` (the shear rates and
+        stresses at their nodes, where the caller has them); ``K`` and ``err_k`` carried up panel
         by panel. Returns the points still live after them (every panel good, y_hi not reached)."""
         rule = self.rule
         y_maps, k_maps = _y_maps(DEGREE), _k_maps(DEGREE)
-        terms = slice(rule.matrix.shape[0], None)                 # the rows of k_maps beyond rule.matrix
         p = live.size
-        r = _at(rheology, live)
-        x = self.x0[live] + WIDTH * ((j0 + np.arange(batch))[:, None] + rule.nodes[:, None, None])  # (nodes, batch, P)
-        g = np.exp(x)
-        tau = self._tau(r, g)
+        if laws is None:
+            x = self.x0[live] + WIDTH * ((j0 + np.arange(batch))[:, None] + rule.nodes[:, None, None])  # (nodes, batch, P)
+            g = np.exp(x)
+            tau = self._tau(_at(rheology, live), g)
+        else:
+            g, tau = laws
         cube = tau * tau * tau
         values = cube * g
         maps = blocked_matmul(k_maps, values.reshape(DEGREE + 1, batch * p)).reshape(-1, batch, p)
-        cumulative = (0.5 * WIDTH) * maps[rule.cumulative]
+        cumulative = (0.5 * WIDTH) * maps[3:DEGREE + 4]
         # K's error at each node: the panel's start's, the tail of the integrand's interpolant
         # (a tail at the rounding of the values, 32 eps of their largest, is noise), and the
         # rounding of the node's own sum, a few eps of the terms it adds up (at the panel's
         # low nodes far below its top: a Newtonian plateau's integrand grows e^4-fold over a
         # panel, and the top's rounding charged to the bottom node failed such fluids)
-        w_tail = np.abs(maps[rule.coef][-3:]).sum(axis=0)
-        noise = w_tail <= 32.0 * _EPS * np.max(values, axis=0)
-        own = np.where(noise, 0.0, (0.5 * WIDTH) * w_tail) + 2.0 * _EPS * ((0.5 * WIDTH) * maps[terms])
-        # K and its error at each panel's start, carried up from the last (the same sums, in the
-        # same order, as panel by panel)
-        k_nodes = np.empty(cumulative.shape)
-        err_nodes = np.empty(cumulative.shape)
-        k_start, e_start = K[live], err_k[live]
-        for b in range(batch):
-            k_nodes[:, b] = k_start + cumulative[:, b]
-            err_nodes[:, b] = e_start + own[:, b] + 2.0 * _EPS * k_nodes[:, b]
-            k_start, e_start = k_nodes[-1, b], err_nodes[-1, b]
-        gamma = (4.0 / 3.0) * (g - k_nodes / cube)
-        y = np.log(gamma)
+        # (the top node's value is the largest of an increasing law's; else smaller: a floor on the
+        # safe side)
+        w_tail = np.abs(maps[:3]).sum(axis=0)
+        noise = w_tail <= 32.0 * _EPS * values[-1]
+        own = np.where(noise, 0.0, (0.5 * WIDTH) * w_tail) + 2.0 * _EPS * ((0.5 * WIDTH) * maps[DEGREE + 4:])
+        # K and its error at each panel's start, carried up from the last: running sums along
+        # the panels (in order, as panel by panel)
+        k_nodes = np.cumsum(np.concatenate([K[live][None], cumulative[-1, :-1]]), axis=0) + cumulative
+        own += 2.0 * _EPS * k_nodes
+        err_nodes = np.cumsum(np.concatenate([err_k[live][None], own[-1, :-1]]), axis=0) + own
+        # Gamma tau^3 = (4/3) (tau^3 gamma_w - K): the flow function's integral by parts
+        gamma_cube = (4.0 / 3.0) * (values - k_nodes)
+        y = np.log(gamma_cube / cube)
         # the interpolant of y's variation from its middle node (the coefficients of y itself,
         # ~35 where Gamma ~ 1e15, would carry rounding of eps |y| each: 1e-13 at a point)
         ref = y[DEGREE // 2]
-        c_and_slope = blocked_matmul(y_maps, (y - ref).reshape(DEGREE + 1, batch * p)).reshape(-1, batch, p)
-        c = c_and_slope[:DEGREE + 1]
-        err_y = np.max((4.0 / 3.0) * err_nodes / (cube * gamma), axis=0)
-        tail = np.abs(c[-3:]).sum(axis=0)
-        good = np.isfinite(y).all(axis=0) & (np.diff(y, axis=0) > 0).all(axis=0) & \
-            (cube > 0).all(axis=0) & (err_y + tail <= TOL + 32.0 * _EPS * np.abs(y).max(axis=0))
+        z = y - ref
+        tail_and_slope = blocked_matmul(y_maps, z.reshape(DEGREE + 1, batch * p)).reshape(-1, batch, p)
+        err_y = ((4.0 / 3.0) * err_nodes / gamma_cube).max(axis=0)
+        tail = np.abs(tail_and_slope[:3]).sum(axis=0)
+        # (a NaN in y fails the first test, an infinite one the tail's)
+        good = (np.diff(y, axis=0) > 0).all(axis=0) & (cube > 0).all(axis=0) & \
+            (err_y + tail <= TOL + 32.0 * _EPS * np.abs(y).max(axis=0))
         # each point takes its panels in order until one fails or reaches y_hi (as one by one):
         # panel b where every panel before it was good and below y_hi
         goes_on = good & (y[-1] < y_hi[live])                      # (batch, P): the next one is built
         taken = np.ones((batch, p), dtype=bool)
         taken[1:] = np.logical_and.accumulate(goes_on[:-1], axis=0)
-        b, at = np.nonzero(taken)
-        j, pts = j0 + b, live[at]
-        self.pair[:, 0, j, pts], self.pair[:-1, 1, j, pts] = c[:, b, at], c_and_slope[DEGREE + 1:2 * DEGREE + 1, b, at]
-        self.offset[j, pts] = ref[b, at]
-        self.y_nodes[:, j, pts] = y[:, b, at]
-        self.node_slopes[:, j, pts] = c_and_slope[2 * DEGREE + 1:, b, at]
-        self.ok[pts[~good[b, at]]] = False
+        # every panel of the batch is stored: one a point did not take lies beyond its count of
+        # panels, which the inverse never reads (and a later batch builds only for points that
+        # took all of theirs)
+        stored = slice(j0, j0 + batch)
+        self.offset[stored, live] = ref
+        self.tops[stored, live] = y[-1]
+        self.nodes[stored, live] = np.stack([z, tail_and_slope[3:]]).transpose(2, 3, 0, 1)
+        if j0 == 0:
+            self.bottom[live] = y[0, 0]
+        self.ok[live[(taken & ~good).any(axis=0)]] = False
         last = taken.sum(axis=0) - 1                                # each point's last panel taken
         K[live], err_k[live] = k_nodes[-1, last, np.arange(p)], err_nodes[-1, last, np.arange(p)]
         self.panels[live] = j0 + last + 1
@@ -289,7 +389,7 @@ class PanelMap:
 
     @staticmethod
     def _tau(rheo, g):
-        return np.asarray(rheo._stress(np.maximum(g, np.finfo(float).tiny)), dtype=float)
+        return np.asarray(rheo._stress(np.maximum(g, _TINY)), dtype=float)
 
     def wall_stress(self, y, x=None):
         """``(tau_w, ok, x)`` at ``y = ln Gamma`` (shape ``(..., P)``, points along the last axis), in
@@ -304,40 +404,61 @@ class PanelMap:
         return tuple(np.concatenate([p[k] for p in parts]).reshape(y.shape) for k in range(3))
 
     def _wall_stress(self, y2, shape):
-        n = self.x0.size
-        cols = np.broadcast_to(np.arange(n), y2.shape)
+        cols = np.arange(self.x0.size)                              # (broadcast against j's rows)
         # the panel of each target: the count of panels whose top is below it
-        tops = self.y_nodes[-1]                                     # (MAX_PANELS, P)
-        with np.errstate(invalid="ignore"):
-            j = np.minimum(np.sum(tops[:, None, :] < y2[None], axis=0), np.maximum(self.panels - 1, 0))
-            nodes = self.y_nodes[:, j, cols]                       # (DEGREE + 1, rows, P)
-            inside = (y2 >= self.y_nodes[0, 0]) & (y2 <= nodes[-1]) & self.ok
-            # the start: the cubic Hermite interpolant between the panel's nodes that bracket y,
-            # from their values and slopes (within ~1e-6: one Newton step fewer than a line)
-            k = np.minimum(np.maximum((nodes < y2[None]).sum(axis=0), 1), DEGREE)
-            t_nodes = self.rule.t
-            ya, yb = self.y_nodes[k - 1, j, cols], self.y_nodes[k, j, cols]
-            ta, tb = t_nodes[k - 1], t_nodes[k]
-            sa, sb = self.node_slopes[k - 1, j, cols], self.node_slopes[k, j, cols]
-            s = hermite_root(yb - ya, y2 - ya, sa * (tb - ta), sb * (tb - ta))
-            t = np.where(np.isfinite(s), ta + (tb - ta) * s, ta)
-            pair = self.pair[:, :, j, cols]                          # (DEGREE + 1, 2, rows, P)
-            y2 = y2 - self.offset[j, cols]                           # (exact within a factor 2: Sterbenz)
+        t_nodes = self.rule.t
+        with np.errstate(invalid="ignore", divide="ignore"):
+            j = np.minimum((self.tops[:, None, :] < y2[None]).sum(axis=0), np.maximum(self.panels - 1, 0))
+            inside = (y2 >= self.bottom) & (y2 <= self.tops[j, cols]) & self.ok
+            nodes = self.nodes[j, cols]                             # (rows, P, 2, DEGREE + 1)
+            z_nodes, slopes = nodes[..., 0, :], nodes[..., 1, :]    # the values the panel interpolated
+            z = y2 - self.offset[j, cols]                           # (exact within a factor 2: Sterbenz)
+            weights = _lobatto_weights(DEGREE)
+            # the start: t as a function of z through the nodes (z_i, t_i), by the linear rational
+            # interpolant with the Lobatto nodes' weights at the z_i, their image under the smooth
+            # increasing y; its error falls exponentially with the degree (Baltensperger, Berrut &
+            # Noël, Math. Comp. 68, 1999): a start, which Newton's method below checks
+            # (a target on a node exactly gives 0/0: the panel's bottom instead, Newton's start;
+            # fmax and fmin drop a NaN)
+            ratio = weights / (z[..., None] - z_nodes)
+            t = np.fmin(np.fmax((ratio * t_nodes).sum(axis=-1) / ratio.sum(axis=-1), -1.0), 1.0)
             # Newton on the interpolant, quadratic: after a step below 1e-9 the error is ~1e-18 and
-            # that point stops (its iterations do not depend on its neighbours')
+            # that point stops (its iterations do not depend on its neighbours'). The interpolant
+            # and its derivative (degree n - 1: exact from its values at the nodes) by the
+            # barycentric formula, stable at Chebyshev points (Higham, IMA J. Numer. Anal. 24, 2004)
             moving = inside.copy()
             for _ in range(10):
-                value, slope = clenshaw(pair, np.broadcast_to(t, pair.shape[1:]))
-                step = (value - y2) / slope
-                step = np.where(moving & np.isfinite(step), step, 0.0)
-                t = np.minimum(np.maximum(t - step, -1.0), 1.0)
+                offset_t = t[..., None] - t_nodes
+                ratio = weights / offset_t
+                total = ratio.sum(axis=-1)
+                value = (ratio * z_nodes).sum(axis=-1) / total
+                slope = (ratio * slopes).sum(axis=-1) / total
+                on_node = offset_t == 0.0
+                if on_node.any():
+                    value = _at_nodes(on_node, value, z_nodes)
+                    slope = _at_nodes(on_node, slope, slopes)
+                # (a point that has converged keeps its t: its bits do not depend on its neighbours';
+                # a NaN step leaves it moving, and unvouched after the last iteration)
+                step = np.where(moving, (value - z) / slope, 0.0)
+                t = np.fmin(np.fmax(t - step, -1.0), 1.0)
                 moving &= ~(np.abs(step) <= 1e-9)
                 if not moving.any():
                     break
             inside &= ~moving
-            x = self.x0[cols] + WIDTH * (j + 0.5 * (t + 1.0))
+            x = self.x0 + WIDTH * (j + 0.5 * (t + 1.0))   # (t = -1: the panel's start)
             tau = self._tau(self.rheology, np.exp(x))            # (the law's parameters: one per point, the last axis)
         return tau.reshape(shape), inside.reshape(shape), x.reshape(shape)
+
+
+def _at_nodes(on_node, value, node_values):
+    """``value`` where no node is hit, else the value at the node hit: the barycentric formula's
+    0/0 there. ``on_node`` ``(..., nodes)``, at most one True per row; ``node_values`` of its
+    shape, or the nodes' own values ``(nodes,)``."""
+    if not on_node.any():
+        return value
+    first = on_node.argmax(axis=-1)
+    at = node_values[first] if node_values.ndim == 1 else np.take_along_axis(node_values, first[..., None], axis=-1)[..., 0]
+    return np.where(on_node.any(axis=-1), at, value)
 
 
 def flow_map(rheology, y_lo, y_hi, x_lo=None, which=None):
@@ -350,7 +471,9 @@ def flow_map(rheology, y_lo, y_hi, x_lo=None, which=None):
     if which is None:
         return None
     y_hi = np.atleast_1d(np.asarray(y_hi, dtype=float))
-    y_lo = np.broadcast_to(np.asarray(np.nan if y_lo is None else y_lo, dtype=float), y_hi.shape)
+    y_lo = np.asarray(np.nan if y_lo is None else y_lo, dtype=float)
+    if y_lo.shape != y_hi.shape:
+        y_lo = np.broadcast_to(y_lo, y_hi.shape)
     model = _points(rheology, y_hi.size)
     return ClosedMap(model, y_lo, y_hi) if which == "closed" else PanelMap(model, y_lo, y_hi, x_lo)
 

@@ -192,7 +192,7 @@ def _far_slope(out, stretch, d, modulus, power):
     if np.ndim(out) == 0:
         if 0.0 < out < math.inf:
             return out
-    elif np.all((out > 0) & (out < math.inf)):
+    elif out.size and 0.0 < out.min() and out.max() < math.inf:       # (a NaN fails the first)
         return out
     with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
         lam = np.asarray(stretch, dtype=float)
@@ -249,7 +249,7 @@ class _ThickForms(_NeoHookeanLaw):
             den *= den
             den *= lam2
             # (in place where the shapes allow: one array of nodes x points fewer)
-            inplace = type(lam2) is np.ndarray and np.broadcast_shapes(lam2.shape, np.shape(d)) == lam2.shape
+            inplace = type(lam2) is np.ndarray and (np.ndim(d) == 0 or np.broadcast_shapes(lam2.shape, np.shape(d)) == lam2.shape)
             num = np.multiply(lam2, d + 2.0, out=lam2) if inplace else lam2 * (d + 2.0)
             num += d
             num *= self._installed_modulus() * d
