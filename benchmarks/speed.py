@@ -36,7 +36,9 @@ thick neo-Hookean wall, mu = 2 kPa.
 7. ``carreau curve``: a 10^4-point Carreau-Yasuda curve (blood, Cho & Kensey constants) in the
    thick wall against the power-law baseline at the same flow rates, per point;
 8. ``carreau scalar``: one scalar Carreau-Yasuda solve with fresh fluid parameters each call
-   (absolute time; a fresh fluid is served by its flow map, no table);
+   (absolute time, the median of 100 calls as a Monte Carlo makes them; a fresh fluid is served
+   by its flow map, no table). The first few calls after start-up are slower, while the
+   interpreter specializes the code: the note gives the median of the first seven;
 8b. ``carreau scenes``: 10^3 random Carreau-Yasuda scenes (every fluid, wall and tube parameter and
    q random), one broadcast call, against the baseline per scene (the power law of each fluid's
    high-shear asymptote, same q, tube and wall);
@@ -100,12 +102,12 @@ class Sizes:
     sample: int = 200          # baseline ODEs per pass (and scalar solves per pass of a loop)
     repeats: int = 7           # interleaved passes per row; medians reported
     calls: int = 200           # scalar solves per Monte Carlo pass
-    carreau_calls: int = 7     # fresh-fluid Carreau solves (one each)
+    carreau_calls: int = 100   # fresh-fluid Carreau solves (one each; the first ones after start-up are slower)
     fits: int = 5              # fits, each on fresh noise
     imports: int = 7           # fresh subprocesses per module
 
 
-QUICK = Sizes(points=200, sample=8, repeats=3, calls=10, carreau_calls=2, fits=2, imports=5)
+QUICK = Sizes(points=200, sample=8, repeats=3, calls=10, carreau_calls=4, fits=2, imports=5)
 
 
 @attrs.define
@@ -440,7 +442,8 @@ def carreau_scalar(row, sizes, rng):
     tubefsi.solve(warm_fluid, wall, TUBE, flow_rate=Q_MC * 1.01)
     warm = time.perf_counter() - t0
     fill_absolute(row, times[1:])                        # the first call also warms the process
-    row.note = (f"q = {Q_MC:g} m^3/s, eta0 and lambda +-20 %, n +-10 %; {sizes.carreau_calls} calls; "
+    row.note = (f"q = {Q_MC:g} m^3/s, eta0 and lambda +-20 %, n +-10 %; median of {sizes.carreau_calls} calls, "
+                f"each with a fresh fluid (of the first 7 after the untimed one: {seconds(statistics.median(times[1:8]))}); "
                 f"the same fluid again: {seconds(warm)}")
 
 

@@ -647,8 +647,8 @@ def _one_batch_mapped(engine, scene, target, index, q, bound, v, solved, live, w
     else:
         rough = np.asarray(pts.rheology._stress(np.exp(y_out)), dtype=float) + zeros
     slope0 = np.asarray(pts.wall._log_slope(pts.outlet_stretch, pts.tb), dtype=float) + zeros
+    # (bound is finite: a NaN guess stays NaN, and fails the test below)
     top = np.minimum(1.5 * target * 2.0 * rough / ((pts.radius * pts.outlet_stretch) * slope0), bound)
-    top = np.where(np.isfinite(top) & (top > 0), top, 0.0)
     live = live[top[live] > 0]
     rtol = max(engine._RTOL, _MAPPED_RTOL)
     split = np.zeros(0, dtype=int)              # (tail missed at the top degree: solved in pieces)
@@ -656,7 +656,7 @@ def _one_batch_mapped(engine, scene, target, index, q, bound, v, solved, live, w
         if live.size == 0:
             break
         every = live.size == target.size           # (no gathers)
-        f, vouched = _mapped_integrand(engine, scene, index if every else index[live], y_out if every else y_out[live],
+        f, vouched = _mapped_integrand(engine, pts if every else scene.at(index[live]), y_out if every else y_out[live],
                                        top if every else top[live], which)
         x, good, short = solve_integral(f, target if every else target[live], top if every else top[live],
                                         rtol=rtol, degree=degree, method="barycentric")
@@ -680,7 +680,7 @@ def _one_batch_mapped(engine, scene, target, index, q, bound, v, solved, live, w
     for pieces in _MAPPED_PIECES:
         if split.size == 0:
             break
-        f, vouched = _mapped_integrand(engine, scene, index[split], y_out[split], top[split], which)
+        f, vouched = _mapped_integrand(engine, scene.at(index[split]), y_out[split], top[split], which)
         x, good = _solve_in_pieces(f, target[split], top[split], pieces, _MAPPED_DEGREES[-1], rtol)
         good &= vouched
         v[split[good]] = x[good]
@@ -694,14 +694,13 @@ def _one_batch_mapped(engine, scene, target, index, q, bound, v, solved, live, w
 _MAPPED_PIECES = (2, 4)
 
 
-def _mapped_integrand(engine, scene, ids, y_out, top, which):
-    """``(f, vouched)``: the separated integrand of the points ``ids`` (a non-separable fluid, at their
-    flow rates: ``y_out`` is ln Gamma at the outlet) from a flow map built over ``[0, top]`` of each,
-    and whether the map vouched for every value ``f`` gave (updated by each call); ``which``: the
-    fluid's :func:`~tubefsi.rheology.flow_map.kind`."""
-    sub = scene.at(ids)
+def _mapped_integrand(engine, sub, y_out, top, which):
+    """``(f, vouched)``: the separated integrand of the points ``sub`` (:class:`~tubefsi.scene.Points`
+    of a non-separable fluid, at their flow rates: ``y_out`` is ln Gamma at the outlet) from a flow
+    map built over ``[0, top]`` of each, and whether the map vouched for every value ``f`` gave
+    (updated by each call); ``which``: the fluid's :func:`~tubefsi.rheology.flow_map.kind`."""
     fmap = flow_map.flow_map(sub.rheology, y_out - 3.0 * top - 1e-9, y_out + 1e-9, which=which)
-    vouched = np.ones(ids.size, dtype=bool)
+    vouched = np.ones(y_out.size, dtype=bool)
 
     def f(u, i):
         tau, ok, _ = fmap.wall_stress(y_out - 3.0 * u)

@@ -88,10 +88,11 @@ def _k_maps(degree):
     interpolant (its tail: rows 0..2), the cumulative integrals at the nodes (the next
     ``degree + 1``) and those rows' absolute values (the last ``degree + 1``): applied to
     positive values, those give the sums of the terms each cumulative integral adds up, the
-    scale of its rounding (constants of the degree, read-only)."""
+    scale of its rounding (constants of the degree, read-only). All on a panel of the map's width
+    (:math:`dx = (W/2)\,dt`: the factor exact, a power of two)."""
     rule = lobatto_rule(degree)
     cumulative = rule.matrix[rule.cumulative]
-    maps = np.vstack([rule.matrix[rule.coef][-3:], cumulative, np.abs(cumulative)])
+    maps = (0.5 * WIDTH) * np.vstack([rule.matrix[rule.coef][-3:], cumulative, np.abs(cumulative)])
     maps.setflags(write=False)
     return maps
 
@@ -102,45 +103,50 @@ _BELOW = 16
 _K_RTOL = 1e-15
 
 
-@functools.lru_cache(maxsize=2)
-def _sum_maps(degree):
-    """Values at the Chebyshev-Lobatto nodes -> their Clenshaw-Curtis integral over [-1, 1] (row 0)
-    and the last three Chebyshev coefficients of their interpolant (its tail; constants)."""
-    rule = lobatto_rule(degree)
-    maps = np.vstack([rule.matrix[rule.cumulative][-1:], rule.matrix[rule.coef][-3:]])
-    maps.setflags(write=False)
-    return maps
+@functools.lru_cache(maxsize=64)
+def _panel_nodes(j0, count):
+    """The nodes of panels ``j0 .. j0 + count - 1`` from a map's start, ``(nodes, count, 1)`` (in
+    units of the panel width; constants, read-only)."""
+    nodes = WIDTH * (np.arange(j0, j0 + count)[:, None] + lobatto_rule(DEGREE).nodes[:, None, None])
+    nodes.setflags(write=False)
+    return nodes
 
 
-def _k_below(rheology, x0, above):
-    r"""``(K, error, g, tau)``: :math:`K = \int_0^{\dot\gamma_0}\tau^3\,d\dot\gamma =
+def _law_panels(rheology, x0, j0, count):
+    """The law on the nodes of panels ``j0 .. j0 + count - 1`` (panel j spans
+    ``[x0 + j W, x0 + (j + 1) W]``; ``j0 < 0`` below the map), each point's (its array parameters
+    and ``x0`` one per point), in one batch: ``(g, cube, values, maps)``, the wall shear rates,
+    :math:`\tau^3`, the integrand :math:`\tau^3\dot\gamma` of :math:`K` in :math:`x`
+    (``(nodes, count, P)``) and :func:`_k_maps` applied to it (``(rows, count, P)``)."""
+    g = np.exp(x0 + _panel_nodes(j0, count))
+    tau = PanelMap._tau(rheology, g)
+    cube = tau * tau * tau
+    values = cube * g
+    maps = blocked_matmul(_k_maps(DEGREE), values.reshape(DEGREE + 1, count * x0.size)).reshape(-1, count, x0.size)
+    return g, cube, values, maps
+
+
+def _k_below(rheology, x0, values, maps):
+    r"""``(K, error)``: :math:`K = \int_0^{\dot\gamma_0}\tau^3\,d\dot\gamma =
     \int_{-\infty}^{x_0}\tau(e^x)^3 e^x\,dx` at each point's ``x0`` (its array parameters one
-    per point), an estimate of its error, and the shear rates and stresses at the nodes of the
-    ``above`` panels above :math:`x_0` (``(nodes, above, P)``: the map's first ones, whose law
-    values are taken in the same batch).
+    per point) and an estimate of its error, from the ``values`` and ``maps`` of
+    :func:`_law_panels` on the ``_BELOW`` unit panels below :math:`x_0`.
 
-    On ``_BELOW`` unit panels below :math:`x_0`, all in one batch (Clenshaw–Curtis on each, its
-    Chebyshev tail its error); below them the rest lies in :math:`[0, \tau_b^3\dot\gamma_b]`
-    for an increasing law (:math:`\tau \le \tau_b` there), taken as half of it, with half of it
-    as its error. Where that misses ``_K_RTOL`` (a law still thinning steeply far below
-    :math:`x_0`: :math:`\tau^3\dot\gamma` falls by less than 1e-16 over the panels) the
-    adaptive quadrature from zero (:func:`~tubefsi.numerics.quadrature.unit_integral`) answers."""
-    rule = lobatto_rule(DEGREE)
-    p = x0.size
-    # panel j (-_BELOW .. above - 1) spans [x0 + j W, x0 + (j + 1) W], as the map's panel j does
-    x = x0 + WIDTH * (np.arange(-_BELOW, above)[:, None] + rule.nodes[:, None, None])    # (nodes, panels, P)
-    g_all = np.exp(x)
-    tau_all = PanelMap._tau(rheology, g_all)
-    g, tau = g_all[:, :_BELOW], tau_all[:, :_BELOW]
-    values = tau * tau * tau * g
-    sums = blocked_matmul(_sum_maps(DEGREE), values.reshape(DEGREE + 1, _BELOW * p)).reshape(4, _BELOW, p)
-    tails = np.abs(sums[1:]).sum(axis=0)
-    tails = np.where(tails <= 32.0 * _EPS * values.max(axis=0), 0.0, tails)      # (the values' rounding)
+    Clenshaw–Curtis on each panel, its Chebyshev tail its error; below them the rest lies in
+    :math:`[0, \tau_b^3\dot\gamma_b]` for an increasing law (:math:`\tau \le \tau_b` there),
+    taken as half of it, with half of it as its error. Where that misses ``_K_RTOL`` (a law
+    still thinning steeply far below :math:`x_0`: :math:`\tau^3\dot\gamma` falls by less than
+    1e-16 over the panels) the adaptive quadrature from zero
+    (:func:`~tubefsi.numerics.quadrature.unit_integral`) answers."""
+    # (the top node's value is the largest of an increasing law's; else smaller: a floor on the
+    # safe side)
+    tails = np.abs(maps[:3]).sum(axis=0)
+    tails = np.where(tails <= (0.5 * WIDTH) * 32.0 * _EPS * values[-1], 0.0, tails)      # (the values' rounding)
     rest = 0.5 * values[0, 0]                                  # the bottom node: x0 - _BELOW W
-    # the sums over the panels along a contiguous last axis (the same order whatever the number
-    # of points)
-    K = rest + (0.5 * WIDTH) * np.ascontiguousarray(sums[0].T).sum(axis=1)
-    error = rest + (0.5 * WIDTH) * np.ascontiguousarray(tails.T).sum(axis=1) + 4.0 * _EPS * K
+    # the sums over the panels (each one's integral: the cumulative's last row) along a contiguous
+    # last axis: the same order whatever the number of points
+    K = rest + np.ascontiguousarray(maps[DEGREE + 3].T).sum(axis=1)
+    error = rest + np.ascontiguousarray(tails.T).sum(axis=1) + 4.0 * _EPS * K
     fine = (error <= _K_RTOL * K) & (values[0, 0] >= 0.0)
     if not fine.all():
         missed = np.flatnonzero(~fine)
@@ -149,7 +155,7 @@ def _k_below(rheology, x0, above):
                              missed.size, rtol=_K_RTOL)
         K[missed] = g0 * base.value
         error[missed] = g0 * base.error + 4.0 * _EPS * np.abs(K[missed])
-    return K, error, g_all[:, _BELOW:], tau_all[:, _BELOW:]
+    return K, error
 
 
 def _overridden(cls, name) -> bool:
@@ -295,15 +301,17 @@ class PanelMap:
             return
         with np.errstate(all="ignore"):
             batch = self._batch(live, 0, y_hi)
-            K, err_k, g, tau = _k_below(rheology, self.x0, batch)
+            # the panels below the map (for K at its start) and its first batch: one law call
+            law = _law_panels(rheology, self.x0, -_BELOW, _BELOW + batch)
+            K, err_k = _k_below(rheology, self.x0, law[2][:, :_BELOW], law[3][:, :_BELOW])
             self.ok &= np.isfinite(K) & (K > 0)
             live = np.nonzero(self.ok)[0]
-            laws = (g, tau) if live.size == n else (g[..., live], tau[..., live])   # (the first batch's law values)
+            law = tuple(a[:, _BELOW:] if live.size == n else a[:, _BELOW:, live] for a in law)
             j = 0
             while live.size and j < MAX_PANELS:
-                live = self._panels(rheology, live, j, batch, K, err_k, y_lo, y_hi, x_lo is None, laws)
+                live = self._panels(rheology, live, j, batch, K, err_k, y_lo, y_hi, x_lo is None, law)
                 j += batch
-                laws = None
+                law = None
                 if live.size and j < MAX_PANELS:
                     batch = self._batch(live, j, y_hi)
             self.ok[live] = False                                   # (beyond MAX_PANELS)
@@ -314,24 +322,15 @@ class PanelMap:
         need = np.ceil((y_hi[live] - math.log(4.0 / 3.0) - self.x0[live]) / WIDTH - j + 1e-9)
         return int(min(MAX_PANELS - j, max(1.0, float(np.sort(need)[(9 * (need.size - 1)) // 10]))))
 
-    def _panels(self, rheology, live, j0, batch, K, err_k, y_lo, y_hi, check_bottom, laws=None):
+    def _panels(self, rheology, live, j0, batch, K, err_k, y_lo, y_hi, check_bottom, law=None):
         """Panels ``j0 .. j0 + batch - 1`` of the points ``live``, their law values in one batch (a
-        point's bits are those of building them one by one), or ``laws`` (the shear rates and
-        stresses at their nodes, where the caller has them); ``K`` and ``err_k`` carried up panel
-        by panel. Returns the points still live after them (every panel good, y_hi not reached)."""
-        rule = self.rule
-        y_maps, k_maps = _y_maps(DEGREE), _k_maps(DEGREE)
+        point's bits are those of building them one by one; :func:`_law_panels`, or ``law``, its
+        result where the caller has it); ``K`` and ``err_k`` carried up panel by panel. Returns
+        the points still live after them (every panel good, y_hi not reached)."""
+        y_maps = _y_maps(DEGREE)
         p = live.size
-        if laws is None:
-            x = self.x0[live] + WIDTH * ((j0 + np.arange(batch))[:, None] + rule.nodes[:, None, None])  # (nodes, batch, P)
-            g = np.exp(x)
-            tau = self._tau(_at(rheology, live), g)
-        else:
-            g, tau = laws
-        cube = tau * tau * tau
-        values = cube * g
-        maps = blocked_matmul(k_maps, values.reshape(DEGREE + 1, batch * p)).reshape(-1, batch, p)
-        cumulative = (0.5 * WIDTH) * maps[3:DEGREE + 4]
+        g, cube, values, maps = _law_panels(_at(rheology, live), self.x0[live], j0, batch) if law is None else law
+        cumulative = maps[3:DEGREE + 4]
         # K's error at each node: the panel's start's, the tail of the integrand's interpolant
         # (a tail at the rounding of the values, 32 eps of their largest, is noise), and the
         # rounding of the node's own sum, a few eps of the terms it adds up (at the panel's
@@ -340,13 +339,14 @@ class PanelMap:
         # (the top node's value is the largest of an increasing law's; else smaller: a floor on the
         # safe side)
         w_tail = np.abs(maps[:3]).sum(axis=0)
-        noise = w_tail <= 32.0 * _EPS * values[-1]
-        own = np.where(noise, 0.0, (0.5 * WIDTH) * w_tail) + 2.0 * _EPS * ((0.5 * WIDTH) * maps[DEGREE + 4:])
+        own = np.where(w_tail <= (0.5 * WIDTH) * 32.0 * _EPS * values[-1], 0.0, w_tail) + 2.0 * _EPS * maps[DEGREE + 4:]
         # K and its error at each panel's start, carried up from the last: running sums along
         # the panels (in order, as panel by panel)
-        k_nodes = np.cumsum(np.concatenate([K[live][None], cumulative[-1, :-1]]), axis=0) + cumulative
+        every = p == K.size                                         # (no gathers)
+        k_start, e_start = (K, err_k) if every else (K[live], err_k[live])
+        k_nodes = np.concatenate([k_start[None], cumulative[-1, :-1]]).cumsum(axis=0) + cumulative
         own += 2.0 * _EPS * k_nodes
-        err_nodes = np.cumsum(np.concatenate([err_k[live][None], own[-1, :-1]]), axis=0) + own
+        err_nodes = np.concatenate([e_start[None], own[-1, :-1]]).cumsum(axis=0) + own
         # Gamma tau^3 = (4/3) (tau^3 gamma_w - K): the flow function's integral by parts
         gamma_cube = (4.0 / 3.0) * (values - k_nodes)
         y = np.log(gamma_cube / cube)
@@ -358,26 +358,32 @@ class PanelMap:
         err_y = ((4.0 / 3.0) * err_nodes / gamma_cube).max(axis=0)
         tail = np.abs(tail_and_slope[:3]).sum(axis=0)
         # (a NaN in y fails the first test, an infinite one the tail's)
-        good = (np.diff(y, axis=0) > 0).all(axis=0) & (cube > 0).all(axis=0) & \
+        good = (y[1:] > y[:-1]).all(axis=0) & (cube > 0).all(axis=0) & \
             (err_y + tail <= TOL + 32.0 * _EPS * np.abs(y).max(axis=0))
         # each point takes its panels in order until one fails or reaches y_hi (as one by one):
         # panel b where every panel before it was good and below y_hi
-        goes_on = good & (y[-1] < y_hi[live])                      # (batch, P): the next one is built
+        goes_on = good & (y[-1] < (y_hi if every else y_hi[live]))  # (batch, P): the next one is built
         taken = np.ones((batch, p), dtype=bool)
-        taken[1:] = np.logical_and.accumulate(goes_on[:-1], axis=0)
+        if batch > 1 and not goes_on[:-1].all():
+            taken[1:] = np.logical_and.accumulate(goes_on[:-1], axis=0)
         # every panel of the batch is stored: one a point did not take lies beyond its count of
         # panels, which the inverse never reads (and a later batch builds only for points that
         # took all of theirs)
         stored = slice(j0, j0 + batch)
         self.offset[stored, live] = ref
         self.tops[stored, live] = y[-1]
-        self.nodes[stored, live] = np.stack([z, tail_and_slope[3:]]).transpose(2, 3, 0, 1)
+        self.nodes[stored, live, 0] = z.transpose(1, 2, 0)
+        self.nodes[stored, live, 1] = tail_and_slope[3:].transpose(1, 2, 0)
         if j0 == 0:
             self.bottom[live] = y[0, 0]
         self.ok[live[(taken & ~good).any(axis=0)]] = False
-        last = taken.sum(axis=0) - 1                                # each point's last panel taken
-        K[live], err_k[live] = k_nodes[-1, last, np.arange(p)], err_nodes[-1, last, np.arange(p)]
-        self.panels[live] = j0 + last + 1
+        if taken.all():                                             # (each point's last panel: the batch's)
+            K[live], err_k[live] = k_nodes[-1, -1], err_nodes[-1, -1]
+            self.panels[live] = j0 + batch
+        else:
+            last = taken.sum(axis=0) - 1                            # each point's last panel taken
+            K[live], err_k[live] = k_nodes[-1, last, np.arange(p)], err_nodes[-1, last, np.arange(p)]
+            self.panels[live] = j0 + last + 1
         if j0 == 0 and check_bottom:
             self.ok[live[y[0, 0] > y_lo[live]]] = False             # (cannot happen for an increasing law)
         return live[goes_on.all(axis=0)]
