@@ -169,12 +169,17 @@ def test_interpolation_maps_against_numpy_chebyshev(degree):
     np.testing.assert_allclose(cumulative, np.polynomial.chebyshev.chebval(t, anti.T), rtol=0, atol=1e-13)
 
 
+METHODS = ["clenshaw", "barycentric"]
+
+
+@pytest.mark.parametrize("method", METHODS)
 @settings(deadline=None, max_examples=scaled(30))
 @given(st.floats(0.0, 4.0), st.floats(0.2, 3.0), st.floats(0.01, 0.6))
-def test_solved_points_meet_the_tolerance_against_mpmath(k, c, target):
-    """int_0^x e^{ku} (c + u) du = T, solved where the estimate says so, against mpmath's root."""
+def test_solved_points_meet_the_tolerance_against_mpmath(method, k, c, target):
+    """int_0^x e^{ku} (c + u) du = T, solved where the estimate says so, against mpmath's root,
+    by either way of finding the root on the interpolant."""
     x, solved, short = solve_integral(lambda u, i: np.exp(k * u) * (c + u), np.array([target]),
-                                      np.array([1.5 * target / c]))
+                                      np.array([1.5 * target / c]), method=method)
     with mpmath.workdps(40):
         f = lambda xx: mpmath.quad(lambda u: mpmath.exp(k * u) * (c + u), [0, xx]) - target
         root = mpmath.findroot(f, target / c)
@@ -184,7 +189,8 @@ def test_solved_points_meet_the_tolerance_against_mpmath(k, c, target):
         assert short[0] or float(root) < 1.5 * target / c
 
 
-def test_what_is_not_resolved_is_left_to_the_caller():
+@pytest.mark.parametrize("method", METHODS)
+def test_what_is_not_resolved_is_left_to_the_caller(method):
     """A kink (|u - 0.3|), a steep exponential, a non-positive and a non-finite integrand, and
     a root beyond the interval: none of them is answered."""
     target = np.array([0.3, 0.5, 0.5, 0.5, 5.0])
@@ -199,21 +205,61 @@ def test_what_is_not_resolved_is_left_to_the_caller():
         out[:, 4] = 1.0
         return out
 
-    x, solved, short = solve_integral(f, target, upper)
+    x, solved, short = solve_integral(f, target, upper, method=method)
     assert not np.any(solved)
     assert list(short) == [False, False, False, False, True]
 
 
-def test_vectorized_solve_equals_one_at_a_time():
+@pytest.mark.parametrize("method", METHODS)
+def test_vectorized_solve_equals_one_at_a_time(method):
+    """A point's answer is the same bits alone and in a batch (and the closed form's)."""
     k = np.array([0.5, 2.0, 3.5])
     target = np.array([0.05, 0.2, 0.3])
-    x, solved, _ = solve_integral(lambda u, i: np.exp(k[i] * u), target, 1.5 * target)
+    x, solved, _ = solve_integral(lambda u, i: np.exp(k[i] * u), target, 1.5 * target, method=method)
     for j in range(3):
-        xj, sj, _ = solve_integral(lambda u, i: np.exp(k[j] * u), target[j:j + 1], 1.5 * target[j:j + 1])
+        xj, sj, _ = solve_integral(lambda u, i: np.exp(k[j] * u), target[j:j + 1], 1.5 * target[j:j + 1],
+                                   method=method)
         assert sj[0] == solved[j]
         assert xj[0] == x[j]
     # the closed form: (e^{kx} - 1)/k = T
     np.testing.assert_allclose(x[solved], (np.log1p(k * target) / k)[solved], rtol=4e-15)
+
+
+@pytest.mark.parametrize("degree", [16, 24])
+def test_barycentric_rule_against_numpy_chebyshev(degree):
+    """The constants of the barycentric root: its matrix's rows are the interpolant's last three
+    Chebyshev coefficients, its antiderivative at the nodes and at s_* (numpy's chebfit, chebint
+    and chebval through the same points), and the n + 2 weights interpolate a polynomial of
+    degree n + 1 exactly (against numpy's polyval off the nodes)."""
+    from tubefsi.numerics.spectral import _barycentric, _barycentric_rule, lobatto_rule
+    matrix, nodes, weights, lobatto = _barycentric_rule(degree)
+    rule = lobatto_rule(degree)
+    y = np.random.default_rng(5).standard_normal(degree + 1)
+    coef = np.polynomial.chebyshev.chebfit(rule.t, y, degree)
+    anti = np.polynomial.chebyshev.chebint(coef, lbnd=-1.0)
+    rows = matrix @ y
+    np.testing.assert_allclose(rows[:3], coef[-3:], rtol=0, atol=1e-13)
+    np.testing.assert_allclose(rows[3:], np.polynomial.chebyshev.chebval(nodes, anti), rtol=0, atol=1e-13)
+    poly = np.random.default_rng(6).standard_normal(degree + 2)      # degree n + 1, on [-1, 1]
+    at = np.array([-0.97, -0.31, 0.013, 0.55, 0.999])
+    got = _barycentric(weights, at[:, None] - nodes, np.polynomial.polynomial.polyval(nodes, poly))
+    np.testing.assert_allclose(got, np.polynomial.polynomial.polyval(at, poly), rtol=0, atol=1e-11)
+    got = _barycentric(lobatto, at[:, None] - rule.t, np.polynomial.polynomial.polyval(rule.t, poly[:-1]))
+    np.testing.assert_allclose(got, np.polynomial.polynomial.polyval(at, poly[:-1]), rtol=0, atol=1e-11)
+
+
+def test_barycentric_root_with_the_target_on_a_node():
+    """The target is a constant integrand's integral at a Lobatto node, to the bit (the rule's own
+    cumulative row there): the start's interpolant gives 0/0 and Newton's method starts from the
+    interval's end instead; the root is still the node (closed form T / c)."""
+    from tubefsi.numerics.spectral import _barycentric_rule, lobatto_rule
+    nodes = lobatto_rule(24).nodes
+    on = [12, 18, 23]
+    target = 0.5 * (_barycentric_rule(24)[0] @ np.full(25, 2.0))[3:][on]      # (X / 2 = 1/2)
+    x, solved, _ = solve_integral(lambda u, i: np.full(u.shape, 2.0), target, np.ones(3), degree=24,
+                                  method="barycentric")
+    assert solved.all()
+    np.testing.assert_allclose(x, nodes[on], rtol=1e-15)
 
 
 def test_hermite_root_of_a_cubic():

@@ -153,6 +153,50 @@ def test_flow_map_vouches_on_the_newtonian_plateau():
         assert rel_err(rate, gamma) < 1e-14, (rate, float(gamma))
 
 
+def test_flow_map_below_a_law_still_thinning_far_down():
+    """A Carreau-Yasuda fluid at wall shear rates e^7-e^16 above its Newtonian plateau, index 0.25:
+    tau^3 gamma_w falls by only e^-28 over the sixteen panels below the map's start, so K there
+    cannot come from those panels and the bound below them; the map takes it from zero by the
+    adaptive quadrature instead, and still vouches. Each wall stress against its apparent rate
+    Gamma = (4/3)(g - K(g)/tau^3), K = int_0^g tau^3 by mpmath quadrature (30 digits, split at
+    the decades from the plateau up), at the g where the reference law gives that stress."""
+    from tubefsi.rheology import flow_map
+
+    p = dict(zero_shear_viscosity=1.0, infinite_shear_viscosity=0.0, relaxation_time=1e3, index=0.25, transition=2.0)
+    ref = CarreauYasudaRef(p["zero_shear_viscosity"], p["infinite_shear_viscosity"], p["relaxation_time"],
+                           p["index"], p["transition"])
+    for rates in (np.array([1e4]), np.array([1e6, 3e6, 1e7])):
+        tau, ok = flow_map.wall_stress(rheologies["carreau-yasuda"](**p), rates)
+        assert ok.all()
+        for rate, t in zip(rates, tau):
+            g = mp.findroot(lambda x: ref.tau(x) - mpf(float(t)), mpf(float(rate)))
+            edges = [0] + [mpf(10) ** k for k in range(-5, int(mp.log10(g)) + 1)] + [g]
+            k = mp.quad(lambda s: ref.tau(s) ** 3, edges)
+            gamma = mpf(4) / 3 * (g - k / ref.tau(g) ** 3)
+            assert rel_err(rate, gamma) < 1e-14, (rate, float(gamma))
+
+
+@pytest.mark.parametrize("wall_name", sorted(WALLS))
+def test_fresh_scalar_fluids_against_mpmath(wall_name):
+    """The benchmark's call shape: one scalar solve per fluid, each with fresh Carreau-Yasuda
+    parameters (zero-shear viscosity and relaxation time +-20 %, index +-10 % about blood's), a
+    Python float flow rate; each pressure drop and inlet displacement against the mpmath
+    reference, to the contract."""
+    wall, tb, ref_wall, flow_rates = WALLS[wall_name]
+    tube = tubefsi.Tube(radius=RADIUS, thickness=tb * RADIUS, length=LENGTH)
+    rng = np.random.default_rng(26)
+    base = SETS["carreau-yasuda"][0]
+    for _ in range(3):
+        p = dict(base, zero_shear_viscosity=base["zero_shear_viscosity"] * rng.uniform(0.8, 1.2),
+                 relaxation_time=base["relaxation_time"] * rng.uniform(0.8, 1.2), index=base["index"] * rng.uniform(0.9, 1.1))
+        q = float(rng.uniform(*flow_rates))
+        sol = tubefsi.solve(rheologies["carreau-yasuda"](**p), wall, tube, flow_rate=q)
+        dp, lam = solve_flow_controlled(_ref_fluid("carreau-yasuda", p), ref_wall, RADIUS, LENGTH, q,
+                                        1 + sol.inlet_displacement / RADIUS)
+        assert rel_err(sol.pressure_drop, dp) < TOL, p
+        assert rel_err(sol.inlet_displacement, (lam - 1) * RADIUS) < TOL * max(1.0, float(lam / (lam - 1)) * 1e-3), p
+
+
 # loaded outlets: the fluid's outlet pressure and the external pressure (transmural 400 Pa)
 OUTLET, EXTERNAL = 300.0, -100.0
 

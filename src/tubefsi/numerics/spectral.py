@@ -282,7 +282,7 @@ def solve_integral(f, target, upper, *, rtol=1e-14, values=None, degree=CHEBYSHE
 
 
 def _root_barycentric(degree, known, y, h, goal):
-    """``(t, unconverged)``: the root :math:`t \in [-1, 1]` of :math:`J(t) =` ``goal``, where
+    r"""``(t, unconverged)``: the root :math:`t \in [-1, 1]` of :math:`J(t) =` ``goal``, where
     :math:`J` is the antiderivative of the interpolant of ``y`` (``(nodes, P)``), ``known`` at the
     nodes and at :math:`s_*` (``(nodes + 1, P)``), with :math:`J' = h\,p`
     (:func:`solve_integral`, ``method="barycentric"``). The points along the first axis and

@@ -84,7 +84,7 @@ def _lobatto_weights(degree):
 
 @functools.lru_cache(maxsize=2)
 def _k_maps(degree):
-    """Values at the Chebyshev-Lobatto nodes -> the last three Chebyshev coefficients of their
+    r"""Values at the Chebyshev-Lobatto nodes -> the last three Chebyshev coefficients of their
     interpolant (its tail: rows 0..2), the cumulative integrals at the nodes (the next
     ``degree + 1``) and those rows' absolute values (the last ``degree + 1``): applied to
     positive values, those give the sums of the terms each cumulative integral adds up, the
@@ -113,7 +113,7 @@ def _panel_nodes(j0, count):
 
 
 def _law_panels(rheology, x0, j0, count):
-    """The law on the nodes of panels ``j0 .. j0 + count - 1`` (panel j spans
+    r"""The law on the nodes of panels ``j0 .. j0 + count - 1`` (panel j spans
     ``[x0 + j W, x0 + (j + 1) W]``; ``j0 < 0`` below the map), each point's (its array parameters
     and ``x0`` one per point), in one batch: ``(g, cube, values, maps)``, the wall shear rates,
     :math:`\tau^3`, the integrand :math:`\tau^3\dot\gamma` of :math:`K` in :math:`x`
