@@ -54,7 +54,9 @@ row reports the median of the passes and the range of the per-pass ratios. A pas
 curve is one tubefsi call on the whole curve, or the baseline on the whole subsample. Before the
 passes, one untimed call on the same scene warms process-level and per-scene caches (the time
 of that first call is in the note). Where a cache keyed by parameter values could be hit across
-passes (Monte Carlo, random scenes, Carreau scalar, fit), every pass draws new parameters.
+passes (Monte Carlo, random scenes, Carreau scalar, fit), every pass draws new parameters. Each
+row draws from its own generator, seeded by its name: its scenes are the same whichever rows run
+before it (``--only``) and however many calls they make.
 
 Accuracy: the larger relative difference of pressure drop and inlet displacement from tubefsi's
 default answer (``solve`` with ``coupler="auto"``), maximised over the points compared; "ref"
@@ -72,6 +74,7 @@ import platform
 import statistics
 import subprocess
 import sys
+import zlib
 import time
 
 try:
@@ -565,27 +568,30 @@ ROWS = [
 ]
 
 
+#: The seed of every row's generator (with the row's name).
+SEED = 20240613
+
+
 def measure(sizes, only=None):
-    rng = np.random.default_rng(20240613)
     fluid, wall = power_law(), thick()
     q_top = 0.9 * tubefsi.max_flow_rate(fluid, wall, TUBE)
     q = np.linspace(q_top / sizes.points, q_top, sizes.points)
     q_cy = np.linspace(Q_CARREAU / sizes.points, Q_CARREAU, sizes.points)
     jobs = {
-        "thick curve": lambda row: flow_curve(row, fluid, wall, q, chapter_thick, sizes),
-        "thin curve": lambda row: flow_curve(
+        "thick curve": lambda row, rng: flow_curve(row, fluid, wall, q, chapter_thick, sizes),
+        "thin curve": lambda row, rng: flow_curve(
             row, fluid, walls["thin-neo-hookean"](shear_modulus=MU, thickness_convention="reference"), q,
             chapter_thin, sizes),
-        "monte carlo": lambda row: monte_carlo(row, sizes, rng),
-        "numpy loop": lambda row: numpy_loop(row, sizes, rng),
-        "random scenes": lambda row: random_row(row, sizes, rng),
-        "infeasible scenes": lambda row: infeasible_row(row, sizes, rng),
-        "carreau curve": lambda row: flow_curve(row, carreau_yasuda(), wall, q_cy, chapter_thick, sizes,
+        "monte carlo": lambda row, rng: monte_carlo(row, sizes, rng),
+        "numpy loop": lambda row, rng: numpy_loop(row, sizes, rng),
+        "random scenes": lambda row, rng: random_row(row, sizes, rng),
+        "infeasible scenes": lambda row, rng: infeasible_row(row, sizes, rng),
+        "carreau curve": lambda row, rng: flow_curve(row, carreau_yasuda(), wall, q_cy, chapter_thick, sizes,
                                                 baseline_fluid=fluid),
-        "carreau scalar": lambda row: carreau_scalar(row, sizes, rng),
-        "carreau scenes": lambda row: carreau_scenes_row(row, sizes, rng),
-        "fit": lambda row: fit_timing(row, sizes, rng),
-        "import": lambda row: imports(row, sizes),
+        "carreau scalar": lambda row, rng: carreau_scalar(row, sizes, rng),
+        "carreau scenes": lambda row, rng: carreau_scenes_row(row, sizes, rng),
+        "fit": lambda row, rng: fit_timing(row, sizes, rng),
+        "import": lambda row, rng: imports(row, sizes),
     }
     rows = []
     for key, shape, kind, unit, target in ROWS:
@@ -594,7 +600,9 @@ def measure(sizes, only=None):
         count = "10^4" if sizes.points == 10_000 else str(sizes.points)
         row = Row(key, shape.replace("{N}", count), kind, unit, target)
         try:
-            jobs[key](row)
+            # each row its own generator (seeded by its name): a row's draws do not depend on which
+            # rows ran before it or on how many calls they made
+            jobs[key](row, np.random.default_rng([SEED, zlib.crc32(key.encode())]))
         except Exception as exc:        # report the row as failed and go on with the others
             row.note = f"FAILED: {type(exc).__name__}: {exc}"[:300]
         if key == "carreau curve" and not row.note.startswith("FAILED"):
