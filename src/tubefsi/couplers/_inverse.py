@@ -70,6 +70,9 @@ _START_STEPS = 8
 #: A one-batch interval shorter than this (in v) tries degree 12 before degree 16: measured over
 #: the random scenes of benchmarks/speed.py, its tail met 1e-14 at every point below 0.19.
 _LOW_DEGREE, _LOW_DEGREE_REACH = 12, 0.15
+#: The degrees :func:`one_batch` tries in turn after that (or first, on a longer interval): a
+#: point whose interpolant's tail misses at one is tried at the next on the same interval.
+_HIGHER_DEGREES = (CHEBYSHEV_DEGREE, 24, 32)
 
 
 def _pick(value, index):
@@ -224,8 +227,10 @@ def one_batch(engine, scene, target, index, bound):
     positive target (separable rheology), on :math:`[0, 1.5 v_0]` (:math:`v_0` the linear guess:
     the root is within a few tens of per cent of it for a moderate strain), and on three times that
     where the integral fell short; never beyond ``bound``. An interval shorter than
-    ``_LOW_DEGREE_REACH`` is tried at degree 12 first, at degree 16 where that interpolant's tail
-    misses: which degree answers depends on the point alone."""
+    ``_LOW_DEGREE_REACH`` is tried at degree 12 first, then (or first, a longer one) at degrees
+    16, 24 and 32 in turn where the interpolant's tail misses (a wall whose slope varies over the
+    interval: a few tens of per cent of strain in a stiffening one): which degree answers depends
+    on the point alone."""
     target = np.asarray(target, dtype=float).ravel()
     index = np.asarray(index).ravel()
     v = np.zeros(target.size)
@@ -257,8 +262,14 @@ def one_batch(engine, scene, target, index, bound):
             good, short = attempt(low, _LOW_DEGREE)
             short_low = low[short]
             high = np.concatenate([high, low[~good & ~short]])     # the tail missed: degree 16
-        short_high = high[attempt(high, CHEBYSHEV_DEGREE)[1]] if high.size else high
-        shorter = np.concatenate([short_low, short_high])
+        shorter = [short_low]
+        for degree in _HIGHER_DEGREES:                             # the tail missed again: higher
+            if high.size == 0:
+                break
+            good, short = attempt(high, degree)
+            shorter.append(high[short])
+            high = high[~good & ~short]
+        shorter = np.concatenate(shorter)
         wider = np.minimum(3.0 * top[shorter], bound[shorter])
         keep = wider > top[shorter]
         top[shorter] = wider
