@@ -748,3 +748,67 @@ def test_solve_with_a_kinked_law():
     a = tubefsi.solve(law, wall, tube, flow_rate=q)
     back = tubefsi.solve(law, wall, tube, pressure_drop=a.pressure_drop)
     np.testing.assert_allclose(back.flow_rate, q, rtol=1e-11)
+
+
+# ---------------------------------------------------------------- laws that break their contract
+@attrs.frozen(kw_only=True)
+class _InfBand(Rheology):
+    """Newtonian, but an infinite stress for 0.5 < rate < 0.6 1/s (a user's law gone wrong)."""
+    eta: float = 0.01
+
+    def _stress(self, g):
+        return np.where((g > 0.5) & (g < 0.6), np.inf, self.eta * g)
+
+
+@attrs.frozen(kw_only=True)
+class _NanBelow(Rheology):
+    """Newtonian, but NaN below 1e-3 1/s."""
+    eta: float = 0.01
+
+    def _stress(self, g):
+        return np.where(g < 1e-3, np.nan, self.eta * g)
+
+
+@attrs.frozen(kw_only=True)
+class _FallingCross(Rheology):
+    """Cross with exponent 2 and eta_inf = 0.05 eta_0: its stress falls for rates of about 1-3 1/s
+    (it increases only where eta_inf > (eta_0 - eta_inf)/8)."""
+    eta0: float = 1.0
+    eta_inf: float = 0.05
+
+    def _stress(self, g):
+        return g * (self.eta_inf + (self.eta0 - self.eta_inf) / (1.0 + g * g))
+
+
+@attrs.frozen(kw_only=True)
+class _NegativeBand(Rheology):
+    """Newtonian, but a negative stress for 0.8 < rate < 1.2 1/s (a band narrower than the
+    quadratures' nodes can be missed by any sampling: this one spans several)."""
+    eta: float = 0.01
+
+    def _stress(self, g):
+        return np.where(np.abs(g - 1.0) < 0.2, -self.eta * g, self.eta * g)
+
+
+_BROKEN_WALL_TUBE = (dict(shear_modulus=5e3), dict(radius=5e-4, thickness=1.5e-4, length=2e-2))
+
+
+@pytest.mark.parametrize("law, load", [
+    (_InfBand(), dict(flow_rate=1e-8)), (_InfBand(), dict(pressure_drop=10.0)),
+    (_NanBelow(), dict(flow_rate=1e-8)), (_NanBelow(), dict(pressure_drop=10.0)),
+    (_FallingCross(), dict(flow_rate=1e-8)), (_FallingCross(), dict(flow_rate=1e-9)),
+    (_NegativeBand(), dict(flow_rate=1e-8)),
+], ids=["inf-flow", "inf-pressure", "nan-flow", "nan-pressure", "falling-1e-8", "falling-1e-9", "negative"])
+def test_a_law_that_is_not_a_rising_finite_stress_is_refused(law, load):
+    """A law written as a plain class whose stress is infinite, NaN, negative or falling over a band
+    of rates well below the wall's: an InvalidParameterError naming the rheology and the shear
+    rate, whether the band lies in the panels of the flow map below its start (used for K alone)
+    or in the generic flow function's quadrature. The flow map's K came from the panels and the
+    bound below them, the generic quadrature clipped 1 - (tau/tau_w)^3 at 0: a pressure drop 0.13 %
+    off (the infinite band), a flow rate of 0 at a feasible drop (NaN), a number at 1e-8 where
+    1e-9 was refused (falling), each without a word."""
+    from tubefsi.registry import walls
+    wall_kw, tube_kw = _BROKEN_WALL_TUBE
+    with pytest.raises(InvalidParameterError) as info:
+        tubefsi.solve(law, walls["thick-neo-hookean"](**wall_kw), tubefsi.Tube(**tube_kw), **load)
+    assert info.value.parameter == "rheology" and "shear rate" in str(info.value)

@@ -124,6 +124,11 @@ def rate_natural_rate(rheology, wall_stress, excess=None, *, rtol: float = RTOL)
     return out.reshape(shape), (res, live)
 
 
+#: How far above the wall stress :func:`stress_natural_rate` lets the stress at a lower rate be
+#: (the wall rate is a root of tau(rate) = tau_w to a few eps): beyond it, a law that does not increase.
+_RATIO_SLACK = 1e-9
+
+
 def stress_natural_rate(rheology, wall_rate, wall_stress, *, rtol: float = RTOL):
     r""":math:`\Gamma` from a stress-natural law, by parts in the shear rate:
     :math:`\Gamma = \tfrac43\dot\gamma_w\int_0^1\bigl[1 - (\tau(\dot\gamma_w t)/\tau_w)^3\bigr]dt`
@@ -139,9 +144,23 @@ def stress_natural_rate(rheology, wall_rate, wall_stress, *, rtol: float = RTOL)
     rl, tl = rw[live], tw[live]
 
     def f(t, idx):
-        ratio = rheology._stress(_positive(rl[idx, None] * t)) / tl[idx, None]
+        exact = rl[idx, None] * t
+        rate = _positive(exact)
+        ratio = np.asarray(rheology._stress(rate), dtype=float) / tl[idx, None]
         # tau(rate_w t) <= tau_w in the tube: a ratio a rounding above 1 (the wall rate is a root
-        # of tau(rate) = tau_w to a few eps) counts nothing, not a negative flow
+        # of tau(rate) = tau_w to a few eps) counts nothing, not a negative flow; a ratio well above
+        # 1, not finite or negative is a law that does not increase, or has no finite stress there:
+        # refused, not clipped into a wrong flow rate (except where the rate was raised to the
+        # smallest normal double, above the wall's own: a law steep enough there clips to 0)
+        bad = ~((ratio >= 0.0) & (ratio <= 1.0 + _RATIO_SLACK)) & (rate == exact)
+        if bad.any():
+            row, col = (int(k[0]) for k in np.nonzero(bad))
+            point = int(idx[row])
+            raise InvalidParameterError(
+                "rheology", "a finite, positive shear stress increasing with the shear rate", rheology,
+                f"at the shear rate {float(np.broadcast_to(rate, ratio.shape)[row, col]):.6g} 1/s its stress is "
+                f"{float(ratio[row, col] * tl[point]):.6g} Pa, not between 0 and the {float(tl[point]):.6g} Pa "
+                f"of the higher rate {float(rl[point]):.6g} 1/s")
         return np.maximum(1.0 - ratio * ratio * ratio, 0.0)
 
     # 1 - ratio^3 is rounded to a few eps absolute where ratio ~ 1: near yield it is small

@@ -34,6 +34,7 @@ import math
 
 import numpy as np
 
+from ..errors import InvalidParameterError
 from ..fields import _array_fields, _replace
 from ..numerics.cache import keep_on_class
 from ..numerics.kernels import blocked_matmul
@@ -115,15 +116,41 @@ def _panel_nodes(j0, count):
 def _law_panels(rheology, x0, j0, count):
     r"""The law on the nodes of panels ``j0 .. j0 + count - 1`` (panel j spans
     ``[x0 + j W, x0 + (j + 1) W]``; ``j0 < 0`` below the map), each point's (its array parameters
-    and ``x0`` one per point), in one batch: ``(g, cube, values, maps)``, the wall shear rates,
-    :math:`\tau^3`, the integrand :math:`\tau^3\dot\gamma` of :math:`K` in :math:`x`
+    and ``x0`` one per point), in one batch: ``(g, tau, cube, values, maps)``, the wall shear
+    rates, the stresses, :math:`\tau^3`, the integrand :math:`\tau^3\dot\gamma` of :math:`K` in :math:`x`
     (``(nodes, count, P)``) and :func:`_k_maps` applied to it (``(rows, count, P)``)."""
     g = np.exp(x0 + _panel_nodes(j0, count))
     tau = PanelMap._tau(rheology, g)
     cube = tau * tau * tau
     values = cube * g
     maps = blocked_matmul(_k_maps(DEGREE), values.reshape(DEGREE + 1, count * x0.size)).reshape(-1, count, x0.size)
-    return g, cube, values, maps
+    return g, tau, cube, values, maps
+
+
+def _check_increasing(rheology, g, tau):
+    """Raise :class:`~tubefsi.errors.InvalidParameterError` where the law's stress ``tau`` (at the
+    shear rates ``g``, ``(nodes, panels, P)``, panels in order along the rate) is not finite,
+    negative, or falls from one node to the next: the panels below a map are
+    used for :math:`K` alone, and no other check looks at them (a decreasing band there would
+    give a flow rate without a word)."""
+    # (a panel's last node is the next one's first, to the bit: rising within each panel, from a
+    # non-negative first value to a finite last, is rising all along; a NaN fails a comparison)
+    fine = (tau[0, 0] >= 0.0) & (tau[1:] >= tau[:-1]).all(axis=(0, 1)) & np.isfinite(tau[-1, -1])
+    if fine.all():
+        return
+    along = np.ascontiguousarray(tau.transpose(1, 0, 2)).reshape(-1, tau.shape[-1])   # in x order
+    p = int(np.flatnonzero(~fine)[0])
+    column = along[:, p]
+    wrong = ~(np.isfinite(column) & (column >= 0.0))                  # the first bad node: a stress
+    wrong[1:] |= ~(column[1:] >= column[:-1]) & ~wrong[:-1]          # not finite or negative, or a fall
+    at = int(np.flatnonzero(wrong)[0])
+    rate = float(np.ascontiguousarray(g.transpose(1, 0, 2)).reshape(-1, g.shape[-1])[at, p])
+    stress = float(column[at])
+    why = ("not a finite stress" if not math.isfinite(stress) else "negative" if stress < 0.0 else
+           f"below the {float(column[at - 1]):.6g} Pa at a lower rate")
+    raise InvalidParameterError("rheology", "a finite, positive shear stress increasing with the shear rate",
+                                rheology, f"its stress at the shear rate {rate:.6g} 1/s is {stress:.6g} Pa: {why}"
+                                + (f" (point {p} of the call)" if tau.shape[-1] > 1 else ""))
 
 
 def _k_below(rheology, x0, values, maps):
@@ -303,7 +330,8 @@ class PanelMap:
             batch = self._batch(live, 0, y_hi)
             # the panels below the map (for K at its start) and its first batch: one law call
             law = _law_panels(rheology, self.x0, -_BELOW, _BELOW + batch)
-            K, err_k = _k_below(rheology, self.x0, law[2][:, :_BELOW], law[3][:, :_BELOW])
+            _check_increasing(rheology, law[0], law[1])
+            K, err_k = _k_below(rheology, self.x0, law[3][:, :_BELOW], law[4][:, :_BELOW])
             self.ok &= np.isfinite(K) & (K > 0)
             live = np.nonzero(self.ok)[0]
             law = tuple(a[:, _BELOW:] if live.size == n else a[:, _BELOW:, live] for a in law)
@@ -329,7 +357,7 @@ class PanelMap:
         the points still live after them (every panel good, y_hi not reached)."""
         y_maps = _y_maps(DEGREE)
         p = live.size
-        g, cube, values, maps = _law_panels(_at(rheology, live), self.x0[live], j0, batch) if law is None else law
+        g, _, cube, values, maps = _law_panels(_at(rheology, live), self.x0[live], j0, batch) if law is None else law
         cumulative = maps[3:DEGREE + 4]
         # K's error at each node: the panel's start's, the tail of the integrand's interpolant
         # (a tail at the rounding of the values, 32 eps of their largest, is noise), and the
