@@ -16,10 +16,13 @@ needs no inner inverse:
   :math:`\tau_w = \tau(e^x)` explicit and, integrating the Rabinowitsch–Mooney integral by parts,
   :math:`\Gamma = \tfrac43\bigl(\dot\gamma_w - K(\dot\gamma_w)/\tau_w^3\bigr)` with the cumulative
   :math:`K(\dot\gamma) = \int_0^{\dot\gamma}\tau^3\,dg`. :class:`PanelMap` takes :math:`K` at the
-  bottom of the range of each fluid once (error-controlled quadrature from 0), then *upward* on
-  unit panels in :math:`x` from Chebyshev–Lobatto values and the integration matrix (no
-  difference of nearly equal integrals), and inverts :math:`y(x)` by Newton's method on each
-  panel's interpolant; :math:`\tau_w = \tau(e^x)` is then evaluated exactly.
+  bottom of the range of each fluid from unit panels below it and a bound on the rest
+  (:func:`_k_below`; the error-controlled quadrature from 0 where that bound is too loose), then
+  *upward* on unit panels in :math:`x` from Chebyshev–Lobatto values and the integration matrix
+  (no difference of nearly equal integrals), and inverts :math:`y(x)` from the rational
+  interpolant of its nodes, then Newton's method on each panel's interpolant (both by the
+  barycentric formula); :math:`\tau_w = \tau(e^x)` is then evaluated exactly. The panels below
+  also check the law: a stress that is not finite, negative or falling there is refused.
 
 Every answer carries its own check: a panel's Chebyshev tails (of :math:`\tau^3\dot\gamma` and of
 :math:`y`) and the quadrature's estimate, a Newton iteration's convergence. A point that misses
