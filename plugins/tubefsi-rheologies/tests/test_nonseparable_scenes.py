@@ -295,6 +295,25 @@ def test_profiles_against_mpmath(name, wall_name):
                 assert rel_err(speed[k, i], v) < TOL, ("velocity", k, i)
 
 
+@pytest.mark.parametrize("name, wall_name", [("carreau-yasuda", "thick neo-Hookean"), ("cross", "stiff thin linear")])
+def test_a_long_profile_against_mpmath(name, wall_name):
+    """A profile at 400 sections of one tube (a fluid of scalar parameters, one flow rate): ln v as
+    a function of ln(L - z) interpolated between direct solves (as a long flow curve is), the
+    pressure and the radius at five sections, the outlet's last micrometre among them, against
+    ``reference.rheology.section`` (30 digits) to the contract."""
+    wall, tb, ref_wall, flow_rates = WALLS[wall_name]
+    s = SETS[name][0]
+    tube = tubefsi.Tube(radius=RADIUS, thickness=tb * RADIUS, length=LENGTH)
+    sol = tubefsi.solve(rheologies[name](**s), wall, tube, flow_rate=flow_rates[-1])
+    z = np.linspace(0.0, LENGTH * (1 - 5e-5), 400)
+    pressure, radius = sol.pressure(z), sol.radius(z)
+    ref = _ref_fluid(name, s)
+    for k in (1, 133, 271, 398, 399):
+        x, lam = section(ref, ref_wall, RADIUS, LENGTH - z[k], flow_rates[-1], radius[k] / RADIUS)
+        assert rel_err(pressure[k], ref_wall.P(lam)) < TOL, ("pressure", k)
+        assert rel_err(radius[k], RADIUS * lam) < TOL, ("radius", k)
+
+
 # three random Carreau-Yasuda scenes of benchmarks/speed.py (seed 0) at large strain (inlet hoop
 # strain 1.35, 1.81, 2.95) in thick neo-Hookean walls: (eta0, eta_inf, lambda, n, a, mu, radius,
 # thickness, length, q)

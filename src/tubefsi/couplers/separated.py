@@ -40,6 +40,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..fields import _array_fields
 from ..numerics.chebyshev import fit_piecewise
 from ..numerics.kernels import EPS
 from ..numerics.quadrature import Integral, adaptive_to_pole, integrate_graded, warn_unconverged
@@ -70,6 +71,35 @@ _CURVE_TOL = 1e-13
 
 #: An :class:`~tubefsi.numerics.quadrature.Integral` of values known exactly (a closed form).
 exact = Integral.exact
+
+
+def _one_section_law(pts: Points) -> bool:
+    """Whether every point of ``pts`` has the same tube, wall and fluid (each a scalar)."""
+    quantities = (pts.radius, pts.length, pts.tb, pts.outlet_stretch, pts.outlet_pressure, pts.log_stretch_max)
+    return all(np.ndim(x) == 0 for x in quantities) and not any(
+        np.ndim(getattr(model, name)) for model in (pts.wall, pts.rheology) for name in _array_fields(type(model)))
+
+
+def _interpolated_log_stretch(log_x, solve):
+    r""":math:`v` at the points ``log_x`` from the interpolant of :math:`\ln v` over their range
+    (:func:`~tubefsi.numerics.chebyshev.fit_piecewise`, degree 16 on panels bisected to
+    ``_CURVE_TOL``), its nodes and check points answered by ``solve(x)`` (``(v, ok, final)`` of
+    direct solves at ``x = exp(log_x)``); None where the range is a point or the fit is not
+    accepted. Which route a point takes depends on the call's values alone."""
+    lo, hi = float(log_x.min()), float(log_x.max())
+    if not hi > lo:
+        return None
+
+    def log_v(x):
+        v, ok, final = solve(np.exp(x))
+        good = ok & np.asarray(final.converged) & (v > 0)
+        return np.where(good, np.log(np.where(v > 0, v, 1.0)), np.nan)
+
+    with np.errstate(all="ignore"):
+        interpolant, error = fit_piecewise(log_v, lo, hi, degree=16, tol=_CURVE_TOL, panels=2, max_panels=64)
+    if interpolant is None:
+        return None
+    return np.exp(interpolant(np.clip(log_x, lo, hi)))
 
 
 def _at_rest(pts, state, z, strain, rise):
@@ -429,24 +459,22 @@ class SeparatedVariables(Coupler):
         to 1e-13 in :math:`\ln v`: a few hundred direct solves serve the whole curve. None where it
         cannot be accepted (the direct path then serves every point). Which route a point takes
         depends on the call's flow rates alone."""
-        log_q = np.log(q)
-        lo, hi = float(log_q.min()), float(log_q.max())
-        if not hi > lo:
-            return None
         length = np.full(1, float(scene.tube.length))
 
-        def log_v(x):
-            flow = np.exp(x)
-            ids = np.zeros(flow.size, dtype=int)
-            v, ok, final = self._solve_J(scene, np.broadcast_to(length, flow.shape), ids, flow)
-            good = ok & np.asarray(final.converged) & (v > 0)
-            return np.where(good, np.log(np.where(v > 0, v, 1.0)), np.nan)
+        def solve(flow):
+            return self._solve_J(scene, np.broadcast_to(length, flow.shape), np.zeros(flow.size, dtype=int), flow)
 
-        with np.errstate(all="ignore"):
-            interpolant, error = fit_piecewise(log_v, lo, hi, degree=16, tol=_CURVE_TOL, panels=2, max_panels=64)
-        if interpolant is None:
-            return None
-        return np.exp(interpolant(np.clip(log_q, lo, hi)))
+        return _interpolated_log_stretch(np.log(q), solve)
+
+    def _profile_curve(self, scene: Scene, q, target, upper):
+        r"""The log-stretches of many sections of one scene without a table (a non-separable fluid
+        at the flow rate ``q``): :math:`\ln v` as a function of :math:`\ln(L - z)`, the target of
+        :math:`H(v; q) = L - z`, is smooth, and is interpolated as :meth:`_curve` interpolates a
+        flow curve. None where it cannot be accepted (each section is then solved directly)."""
+        def solve(t):
+            return self._solve_J(scene, t, np.zeros(t.size, dtype=int), np.full(t.size, q), upper=np.full(t.size, upper))
+
+        return _interpolated_log_stretch(np.log(target), solve)
 
     def pressure_controlled(self, scene: Scene, pressure_drop) -> State:
         """Solve for the flow rate at each pressure drop (flat array, one per point)."""
@@ -510,8 +538,16 @@ class SeparatedVariables(Coupler):
         if np.any(direct):
             sub = np.flatnonzero(direct)
             upper = (v_in[sub] if np.ndim(v_in) else v_in) * (1 + 1e-12) + 1e-300
-            v[sub], ok, final = self._solve_J(scene, target[sub], sub, q[sub] if np.ndim(q) else q, upper=upper)
-            warn_unconverged("the separated-variables integral", final, where=ok)
+            curve = None
+            flows = np.broadcast_to(q, target.shape)[sub]
+            if sub.size >= _CURVE_MIN_POINTS and not scene.rheology.separable and _one_section_law(pts) \
+                    and np.all(flows == flows[0]):       # (one tube, one flow rate: many sections)
+                curve = self._profile_curve(scene, float(flows[0]), target[sub], float(np.max(upper)))
+            if curve is not None:
+                v[sub] = curve
+            else:
+                v[sub], ok, final = self._solve_J(scene, target[sub], sub, q[sub] if np.ndim(q) else q, upper=upper)
+                warn_unconverged("the separated-variables integral", final, where=ok)
         rest = np.isnan(rise)
         if np.any(rest):                     # the directly solved points, the inlet itself
             sub = np.flatnonzero(rest)
