@@ -231,7 +231,7 @@ def test_barycentric_rule_against_numpy_chebyshev(degree):
     Chebyshev coefficients, its antiderivative at the nodes and at s_* (numpy's chebfit, chebint
     and chebval through the same points), and the n + 2 weights interpolate a polynomial of
     degree n + 1 exactly (against numpy's polyval off the nodes)."""
-    from tubefsi.numerics.spectral import _barycentric, _barycentric_rule, lobatto_rule
+    from tubefsi.numerics.spectral import _barycentric_rule, barycentric, lobatto_rule
     matrix, nodes, weights, lobatto = _barycentric_rule(degree)
     rule = lobatto_rule(degree)
     y = np.random.default_rng(5).standard_normal(degree + 1)
@@ -242,9 +242,9 @@ def test_barycentric_rule_against_numpy_chebyshev(degree):
     np.testing.assert_allclose(rows[3:], np.polynomial.chebyshev.chebval(nodes, anti), rtol=0, atol=1e-13)
     poly = np.random.default_rng(6).standard_normal(degree + 2)      # degree n + 1, on [-1, 1]
     at = np.array([-0.97, -0.31, 0.013, 0.55, 0.999])
-    got = _barycentric(weights, at[:, None] - nodes, np.polynomial.polynomial.polyval(nodes, poly))
+    got = barycentric(weights, at[:, None] - nodes, np.polynomial.polynomial.polyval(nodes, poly))
     np.testing.assert_allclose(got, np.polynomial.polynomial.polyval(at, poly), rtol=0, atol=1e-11)
-    got = _barycentric(lobatto, at[:, None] - rule.t, np.polynomial.polynomial.polyval(rule.t, poly[:-1]))
+    got = barycentric(lobatto, at[:, None] - rule.t, np.polynomial.polynomial.polyval(rule.t, poly[:-1]))
     np.testing.assert_allclose(got, np.polynomial.polynomial.polyval(at, poly[:-1]), rtol=0, atol=1e-11)
 
 

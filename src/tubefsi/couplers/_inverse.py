@@ -657,7 +657,7 @@ def _one_batch_mapped(engine, scene, target, index, q, bound, v, solved, live, w
         rough = rough[0]
     else:
         rough = np.asarray(pts.rheology._stress(np.exp(y_out)), dtype=float) + zeros
-    slope0 = np.asarray(pts.wall._log_slope(pts.outlet_stretch, pts.tb), dtype=float) + zeros
+    slope0 = np.asarray(engine._slope(pts, 0.0), dtype=float) + zeros           # (at the outlet, u = 0)
     # (bound is finite: a NaN guess stays NaN, and fails the test below)
     top = np.minimum(1.5 * target * 2.0 * rough / ((pts.radius * pts.outlet_stretch) * slope0), bound)
     live = live[top[live] > 0]
@@ -666,11 +666,10 @@ def _one_batch_mapped(engine, scene, target, index, q, bound, v, solved, live, w
     for degree in _MAPPED_DEGREES:
         if live.size == 0:
             break
-        every = live.size == target.size           # (no gathers)
-        f, vouched = _mapped_integrand(engine, pts if every else scene.at(index[live]), y_out if every else y_out[live],
-                                       top if every else top[live], which)
-        x, good, short = solve_integral(f, target if every else target[live], top if every else top[live],
-                                        rtol=rtol, degree=degree, method="barycentric")
+        every = live.size == target.size
+        sel = slice(None) if every else live       # (every point: views, no gathers)
+        f, vouched = _mapped_integrand(engine, pts if every else scene.at(index[live]), y_out[sel], top[sel], which)
+        x, good, short = solve_integral(f, target[sel], top[sel], rtol=rtol, degree=degree, method="barycentric")
         good &= vouched
         v[live[good]] = x[good]
         solved[live[good]] = True
@@ -712,12 +711,12 @@ def _mapped_integrand(engine, sub, y_out, top, which):
     (updated by each call); ``which``: the fluid's :func:`~tubefsi.rheology.flow_map.kind`."""
     fmap = flow_map.flow_map(sub.rheology, y_out - 3.0 * top - 1e-9, y_out + 1e-9, which=which)
     vouched = np.ones(y_out.size, dtype=bool)
+    a_out = sub.radius * sub.outlet_stretch
 
     def f(u, i):
         tau, ok, _ = fmap.wall_stress(y_out - 3.0 * u)
         vouched[:] &= ok.all(axis=0)
-        stretch = engine.stretch_at(sub, u)
-        return sub.wall._log_slope(stretch, sub.tb) * (sub.radius * stretch) / (2.0 * tau)
+        return engine._slope(sub, u) * (a_out * np.exp(u)) / (2.0 * tau)
 
     return f, vouched
 

@@ -40,7 +40,6 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..fields import _array_fields
 from ..numerics.chebyshev import fit_piecewise
 from ..numerics.kernels import EPS
 from ..numerics.quadrature import Integral, adaptive_to_pole, integrate_graded, warn_unconverged
@@ -71,13 +70,6 @@ _CURVE_TOL = 1e-13
 
 #: An :class:`~tubefsi.numerics.quadrature.Integral` of values known exactly (a closed form).
 exact = Integral.exact
-
-
-def _one_section_law(pts: Points) -> bool:
-    """Whether every point of ``pts`` has the same tube, wall and fluid (each a scalar)."""
-    quantities = (pts.radius, pts.length, pts.tb, pts.outlet_stretch, pts.outlet_pressure, pts.log_stretch_max)
-    return all(np.ndim(x) == 0 for x in quantities) and not any(
-        np.ndim(getattr(model, name)) for model in (pts.wall, pts.rheology) for name in _array_fields(type(model)))
 
 
 def _interpolated_log_stretch(log_x, solve):
@@ -410,10 +402,7 @@ class SeparatedVariables(Coupler):
             else:
                 v[served], rise[served] = v_t[served], rise_t[served]
             todo &= ~served
-        if todo.all():
-            target = self.target(pts, q) + 0.0 * q
-        else:
-            target = np.where(todo, self.target(pts, np.where(todo, q, 1.0)), 0.0) if todo.any() else todo * 0.0
+        target = np.where(todo, self.target(pts, np.where(todo, q, 1.0)), 0.0) if todo.any() else todo * 0.0
         solved = self._flow_direct(scene, q, target, todo, v)
         feasible = None
         if not solved.ok.all():
@@ -540,7 +529,7 @@ class SeparatedVariables(Coupler):
             upper = (v_in[sub] if np.ndim(v_in) else v_in) * (1 + 1e-12) + 1e-300
             curve = None
             flows = np.broadcast_to(q, target.shape)[sub]
-            if sub.size >= _CURVE_MIN_POINTS and not scene.rheology.separable and _one_section_law(pts) \
+            if sub.size >= _CURVE_MIN_POINTS and scene.size == 1 and not scene.rheology.separable \
                     and np.all(flows == flows[0]):       # (one tube, one flow rate: many sections)
                 curve = self._profile_curve(scene, float(flows[0]), target[sub], float(np.max(upper)))
             if curve is not None:

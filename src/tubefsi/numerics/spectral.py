@@ -16,7 +16,8 @@ import numpy as np
 
 from .kernels import blocked_matmul
 
-__all__ = ["solve_integral", "CHEBYSHEV_DEGREE", "LOBATTO_NODES", "lobatto_rule", "clenshaw", "hermite_root"]
+__all__ = ["solve_integral", "CHEBYSHEV_DEGREE", "LOBATTO_NODES", "lobatto_rule", "clenshaw", "hermite_root",
+           "lobatto_weights", "barycentric", "at_nodes"]
 
 #: Degree of the Chebyshev interpolant of :func:`solve_integral` (17 Chebyshev–Lobatto nodes).
 CHEBYSHEV_DEGREE = 16
@@ -132,19 +133,41 @@ def _barycentric_rule(n):
     np.fill_diagonal(gaps, 1.0)
     weights = 1.0 / np.prod(gaps, axis=1)
     weights /= np.abs(weights).max()
-    lobatto = (-1.0) ** np.arange(n + 1)
-    lobatto[[0, -1]] *= 0.5
-    for constant in (matrix, nodes, weights, lobatto):
+    for constant in (matrix, nodes, weights):
         constant.setflags(write=False)
-    return matrix, nodes, weights, lobatto
+    return matrix, nodes, weights, lobatto_weights(n)
 
 
-def _barycentric(weights, offsets, values):
+@functools.lru_cache(maxsize=4)
+def lobatto_weights(n):
+    """The barycentric weights of the ``n + 1`` Chebyshev–Lobatto nodes: :math:`(-1)^i`, halved
+    at the ends (Berrut & Trefethen, *SIAM Review* 46, 2004; a common factor cancels; a
+    constant, read-only)."""
+    w = (-1.0) ** np.arange(n + 1)
+    w[[0, -1]] *= 0.5
+    w.setflags(write=False)
+    return w
+
+
+def barycentric(weights, offsets, values):
     """The barycentric formula (second form) along the last axis: the interpolant of ``values``
     at the points whose offsets from the nodes are ``offsets`` (NaN where a point is on a node,
-    an offset exactly 0: the caller takes the node's value there)."""
+    an offset exactly 0: :func:`at_nodes` takes the node's value there). With the Lobatto weights
+    at mapped nodes, the linear rational interpolant of Baltensperger, Berrut & Noël (*Math.
+    Comp.* 68, 1999). Sums along the last axis: in one order whatever the leading dimensions."""
     ratio = weights / offsets
     return (ratio * values).sum(axis=-1) / ratio.sum(axis=-1)
+
+
+def at_nodes(on_node, value, node_values):
+    """``value`` where no node is hit, else the value at the node hit: the barycentric formula's
+    0/0 there. ``on_node`` ``(..., nodes)``, at most one True per row; ``node_values`` of its
+    shape, or the nodes' own values ``(nodes,)``."""
+    if not on_node.any():
+        return value
+    first = on_node.argmax(axis=-1)
+    at = node_values[first] if node_values.ndim == 1 else np.take_along_axis(node_values, first[..., None], axis=-1)[..., 0]
+    return np.where(on_node.any(axis=-1), at, value)
 
 
 def solve_integral(f, target, upper, *, rtol=1e-14, values=None, degree=CHEBYSHEV_DEGREE, method="clenshaw"):
@@ -298,20 +321,18 @@ def _root_barycentric(degree, known, y, h, goal):
     # falls exponentially with the degree (Baltensperger, Berrut & Noël, Math. Comp. 68, 1999):
     # a start, which Newton's method checks
     with np.errstate(all="ignore"):
-        t = np.fmin(np.fmax(_barycentric(lobatto, goal[:, None] - j_nodes, rule.t), -1.0), 1.0)   # (a NaN: -1)
+        t = np.fmin(np.fmax(barycentric(lobatto, goal[:, None] - j_nodes, rule.t), -1.0), 1.0)   # (a NaN: -1)
         # Newton on the interpolant: quadratic, so a step below 1e-9 leaves an error of order
         # (f'/f) 1e-18 after it, and is the last one
         moving = np.ones(goal.size, dtype=bool)
         for _ in range(8):
             offsets = t[:, None] - nodes
-            integral = _barycentric(weights, offsets, values_j)
-            integrand = _barycentric(lobatto, offsets[:, :-1], values_f)
+            integral = barycentric(weights, offsets, values_j)
+            integrand = barycentric(lobatto, offsets[:, :-1], values_f)
             on_node = offsets[:, :-1] == 0.0
             if on_node.any():               # (the formula's 0/0: the node's own values)
-                hit, first = on_node.any(axis=1), on_node.argmax(axis=1)
-                rows = np.arange(goal.size)
-                integral = np.where(hit, j_nodes[rows, first], integral)
-                integrand = np.where(hit, values_f[rows, first], integrand)
+                integral = at_nodes(on_node, integral, j_nodes)
+                integrand = at_nodes(on_node, integrand, values_f)
             step = np.where(moving, (integral - goal) / (integrand * h), 0.0)
             t = np.fmin(np.fmax(t - step, -1.0), 1.0)
             moving &= ~(np.abs(step) <= 1e-9)

@@ -42,7 +42,7 @@ from ..fields import _array_fields, _replace
 from ..numerics.cache import keep_on_class
 from ..numerics.kernels import blocked_matmul
 from ..numerics.quadrature import unit_integral
-from ..numerics.spectral import lobatto_rule
+from ..numerics.spectral import at_nodes, barycentric, lobatto_rule, lobatto_weights
 
 __all__ = ["kind", "ClosedMap", "PanelMap", "flow_map", "wall_stress", "log_rate_bracket"]
 
@@ -74,16 +74,6 @@ def _y_maps(degree):
     maps = np.vstack([to_coef[-3:], at_nodes])
     maps.setflags(write=False)
     return maps
-
-
-@functools.lru_cache(maxsize=2)
-def _lobatto_weights(degree):
-    """The barycentric weights of the Chebyshev-Lobatto nodes: :math:`(-1)^i`, halved at the ends
-    (Berrut & Trefethen, *SIAM Review* 46, 2004; a common factor cancels)."""
-    w = (-1.0) ** np.arange(degree + 1)
-    w[[0, -1]] *= 0.5
-    w.setflags(write=False)
-    return w
 
 
 @functools.lru_cache(maxsize=2)
@@ -337,7 +327,8 @@ class PanelMap:
             K, err_k = _k_below(rheology, self.x0, law[3][:, :_BELOW], law[4][:, :_BELOW])
             self.ok &= np.isfinite(K) & (K > 0)
             live = np.nonzero(self.ok)[0]
-            law = tuple(a[:, _BELOW:] if live.size == n else a[:, _BELOW:, live] for a in law)
+            sel = slice(None) if live.size == n else live          # (every point: views, no gathers)
+            law = tuple(a[:, _BELOW:, sel] for a in law)
             j = 0
             while live.size and j < MAX_PANELS:
                 live = self._panels(rheology, live, j, batch, K, err_k, y_lo, y_hi, x_lo is None, law)
@@ -373,8 +364,8 @@ class PanelMap:
         own = np.where(w_tail <= (0.5 * WIDTH) * 32.0 * _EPS * values[-1], 0.0, w_tail) + 2.0 * _EPS * maps[DEGREE + 4:]
         # K and its error at each panel's start, carried up from the last: running sums along
         # the panels (in order, as panel by panel)
-        every = p == K.size                                         # (no gathers)
-        k_start, e_start = (K, err_k) if every else (K[live], err_k[live])
+        sel = slice(None) if p == K.size else live                  # (every point: views, no gathers)
+        k_start, e_start = K[sel], err_k[sel]
         k_nodes = np.concatenate([k_start[None], cumulative[-1, :-1]]).cumsum(axis=0) + cumulative
         own += 2.0 * _EPS * k_nodes
         err_nodes = np.concatenate([e_start[None], own[-1, :-1]]).cumsum(axis=0) + own
@@ -393,7 +384,7 @@ class PanelMap:
             (err_y + tail <= TOL + 32.0 * _EPS * np.abs(y).max(axis=0))
         # each point takes its panels in order until one fails or reaches y_hi (as one by one):
         # panel b where every panel before it was good and below y_hi
-        goes_on = good & (y[-1] < (y_hi if every else y_hi[live]))  # (batch, P): the next one is built
+        goes_on = good & (y[-1] < y_hi[sel])                       # (batch, P): the next one is built
         taken = np.ones((batch, p), dtype=bool)
         if batch > 1 and not goes_on[:-1].all():
             taken[1:] = np.logical_and.accumulate(goes_on[:-1], axis=0)
@@ -450,15 +441,14 @@ class PanelMap:
             nodes = self.nodes[j, cols]                             # (rows, P, 2, DEGREE + 1)
             z_nodes, slopes = nodes[..., 0, :], nodes[..., 1, :]    # the values the panel interpolated
             z = y2 - self.offset[j, cols]                           # (exact within a factor 2: Sterbenz)
-            weights = _lobatto_weights(DEGREE)
+            weights = lobatto_weights(DEGREE)
             # the start: t as a function of z through the nodes (z_i, t_i), by the linear rational
             # interpolant with the Lobatto nodes' weights at the z_i, their image under the smooth
             # increasing y; its error falls exponentially with the degree (Baltensperger, Berrut &
             # Noël, Math. Comp. 68, 1999): a start, which Newton's method below checks
             # (a target on a node exactly gives 0/0: the panel's bottom instead, Newton's start;
             # fmax and fmin drop a NaN)
-            ratio = weights / (z[..., None] - z_nodes)
-            t = np.fmin(np.fmax((ratio * t_nodes).sum(axis=-1) / ratio.sum(axis=-1), -1.0), 1.0)
+            t = np.fmin(np.fmax(barycentric(weights, z[..., None] - z_nodes, t_nodes), -1.0), 1.0)
             # Newton on the interpolant, quadratic: after a step below 1e-9 the error is ~1e-18 and
             # that point stops (its iterations do not depend on its neighbours'). The interpolant
             # and its derivative (degree n - 1: exact from its values at the nodes) by the
@@ -472,8 +462,8 @@ class PanelMap:
                 slope = (ratio * slopes).sum(axis=-1) / total
                 on_node = offset_t == 0.0
                 if on_node.any():
-                    value = _at_nodes(on_node, value, z_nodes)
-                    slope = _at_nodes(on_node, slope, slopes)
+                    value = at_nodes(on_node, value, z_nodes)
+                    slope = at_nodes(on_node, slope, slopes)
                 # (a point that has converged keeps its t: its bits do not depend on its neighbours';
                 # a NaN step leaves it moving, and unvouched after the last iteration)
                 step = np.where(moving, (value - z) / slope, 0.0)
@@ -485,17 +475,6 @@ class PanelMap:
             x = self.x0 + WIDTH * (j + 0.5 * (t + 1.0))   # (t = -1: the panel's start)
             tau = self._tau(self.rheology, np.exp(x))            # (the law's parameters: one per point, the last axis)
         return tau.reshape(shape), inside.reshape(shape), x.reshape(shape)
-
-
-def _at_nodes(on_node, value, node_values):
-    """``value`` where no node is hit, else the value at the node hit: the barycentric formula's
-    0/0 there. ``on_node`` ``(..., nodes)``, at most one True per row; ``node_values`` of its
-    shape, or the nodes' own values ``(nodes,)``."""
-    if not on_node.any():
-        return value
-    first = on_node.argmax(axis=-1)
-    at = node_values[first] if node_values.ndim == 1 else np.take_along_axis(node_values, first[..., None], axis=-1)[..., 0]
-    return np.where(on_node.any(axis=-1), at, value)
 
 
 def flow_map(rheology, y_lo, y_hi, x_lo=None, which=None):
